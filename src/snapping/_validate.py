@@ -1,0 +1,75 @@
+"""Input checks shared by every public function.
+
+Every check raises :class:`SnappingInputError` (a ``ValueError``) whose message
+names the parameter, the offending value and the valid range, so that the
+command line can print it as one line and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+__all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer"]
+
+
+class SnappingInputError(ValueError):
+    """Bad input to a public function: names the parameter, the value and the valid range."""
+
+
+def _as_float(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        try:
+            import numpy as np
+
+            if isinstance(value, np.ndarray) and value.ndim == 0:
+                value = value.item()
+            else:
+                raise TypeError
+        except TypeError:
+            raise SnappingInputError(
+                f"{name}={value!r} is not a real number (expected a finite float)"
+            ) from None
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise SnappingInputError(f"{name}={value!r} is not a real number (expected a finite float)")
+    x = float(value)
+    if not math.isfinite(x):
+        raise SnappingInputError(f"{name}={x!r} must be a finite real number")
+    return x
+
+
+def real(name: str, value) -> float:
+    """Return ``value`` as a finite float, or raise naming ``name``."""
+    return _as_float(name, value)
+
+
+def positive(name: str, value) -> float:
+    """Return ``value`` as a float in (0, inf), or raise naming ``name``."""
+    x = _as_float(name, value)
+    if not x > 0.0:
+        raise SnappingInputError(f"{name}={x!r} is out of range: must be > 0")
+    return x
+
+
+def open_interval(name: str, value, lo: float, hi: float) -> float:
+    """Return ``value`` as a float in the open interval (lo, hi), or raise naming ``name``."""
+    x = _as_float(name, value)
+    if not lo < x < hi:
+        raise SnappingInputError(f"{name}={x!r} is out of range: must lie in the open interval ({lo:g}, {hi:g})")
+    return x
+
+
+def integer(name: str, value, minimum: int = 1, maximum: int | None = None) -> int:
+    """Return ``value`` as an int in [minimum, maximum], or raise naming ``name``."""
+    if isinstance(value, bool):
+        raise SnappingInputError(f"{name}={value!r} is not an integer")
+    if isinstance(value, numbers.Integral):
+        n = int(value)
+    elif isinstance(value, numbers.Real) and math.isfinite(float(value)) and float(value).is_integer():
+        n = int(value)
+    else:
+        raise SnappingInputError(f"{name}={value!r} is not an integer")
+    hi = "inf" if maximum is None else str(maximum)
+    if n < minimum or (maximum is not None and n > maximum):
+        raise SnappingInputError(f"{name}={n} is out of range: must be an integer in [{minimum}, {hi}]")
+    return n

@@ -1,0 +1,124 @@
+"""The run Dataset: the one place where its names are defined.
+
+A run of :mod:`snapping.simulate` is one :class:`xarray.Dataset`, written to disk
+as netCDF4. Its variable, dimension and attribute names are a public contract
+between ``simulate``, ``scaling``, files on users' disks and scripts: they are
+listed here, with units and CF ``long_name``, and nowhere else. Code that writes
+or reads a run imports these tables instead of spelling names itself.
+
+Everything is nondimensional (length l = 1, g = 1, rho = 1; velocity sqrt(g l),
+time sqrt(l/g), force rho g l), hence ``units = "1"``.
+
+Conventions (the paper's appendix): nodes are numbered from the free end
+(node 1, index 0 here) to the pinned node N+1 (index N). The arclength
+coordinate ``s`` is the paper's: s = 0 at the pin, s = 1 at the free end, so
+node k sits at s = (N + 1 - k)/N. Link k joins nodes k and k+1 and carries the
+tension ``sigma_k``. Gravity points along +e2 (``y`` grows downward).
+
+Dimensions
+----------
+``step``      accepted time steps that were recorded (coordinate ``t``)
+``snapshot``  full-profile snapshots (coordinate ``t_snapshot``)
+``node``      the N+1 nodes (coordinate ``s_node``)
+``link``      the N links (coordinate ``s_link``, the link midpoints)
+
+Example
+-------
+>>> from snapping import schema
+>>> schema.STEP_VARS["v_max"]["long_name"]
+'maximum speed over the chain'
+"""
+
+from __future__ import annotations
+
+STEP_DIM = "step"
+SNAPSHOT_DIM = "snapshot"
+NODE_DIM = "node"
+LINK_DIM = "link"
+
+
+def _v(long_name: str, units: str = "1") -> dict[str, str]:
+    return {"long_name": long_name, "units": units}
+
+
+#: Coordinates.
+COORDS: dict[str, dict[str, str]] = {
+    "t": _v("time"),
+    "t_snapshot": _v("time of the profile snapshot"),
+    "s_node": _v("arclength of the node from the pinned end"),
+    "s_link": _v("arclength of the link midpoint from the pinned end"),
+}
+
+#: Per accepted step (dimension ``step``), in the order they are recorded.
+STEP_VARS: dict[str, dict[str, str]] = {
+    "dt": _v("accepted time step"),
+    "v_max": _v("maximum speed over the chain"),
+    "a_max": _v("maximum acceleration magnitude over the chain"),
+    "sigma_max": _v("maximum link tension over the chain"),
+    "kappa_max": _v("maximum absolute curvature over the chain"),
+    "s_kappa_max": _v("arclength of the curvature maximum"),
+    "s_a_max": _v("arclength of the acceleration maximum"),
+    "s_v_max": _v("arclength of the speed maximum"),
+    "v_end": _v("speed of the free end"),
+    "a_end": _v("acceleration magnitude of the free end"),
+    "pin_force_x": _v("horizontal (e1) component of the force of the chain on the pin"),
+    "pin_force_y": _v("vertical (e2, downward) component of the force of the chain on the pin"),
+    "energy": _v("total mechanical energy (kinetic + potential, zero for the chain hanging at rest)"),
+    "link_error": _v("largest relative link-length error max_k |N |r_k+1 - r_k| - 1|"),
+    "error_estimate": _v("stepper error estimate of the accepted step"),
+}
+
+#: Per snapshot profiles.
+NODE_PROFILE_VARS: dict[str, dict[str, str]] = {
+    "x": _v("node position, e1 component"),
+    "y": _v("node position, e2 component (downward)"),
+    "vx": _v("node velocity, e1 component"),
+    "vy": _v("node velocity, e2 component"),
+    "ax": _v("node acceleration, e1 component"),
+    "ay": _v("node acceleration, e2 component"),
+    "speed": _v("node speed"),
+    "accel": _v("node acceleration magnitude"),
+    "curvature": _v("discrete curvature N (theta_k+1 - theta_k) at the node (NaN at the two ends)"),
+}
+LINK_PROFILE_VARS: dict[str, dict[str, str]] = {
+    "tension": _v("link tension"),
+}
+
+#: Global attributes: inputs. A run file alone must be enough to rerun it.
+INPUT_ATTRS: dict[str, str] = {
+    "chi": "initial end-to-end separation (fraction of the length), in (0, 1)",
+    "N": "number of links",
+    "method": "time-stepping method",
+    "tol": "stepper tolerance",
+    "dt0": "initial time step",
+    "t_end": "end time (0 = stop automatically after the snap)",
+    "stop_fraction": "automatic stop once the maximum speed has fallen to this fraction of its peak",
+    "snapshot_times": "requested snapshot times (besides the automatic ones)",
+    "record_thin": "relative change below which a step is not recorded (0 = record every step)",
+}
+
+#: Global attributes: results.
+RESULT_ATTRS: dict[str, str] = {
+    "status": "'completed', 'interrupted' or 'failed'",
+    "stop_reason": "why the run stopped",
+    "t_snap_v": "snapping time from the peak of the maximum speed",
+    "t_snap_a": "snapping time from the peak of the maximum acceleration",
+    "t_snap_sigma": "snapping time from the peak of the maximum tension",
+    "v_peak": "peak of the maximum speed",
+    "a_peak": "peak of the maximum acceleration",
+    "sigma_peak": "peak of the maximum tension",
+    "kappa_peak": "peak of the maximum curvature",
+    "kappa_max_0": "maximum curvature at t = 0",
+    "energy_drift": "max |E(t) - E(0)| over the run",
+    "link_drift": "max relative link-length error against 1/N over the run",
+    "link_drift_initial": "max relative link-length change against the initial chords",
+    "length_drift": "max relative change of the total length against the initial chords",
+    "link_error_initial": "relative error of the initial chords against 1/N (sampling the catenary)",
+    "n_steps": "accepted steps",
+    "n_rejected": "rejected steps",
+    "n_rhs": "right-hand-side evaluations",
+    "wall_time": "wall-clock time of the run in seconds",
+    "snapping_version": "version of the snapping package that wrote the file",
+}
+
+ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS}
