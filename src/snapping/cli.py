@@ -1,0 +1,203 @@
+"""The ``snapping`` command line: thin wrappers over the library.
+
+Each subcommand has an ``_add_<name>`` function that declares its arguments
+(with a working example in its epilog) and a ``_cmd_<name>`` function that
+calls the library and prints. No physics lives here.
+
+Bad input (a :class:`ValueError` from the library, or an argparse error) prints
+one line on stderr and exits with status 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+EXIT_BAD_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str):  # noqa: D401 - argparse API
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def _formatter(prog):
+    return argparse.RawDescriptionHelpFormatter(prog, max_help_position=32)
+
+
+def _json_default(obj):
+    import numpy as np
+
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return str(obj)
+
+
+def print_json(obj) -> None:
+    """Print one JSON object (NaN/inf written as null)."""
+
+    def clean(x):
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v) for v in x]
+        if isinstance(x, float) and not math.isfinite(x):
+            return None
+        return x
+
+    print(json.dumps(clean(obj), default=_json_default, indent=2))
+
+
+def print_table(rows, title: str | None = None) -> None:
+    """Print (name, value, unit/comment) rows as an aligned table."""
+    if title:
+        print(title)
+        print("-" * len(title))
+    rows = [tuple("" if c is None else c for c in r) for r in rows]
+    fmt_rows = []
+    for r in rows:
+        name, value = r[0], r[1]
+        if isinstance(value, float):
+            value = f"{value:.6g}"
+        fmt_rows.append((str(name), str(value), *(str(c) for c in r[2:])))
+    w0 = max(len(r[0]) for r in fmt_rows)
+    w1 = max(len(r[1]) for r in fmt_rows)
+    for r in fmt_rows:
+        rest = "  ".join(r[2:])
+        print(f"  {r[0]:<{w0}}  {r[1]:>{w1}}  {rest}".rstrip())
+
+
+# --------------------------------------------------------------------------- ideal
+def _add_ideal(sub) -> None:
+    p = sub.add_parser(
+        "ideal",
+        help="the perfectly folded falling string: t*, exponents, prefactors",
+        formatter_class=_formatter,
+        description="Exact results for the perfectly folded falling string (chi = 0).",
+        epilog="example:\n  snapping ideal --digits 30\n  snapping ideal --json",
+    )
+    p.add_argument("--digits", type=int, default=15, help="significant digits of t* (default 15)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_cmd_ideal)
+
+
+def _cmd_ideal(args) -> int:
+    from . import ideal
+
+    summary = ideal.summary(digits=args.digits)
+    if args.json:
+        print_json(summary)
+    else:
+        ideal.print_summary(summary)
+    return 0
+
+
+# ------------------------------------------------------------------------ estimate
+def _add_estimate(sub) -> None:
+    p = sub.add_parser(
+        "estimate",
+        help="peak speed, acceleration and tension from the initial geometry alone",
+        formatter_class=_formatter,
+        description=(
+            "Design-rule estimates of the snap from the initial catenary alone (no simulation).\n"
+            "Give the end separation as a fraction --chi of the length, or in metres with\n"
+            "--separation, or the initial maximum curvature in 1/m with --curvature."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping estimate --chi 0.25\n"
+            "  snapping estimate --chi 0.25 --length 1.022 --mass 0.0208\n"
+            "  snapping estimate --curvature 20 --length 1.022 --mass 0.0208 --json"
+        ),
+    )
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument("--chi", type=float, help="end separation / length, in (0, 1)")
+    g.add_argument("--separation", type=float, help="end separation in metres (needs --length)")
+    g.add_argument("--curvature", type=float, help="initial maximum curvature in 1/m (needs --length)")
+    p.add_argument("--length", type=float, default=None, help="chain length in m (default: the paper's 1.022)")
+    p.add_argument("--mass", type=float, default=None, help="chain mass in kg (default: the paper's 0.0208)")
+    p.add_argument("--g", type=float, default=None, help="gravity in m/s^2 (default 9.81)")
+    p.add_argument("--N", type=int, default=None, help="number of links, adds the delta_N = 1/N prediction")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=_cmd_estimate)
+
+
+def _cmd_estimate(args) -> int:
+    from . import estimates
+
+    chain = estimates.Chain(
+        **{k: v for k, v in (("length", args.length), ("mass", args.mass), ("g", args.g)) if v is not None}
+    )
+    if args.chi is not None:
+        est = estimates.design_estimate(chain, chi=args.chi, N=args.N)
+    elif args.separation is not None:
+        est = estimates.design_estimate(chain, separation=args.separation, N=args.N)
+    else:
+        est = estimates.design_estimate(chain, curvature=args.curvature, N=args.N)
+    if args.json:
+        print_json(est.to_dict())
+    else:
+        estimates.print_estimate(est)
+    return 0
+
+
+# ------------------------------------------------------------------------ simulate
+def _add_simulate(sub) -> None:  # filled in by the simulator
+    return None
+
+
+# ----------------------------------------------------------------------------- fit
+def _add_fit(sub) -> None:  # filled in by the scaling analysis
+    return None
+
+
+# ---------------------------------------------------------------------------- main
+def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
+    parser = _Parser(
+        prog="snapping",
+        formatter_class=_formatter,
+        description=(
+            "snapping: the physics of snapping in flexible bodies (falling chains, whips).\n"
+            "Exact folded-string results, design-rule estimates, a compiled chain simulator\n"
+            "and scaling analysis."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping ideal --digits 30          # t* = 2E(pi/4|2) and the exponents\n"
+            "  snapping estimate --chi 0.25        # how big will the spike be?\n"
+            "  snapping <command> --help           # each command's options and examples"
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"snapping {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
+    for add in (_add_ideal, _add_estimate, _add_simulate, _add_fit):
+        add(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return EXIT_BAD_INPUT
+    try:
+        return int(args.func(args) or 0)
+    except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
+        print(f"snapping {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print(f"snapping {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,424 @@
+"""Design-rule estimates of the snap from the initial geometry alone.
+
+The initial shape is the paper's catenary of unit length hanging from the pin at
+the origin with its free end at (chi, 0) (gravity along +e2, so ``y`` grows
+downward). From it follow the initial maximum curvature kappa_m(0) = 1/a, the
+available energy P (catenary minus the vertically hanging string), the
+regularising length scales delta and, through the rigid whirling-rod model of
+the paper's eq. (estimates), predictions of the peak speed, acceleration and
+tension. :class:`Chain` carries these to SI units.
+
+Nondimensional units: length l, velocity sqrt(g l), acceleration g, force
+rho g l = M g, time sqrt(l/g).
+
+Example
+-------
+>>> import math
+>>> from snapping import estimates
+>>> a = estimates.catenary_parameter(0.25)
+>>> round(a, 6), round(2 * a * math.sinh(0.25 / (2 * a)), 12)   # 1 = 2 a sinh(chi/2a)
+(0.038299, 1.0)
+>>> est = estimates.design_estimate(estimates.Chain(), chi=0.25)   # the paper's chain
+>>> round(est.nondim["kappa_m0"], 2), round(est.si["kappa_m0_per_m"], 2)   # 1/l and 1/m
+(26.11, 25.55)
+>>> {k: round(v) for k, v in est.predictions["delta_c"].items()}
+{'v': 7, 'a': 1725, 'sigma': 26}
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import _validate as V
+
+__all__ = [
+    "catenary_parameter",
+    "catenary_shape",
+    "chi_from_parameter",
+    "kappa_m0",
+    "available_energy",
+    "delta_kappa0",
+    "delta_crude",
+    "delta_N",
+    "whirling_rod",
+    "Chain",
+    "DesignEstimate",
+    "design_estimate",
+    "print_estimate",
+    "PAPER_CHAIN",
+]
+
+
+# ----------------------------------------------------------------------- catenary
+def _log_sinhc(b: float) -> float:
+    """log(sinh(b)/b) for b > 0 without overflow or cancellation."""
+    if b < 1e-4:
+        return b * b / 6.0 - b**4 / 180.0
+    if b > 20.0:
+        return b - math.log(2.0 * b) + math.log1p(-math.exp(-2.0 * b))
+    return math.log(math.sinh(b) / b)
+
+
+def catenary_parameter(chi: float) -> float:
+    """Catenary parameter ``a`` of a unit-length string with end separation ``chi``.
+
+    Solves ``1 = 2 a sinh(chi / (2 a))`` (the paper, after Lockwood) for a > 0.
+    Written in ``b = chi/(2a)`` as ``log(sinh(b)/b) = -log(chi)``, which is
+    monotone in b and solved by bracketed root finding, robust as chi -> 0
+    (a -> 0, b ~ log(1/chi)) and chi -> 1 (a -> inf, b ~ sqrt(6 (1 - chi))).
+
+    Parameters
+    ----------
+    chi : float
+        End-to-end separation over length, in the open interval (0, 1).
+
+    Returns
+    -------
+    float
+        ``a``; the initial maximum curvature is ``kappa_m(0) = 1/a``.
+
+    Examples
+    --------
+    >>> a = catenary_parameter(0.1)
+    >>> abs(2 * a * math.sinh(0.1 / (2 * a)) - 1) < 1e-13
+    True
+    """
+    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    target = -math.log(chi)
+    # log(sinh b / b) ~ b^2/6 for small b and ~ b - log(2b) for large b.
+    hi = max(1.0, 2.0 * (target + math.log(2.0 * target + 2.0)) + 2.0)
+    b = brentq(lambda bb: _log_sinhc(bb) - target, 0.0, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    if b == 0.0:  # chi so close to 1 that the root underflows: use the series
+        b = math.sqrt(6.0 * target)
+    return chi / (2.0 * b)
+
+
+def chi_from_parameter(a: float) -> float:
+    """End separation chi of the unit-length catenary with parameter ``a`` (inverse of
+    :func:`catenary_parameter`): ``chi = 2 a asinh(1/(2a))``.
+
+    >>> round(chi_from_parameter(catenary_parameter(0.3)), 12)
+    0.3
+    """
+    a = V.positive("a", a)
+    return 2.0 * a * math.asinh(1.0 / (2.0 * a))
+
+
+def catenary_shape(s, chi: float):
+    """Initial shape r(s) of the paper: the catenary from the pin (s = 0, origin)
+    to the free end (s = 1, at (chi, 0)).
+
+    ``x(s) = a asinh((s - 1/2)/a) + chi/2``,
+    ``y(s) = sqrt(a^2 + 1/4) - sqrt(a^2 + (s - 1/2)^2)`` (downward).
+
+    Parameters
+    ----------
+    s : array_like
+        Arclength(s) in [0, 1].
+    chi : float
+        End separation in (0, 1).
+
+    Returns
+    -------
+    x, y : ndarray
+        Components along e1 and e2 (gravity direction).
+
+    Examples
+    --------
+    >>> x, y = catenary_shape([0.0, 1.0], 0.25)
+    >>> [round(float(v), 12) + 0.0 for v in (*x, *y)]
+    [0.0, 0.25, 0.0, 0.0]
+    """
+    a = catenary_parameter(chi)
+    s = np.asarray(s, dtype=float)
+    if s.size and (not np.all(np.isfinite(s)) or s.min() < 0.0 or s.max() > 1.0):
+        raise V.SnappingInputError(f"s must lie in [0, 1]; got values in [{s.min()!r}, {s.max()!r}]")
+    u = s - 0.5
+    x = a * np.arcsinh(u / a) + 0.5 * chi
+    # sqrt(a^2+1/4) - sqrt(a^2+u^2) = (1/4 - u^2)/(sqrt(a^2+1/4)+sqrt(a^2+u^2)): no cancellation
+    y = (0.25 - u * u) / (math.sqrt(a * a + 0.25) + np.sqrt(a * a + u * u))
+    return x, y
+
+
+def kappa_m0(chi: float) -> float:
+    """Initial maximum curvature kappa_m(0) = 1/a of the catenary (at its bottom, s = 1/2).
+
+    >>> round(kappa_m0(0.25), 4)
+    26.1104
+    """
+    return 1.0 / catenary_parameter(chi)
+
+
+def available_energy(chi: float) -> float:
+    """Available energy P(chi): potential energy of the catenary minus that of the
+    vertically hanging string (paper, section "Regularization is not by discreteness").
+
+    With the potential -integral y ds (y downward, rho = g = 1),
+    ``P = 1/2 - integral_0^1 y ds`` and, integrating the catenary in closed form,
+    ``P = 1/2 - (sqrt(a^2 + 1/4) - a chi)/2``. Limits: P -> 1/4 as chi -> 0 (the
+    folded string), P -> 1/2 as chi -> 1 (the horizontal string).
+
+    >>> round(available_energy(0.25), 6)
+    0.254055
+    >>> round(available_energy(1e-9), 9), round(available_energy(1 - 1e-9), 3)
+    (0.25, 0.5)
+    """
+    a = catenary_parameter(chi)
+    # sqrt(a^2+1/4) - a chi = (sqrt(a^2+1/4) - a) + a (1 - chi), the first term without cancellation
+    sag = 0.25 / (math.sqrt(a * a + 0.25) + a)
+    return 0.5 - 0.5 * (sag + a * (1.0 - chi))
+
+
+# ------------------------------------------------------------------------- scales
+def delta_kappa0(chi: float) -> float:
+    """delta_kappa_m(0) = (pi/2)/kappa_m(0): a terminal quarter circle of the initial curvature.
+
+    >>> round(delta_kappa0(0.25), 6)
+    0.06016
+    """
+    return 0.5 * math.pi / kappa_m0(chi)
+
+
+def delta_crude(chi: float) -> float:
+    """The crude scale delta_c = (1/2) (pi/kappa_m(0))^(4/3) (paper eq. deltacrude).
+
+    Derivation (checked in the tests): the front distance from the end,
+    (1/2) (tau/t*)^(2/3), meets the curvature scale (pi/2) kappa_m(0)^-1 (tau/t*)^(1/6)
+    at tau/t* = (pi/kappa_m(0))^2, where both equal delta_c.
+
+    >>> round(delta_crude(0.25), 6)
+    0.0297
+    """
+    return 0.5 * (math.pi / kappa_m0(chi)) ** (4.0 / 3.0)
+
+
+def delta_N(N: int) -> float:
+    """delta_N = 1/N, the only scale if discreteness regularised the snap.
+
+    >>> delta_N(2000)
+    0.0005
+    """
+    return 1.0 / V.integer("N", N, 1)
+
+
+def whirling_rod(P: float, delta: float) -> dict[str, float]:
+    """Peak values of a rigid rod of length delta whirling about s = 1 - delta with
+    kinetic energy P (paper eq. estimates).
+
+    ``v = (6 P/delta)^(1/2)``, ``a = v^2/delta``, ``sigma = v^2/2``
+    (from P = omega^2 delta^3 / 6 and v = omega delta).
+
+    >>> whirling_rod(0.25, 0.5)
+    {'v': 1.7320508075688772, 'a': 5.999999999999999, 'sigma': 1.4999999999999998}
+    """
+    P = V.positive("P", P)
+    delta = V.positive("delta", delta)
+    v = math.sqrt(6.0 * P / delta)
+    return {"v": v, "a": v * v / delta, "sigma": 0.5 * v * v}
+
+
+# ------------------------------------------------------------------ SI design rules
+def _t_star() -> float:
+    """Ideal snapping time of the folded string (see :mod:`snapping.ideal`)."""
+    from .ideal import t_star
+
+    return float(t_star())
+
+
+@dataclass(frozen=True)
+class Chain:
+    """A real chain or tether: length [m], mass [kg] and gravity [m/s^2].
+
+    Converts the nondimensional quantities of the library (length l, velocity
+    sqrt(g l), acceleration g, force M g, time sqrt(l/g)) to SI. The defaults
+    are the paper's chain (Tomaszewski et al.; Geminard & Vanel): 1.022 m,
+    0.0208 kg, 229 links.
+
+    Examples
+    --------
+    >>> c = Chain()
+    >>> round(c.velocity(1.0), 4)   # sqrt(g l) in m/s
+    3.1664
+    >>> round(c.force(1.0), 6)      # M g in N
+    0.204048
+    """
+
+    length: float = 1.022
+    mass: float = 0.0208
+    g: float = 9.81
+
+    def __post_init__(self):
+        V.positive("length", self.length)
+        V.positive("mass", self.mass)
+        V.positive("g", self.g)
+
+    def velocity(self, v):
+        """Nondimensional speed -> m/s."""
+        return v * math.sqrt(self.g * self.length)
+
+    def acceleration(self, a):
+        """Nondimensional acceleration -> m/s^2."""
+        return a * self.g
+
+    def force(self, sigma):
+        """Nondimensional tension -> N (rho g l = M g)."""
+        return sigma * self.mass * self.g
+
+    def time(self, t):
+        """Nondimensional time -> s."""
+        return t * math.sqrt(self.length / self.g)
+
+    def distance(self, x):
+        """Nondimensional length -> m."""
+        return x * self.length
+
+    def energy(self, e):
+        """Nondimensional energy -> J (rho g l^2 = M g l)."""
+        return e * self.mass * self.g * self.length
+
+
+PAPER_CHAIN = Chain()
+
+_SCALE_LABELS = {
+    "delta_kappa0": "delta_kappa0 = (pi/2)/kappa_m(0)",
+    "delta_c": "delta_c = (1/2)(pi/kappa_m(0))^(4/3)",
+    "delta_N": "delta_N = 1/N",
+}
+
+
+@dataclass
+class DesignEstimate:
+    """Everything :func:`design_estimate` predicts, nondimensional and SI.
+
+    ``nondim`` holds the geometry (chi, a, kappa_m0, P, t_star); ``scales`` the
+    lengths delta; ``predictions[scale]`` the whirling-rod peaks {v, a, sigma};
+    ``si`` the same in SI units for ``chain``.
+    """
+
+    chain: Chain
+    nondim: dict[str, float]
+    scales: dict[str, float]
+    predictions: dict[str, dict[str, float]]
+    si: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """One JSON-serialisable dict whose keys name the quantities (with units in SI keys)."""
+        return {
+            "chain": {"length_m": self.chain.length, "mass_kg": self.chain.mass, "g_m_per_s2": self.chain.g},
+            **self.nondim,
+            "scales": dict(self.scales),
+            "predictions": {k: dict(v) for k, v in self.predictions.items()},
+            "si": self.si,
+        }
+
+
+def design_estimate(
+    chain: Chain = PAPER_CHAIN,
+    *,
+    chi: float | None = None,
+    separation: float | None = None,
+    curvature: float | None = None,
+    N: int | None = None,
+) -> DesignEstimate:
+    """Predict the snap of ``chain`` from its initial catenary alone.
+
+    Give exactly one of ``chi`` (end separation / length), ``separation`` (end
+    separation in m) or ``curvature`` (initial maximum curvature in 1/m). The
+    scales delta_kappa0 and delta_c (and delta_N if ``N`` is given) each give
+    the whirling-rod peaks of the paper's eq. (estimates),
+    v = (6P/delta)^(1/2), a = v^2/delta, sigma = v^2/2, which are also
+    converted to SI together with the ideal snapping time t* sqrt(l/g).
+
+    Examples
+    --------
+    >>> est = design_estimate(Chain(length=1.022, mass=0.0208), chi=0.25)
+    >>> round(est.si["t_star_s"], 4)   # 2E(pi/4|2) sqrt(l/g) in s
+    0.3867
+    """
+    given = [name for name, v in (("chi", chi), ("separation", separation), ("curvature", curvature)) if v is not None]
+    if len(given) != 1:
+        raise V.SnappingInputError(
+            f"give exactly one of chi, separation, curvature (got {', '.join(given) or 'none'})"
+        )
+    if separation is not None:
+        sep = V.open_interval("separation", separation, 0.0, chain.length)
+        chi = sep / chain.length
+    elif curvature is not None:
+        kappa = V.positive("curvature", curvature)
+        chi = chi_from_parameter(1.0 / (kappa * chain.length))
+        if not 0.0 < chi < 1.0:  # curvature so small or large that chi rounds to 0 or 1
+            raise V.SnappingInputError(
+                f"curvature={kappa!r} 1/m gives chi={chi!r}, outside (0, 1): give a curvature in "
+                f"(0, inf) that is not extreme for length {chain.length} m"
+            )
+    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    if N is not None:
+        N = V.integer("N", N, 1)
+    a = catenary_parameter(chi)
+    P = available_energy(chi)
+    t_star = _t_star()
+    nondim = {"chi": chi, "a": a, "kappa_m0": 1.0 / a, "P": P, "t_star": t_star}
+    scales = {"delta_kappa0": delta_kappa0(chi), "delta_c": delta_crude(chi)}
+    if N is not None:
+        scales["delta_N"] = delta_N(N)
+    predictions = {name: whirling_rod(P, d) for name, d in scales.items()}
+    si = {
+        "separation_m": chain.distance(chi),
+        "kappa_m0_per_m": 1.0 / chain.distance(a),
+        "P_J": chain.energy(P),
+        "t_star_s": chain.time(t_star),
+        "scales_m": {name: chain.distance(d) for name, d in scales.items()},
+        "predictions": {
+            name: {
+                "v_m_per_s": chain.velocity(p["v"]),
+                "a_m_per_s2": chain.acceleration(p["a"]),
+                "sigma_N": chain.force(p["sigma"]),
+            }
+            for name, p in predictions.items()
+        },
+    }
+    return DesignEstimate(chain=chain, nondim=nondim, scales=scales, predictions=predictions, si=si)
+
+
+def print_estimate(est: DesignEstimate, file=None) -> None:
+    """Print a :class:`DesignEstimate` as a readable table (what ``snapping estimate`` shows)."""
+    import sys
+
+    out = file or sys.stdout
+    c, nd, si = est.chain, est.nondim, est.si
+
+    def line(s=""):
+        print(s, file=out)
+
+    line(f"Snap estimate for a catenary with chi = {nd['chi']:.6g}")
+    line(f"chain: length {c.length:g} m, mass {c.mass:g} kg, g {c.g:g} m/s^2")
+    line()
+    line(f"  {'quantity':<34} {'nondimensional':>15} {'SI':>15}")
+    rows = [
+        ("end separation chi", nd["chi"], si["separation_m"], "m"),
+        ("catenary parameter a", nd["a"], c.distance(nd["a"]), "m"),
+        ("initial max curvature kappa_m(0)", nd["kappa_m0"], si["kappa_m0_per_m"], "1/m"),
+        ("available energy P", nd["P"], si["P_J"], "J"),
+        ("ideal snapping time t*", nd["t_star"], si["t_star_s"], "s"),
+    ]
+    for name, d in est.scales.items():
+        rows.append((_SCALE_LABELS[name], d, si["scales_m"][name], "m"))
+    for name, nd_v, si_v, unit in rows:
+        line(f"  {name:<34} {nd_v:>15.6g} {si_v:>15.6g} {unit}")
+    line()
+    line("Predicted peaks (whirling rod, eq. estimates: v = (6P/delta)^1/2, a = v^2/delta, sigma = v^2/2)")
+    line(f"  {'scale':<14} {'v':>10} {'a':>12} {'sigma':>10} | {'v [m/s]':>10} {'a [m/s^2]':>12} {'sigma [N]':>10}")
+    for name, p in est.predictions.items():
+        q = si["predictions"][name]
+        line(
+            f"  {name:<14} {p['v']:>10.4g} {p['a']:>12.4g} {p['sigma']:>10.4g} | "
+            f"{q['v_m_per_s']:>10.4g} {q['a_m_per_s2']:>12.4g} {q['sigma_N']:>10.4g}"
+        )
+    line()
+    line("delta_kappa0 tends to underestimate the acceleration by ~100x; delta_c is the practical")
+    line("estimate from the initial geometry alone (paper, Fig. 4). delta_kappa_m needs a run")
+    line("(snapping fit).")
