@@ -22,7 +22,7 @@ Example
 >>> round(est.nondim["kappa_m0"], 2), round(est.si["kappa_m0_per_m"], 2)   # 1/l and 1/m
 (26.11, 25.55)
 >>> {k: round(v) for k, v in est.predictions["delta_c"].items()}
-{'v': 7, 'a': 1725, 'sigma': 26}
+{'v': 7, 'a': 1728, 'sigma': 26}
 """
 
 from __future__ import annotations
