@@ -47,6 +47,7 @@ COORDS: dict[str, dict[str, str]] = {
     "t_snapshot": _v("time of the profile snapshot"),
     "s_node": _v("arclength of the node from the pinned end"),
     "s_link": _v("arclength of the link midpoint from the pinned end"),
+    "snapshot_kind": _v("why the snapshot was taken: initial, requested, speed_level, peak, after_peak or final"),
 }
 
 #: Per accepted step (dimension ``step``), in the order they are recorded.
@@ -95,6 +96,10 @@ INPUT_ATTRS: dict[str, str] = {
     "stop_fraction": "automatic stop once the maximum speed has fallen to this fraction of its peak",
     "snapshot_times": "requested snapshot times (besides the automatic ones)",
     "record_thin": "relative change below which a step is not recorded (0 = record every step)",
+    "chords": "initial node placement on the catenary: 'arclength' (the paper's) or 'exact' (chords 1/N)",
+    "initial": "initial condition: 'catenary' (from chi) or 'snapshot' (the snapshot of kind 'initial' holds it)",
+    "t_end_max": "hard end time of an automatic (stop after the snap) run",
+    "max_link_error": "relative link-length error at which the run fails",
 }
 
 #: Global attributes: results.
@@ -114,6 +119,10 @@ RESULT_ATTRS: dict[str, str] = {
     "link_drift_initial": "max relative link-length change against the initial chords",
     "length_drift": "max relative change of the total length against the initial chords",
     "link_error_initial": "relative error of the initial chords against 1/N (sampling the catenary)",
+    "t_final": "time at which the run stopped",
+    "energy_initial": "total energy at t = 0",
+    "dt_min_accepted": "smallest accepted time step",
+    "dt_max_accepted": "largest accepted time step",
     "n_steps": "accepted steps",
     "n_rejected": "rejected steps",
     "n_rhs": "right-hand-side evaluations",
