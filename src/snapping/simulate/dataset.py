@@ -1,0 +1,155 @@
+"""The run :class:`xarray.Dataset`: building it, saving, loading, reading inputs back.
+
+All names, units and long names come from :mod:`snapping.schema`.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import xarray as xr
+
+from .. import _validate as V
+from .. import schema
+from . import kernels as K
+from .chain import ChainState, curvature_profile, link_arclength, node_arclength
+
+__all__ = ["build_dataset", "save", "load_run", "inputs_from_attrs", "initial_from_dataset"]
+
+
+def _attr_value(v):
+    """netCDF-friendly attribute value."""
+    if v is None:
+        return ""
+    if isinstance(v, (bool, np.bool_)):
+        return int(v)
+    if isinstance(v, (list, tuple)):
+        return np.asarray(v, dtype=float)
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, results: dict) -> xr.Dataset:
+    """Assemble a run Dataset.
+
+    Parameters
+    ----------
+    records : ndarray, shape (n_steps, 16)
+        Per-step rows in the column order of ``kernels.RECORD_NAMES``.
+    snapshots : list of (t, kind, Z)
+        Full states in the (7, N + 1) kernel layout.
+    N : int
+        Number of links.
+    inputs, results : dict
+        Global attributes (schema.INPUT_ATTRS, schema.RESULT_ATTRS).
+    """
+    t = records[:, K.R_T]
+    data_vars = {}
+    for col, name in enumerate(K.RECORD_NAMES):
+        if name == "t":
+            continue
+        data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(schema.STEP_VARS[name]))
+    snapshots = sorted(snapshots, key=lambda s: s[0])
+    ns = len(snapshots)
+    prof = {name: np.full((ns, N + 1), np.nan) for name in schema.NODE_PROFILE_VARS}
+    tension = np.full((ns, N), np.nan)
+    for i, (_, _, Z) in enumerate(snapshots):
+        prof["x"][i], prof["y"][i] = Z[K.RX], Z[K.RY]
+        prof["vx"][i], prof["vy"][i] = Z[K.RVX], Z[K.RVY]
+        prof["ax"][i], prof["ay"][i] = Z[K.RAX], Z[K.RAY]
+        prof["speed"][i] = np.hypot(Z[K.RVX], Z[K.RVY])
+        prof["accel"][i] = np.hypot(Z[K.RAX], Z[K.RAY])
+        prof["curvature"][i] = curvature_profile(Z[K.RX], Z[K.RY])
+        tension[i] = Z[K.RSIG, :N]
+    for name, arr in prof.items():
+        data_vars[name] = ((schema.SNAPSHOT_DIM, schema.NODE_DIM), arr, dict(schema.NODE_PROFILE_VARS[name]))
+    data_vars["tension"] = ((schema.SNAPSHOT_DIM, schema.LINK_DIM), tension, dict(schema.LINK_PROFILE_VARS["tension"]))
+    coords = {
+        "t": (schema.STEP_DIM, t.copy(), dict(schema.COORDS["t"])),
+        "t_snapshot": (schema.SNAPSHOT_DIM, np.array([s[0] for s in snapshots], dtype=float),
+                       dict(schema.COORDS["t_snapshot"])),
+        "snapshot_kind": (schema.SNAPSHOT_DIM, np.array([s[1] for s in snapshots], dtype=str),
+                          dict(schema.COORDS["snapshot_kind"])),
+        "s_node": (schema.NODE_DIM, node_arclength(N), dict(schema.COORDS["s_node"])),
+        "s_link": (schema.LINK_DIM, link_arclength(N), dict(schema.COORDS["s_link"])),
+    }
+    attrs = {"title": "snapping: falling-chain run (nondimensional: length l, g, rho = 1)",
+             "Conventions": "CF-1.8"}
+    for k, v in {**inputs, **results}.items():
+        attrs[k] = _attr_value(v)
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def check_writable(path) -> str:
+    """Raise :class:`SnappingInputError` unless ``path`` can be written (checked before a run)."""
+    p = os.fspath(path)
+    if not p:
+        raise V.SnappingInputError("output='' is not a file path")
+    if os.path.isdir(p):
+        raise V.SnappingInputError(f"output={p!r} is a directory, not a writable file path")
+    parent = os.path.dirname(os.path.abspath(p))
+    if not os.path.isdir(parent):
+        raise V.SnappingInputError(f"output={p!r}: directory {parent!r} does not exist")
+    if not os.access(parent, os.W_OK) or (os.path.exists(p) and not os.access(p, os.W_OK)):
+        raise V.SnappingInputError(f"output={p!r} is not writable")
+    return p
+
+
+def save(ds: xr.Dataset, path) -> str:
+    """Write a run Dataset as netCDF4; returns the path."""
+    p = os.fspath(path)
+    encoding = {name: {"zlib": True, "complevel": 1} for name in ds.data_vars}
+    ds.to_netcdf(p, format="NETCDF4", engine="netcdf4", encoding=encoding)
+    return p
+
+
+def load_run(path) -> xr.Dataset:
+    """Open a run file (loaded into memory, the file is closed).
+
+    >>> import tempfile, os
+    >>> from snapping.simulate import run
+    >>> r = run(0.5, 4, t_end=0.01, progress=False)
+    >>> p = os.path.join(tempfile.mkdtemp(), "run.nc"); _ = r.save(p)
+    >>> int(load_run(p).attrs["N"])
+    4
+    """
+    with xr.open_dataset(os.fspath(path), engine="netcdf4") as ds:
+        return ds.load()
+
+
+def initial_from_dataset(ds: xr.Dataset) -> ChainState:
+    """The initial state stored in a run (its snapshot of kind 'initial')."""
+    kinds = [str(k) for k in ds["snapshot_kind"].values]
+    if "initial" not in kinds:
+        raise V.SnappingInputError("the run has no snapshot of kind 'initial'")
+    i = kinds.index("initial")
+    sn = ds.isel({schema.SNAPSHOT_DIM: i})
+    return ChainState(sn["x"].values, sn["y"].values, sn["vx"].values, sn["vy"].values, float(sn["t_snapshot"]))
+
+
+def inputs_from_attrs(ds: xr.Dataset) -> dict:
+    """Keyword arguments of :func:`snapping.simulate.run` that reproduce a run.
+
+    Runs are deterministic (no fastmath, fixed operation order), so
+    ``run(**inputs_from_attrs(ds))`` recomputes the same numbers.
+    """
+    a = ds.attrs
+    out = {
+        "chi": None if not np.isfinite(float(a["chi"])) else float(a["chi"]),
+        "N": int(a["N"]),
+        "tol": float(a["tol"]),
+        "method": str(a["method"]),
+        "dt0": float(a["dt0"]),
+        "t_end": None if float(a["t_end"]) == 0.0 else float(a["t_end"]),
+        "stop_fraction": float(a["stop_fraction"]),
+        "snapshot_times": tuple(float(v) for v in np.atleast_1d(np.asarray(a["snapshot_times"], dtype=float))),
+        "record_thin": float(a["record_thin"]),
+        "chords": str(a["chords"]),
+        "t_end_max": float(a["t_end_max"]),
+        "max_link_error": float(a["max_link_error"]),
+    }
+    if str(a.get("initial", "catenary")) == "snapshot":
+        out["initial"] = initial_from_dataset(ds)
+    return out
