@@ -173,7 +173,7 @@ def initial_state(chi: float, N: int, chords: str = "arclength") -> ChainState:
             hi = s0 + 2.0 * h
             while f(hi) < 0.0:
                 hi += h
-            s[k] = brentq(f, s0 + 0.5 * h, hi, xtol=1e-16, rtol=4e-16, maxiter=200)
+            s[k] = brentq(f, s0 + 0.5 * h, hi, xtol=1e-16, rtol=1e-15, maxiter=200)
             xv, yv = _catenary_xy(s[k], chi, a)
             xs[k], ys[k] = float(xv), float(yv)
         # walking from the pin: reverse into the paper's node order (index 0 = free end)

@@ -1,0 +1,284 @@
+"""The chain simulator: physics, numerics, the run Dataset, inputs and the CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import mpmath
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.integrate import solve_ivp
+from scipy.special import ellipk
+
+from snapping import SnappingInputError, schema
+from snapping.cli import main
+from snapping.simulate import (
+    ChainState,
+    SimulationError,
+    evaluate,
+    initial_state,
+    integrate_fixed,
+    load_run,
+    rerun,
+    run,
+)
+
+T_STAR = float(2 * mpmath.ellipe(mpmath.pi / 4, 2))  # ideal snapping time 2E(pi/4|2)
+
+
+def pendulum_state(phi0: float) -> ChainState:
+    """N = 1: the unit-length pendulum at rest at angle phi0 from the downward vertical."""
+    return ChainState([math.sin(phi0), 0.0], [math.cos(phi0), 0.0], [0.0, 0.0], [0.0, 0.0])
+
+
+def hanging_state(N: int) -> ChainState:
+    z = np.zeros(N + 1)
+    return ChainState(z, (N - np.arange(N + 1)) / N, z, z)
+
+
+# ---------------------------------------------------------------- N = 1 and N = 2
+def test_simple_pendulum_period_and_tension():
+    phi0 = 1.2
+    period = 4.0 * ellipk(math.sin(phi0 / 2) ** 2)  # exact, K(m) with m = k^2
+    r = run(initial=pendulum_state(phi0), t_end=period / 2, tol=1e-11)
+    s = r.state
+    # half a period later: at rest at the opposite angle
+    assert s.x[0] == pytest.approx(-math.sin(phi0), abs=1e-7)
+    assert s.y[0] == pytest.approx(math.cos(phi0), abs=1e-7)
+    assert math.hypot(s.vx[0], s.vy[0]) < 1e-6
+    # tension m g cos(phi) + m v^2 / l in every snapshot, and energy conserved
+    ds = r.dataset
+    y, v2 = ds["y"].isel(node=0).values, (ds["speed"].isel(node=0) ** 2).values
+    np.testing.assert_allclose(ds["tension"].isel(link=0).values, y + v2, rtol=0, atol=1e-12)
+    assert ds.attrs["energy_drift"] < 1e-8
+    # the automatic stop finds the speed peak at the bottom, a quarter period in
+    auto = run(initial=pendulum_state(phi0), tol=1e-11)
+    assert auto.dataset.attrs["t_snap_v"] == pytest.approx(period / 4, abs=1e-6)
+    assert auto.dataset.attrs["v_peak"] == pytest.approx(math.sqrt(2 * (1 - math.cos(phi0))), rel=1e-8)
+    assert auto.dataset.attrs["sigma_peak"] == pytest.approx(1 + 2 * (1 - math.cos(phi0)), rel=1e-8)
+
+
+def _double_pendulum_rhs(t, u):
+    """Lagrange equations of two point masses m = 1/2 on massless rods l = 1/2, g = 1
+    (angles from the downward vertical; 1 = upper link, 2 = lower link)."""
+    m, l = 0.5, 0.5
+    th1, th2, w1, w2 = u
+    c, s = math.cos(th1 - th2), math.sin(th1 - th2)
+    # [2 m l, m l c; l c, l] [th1'', th2''] = [-m l w2^2 s - 2 m sin th1, l w1^2 s - sin th2]
+    A = np.array([[2 * m * l, m * l * c], [l * c, l]])
+    b = np.array([-m * l * w2 * w2 * s - 2 * m * math.sin(th1), l * w1 * w1 * s - math.sin(th2)])
+    a1, a2 = np.linalg.solve(A, b)
+    return [w1, w2, a1, a2]
+
+
+def test_double_pendulum_against_lagrange_equations():
+    th1, th2, T = 0.8, 2.0, 1.5
+    l = 0.5
+    x1, y1 = l * math.sin(th1), l * math.cos(th1)  # node 2 (index 1)
+    x0, y0 = x1 + l * math.sin(th2), y1 + l * math.cos(th2)  # node 1, the free end
+    state = ChainState([x0, x1, 0.0], [y0, y1, 0.0], [0.0] * 3, [0.0] * 3)
+    r = run(initial=state, t_end=T, tol=1e-11)
+    ref = solve_ivp(_double_pendulum_rhs, (0, T), [th1, th2, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12)
+    a1, a2, w1, w2 = ref.y[:, -1]
+    xe1, ye1 = l * math.sin(a1), l * math.cos(a1)
+    xe0, ye0 = xe1 + l * math.sin(a2), ye1 + l * math.cos(a2)
+    vx1, vy1 = l * w1 * math.cos(a1), -l * w1 * math.sin(a1)
+    vx0, vy0 = vx1 + l * w2 * math.cos(a2), vy1 - l * w2 * math.sin(a2)
+    s = r.state
+    np.testing.assert_allclose([s.x[0], s.y[0], s.x[1], s.y[1]], [xe0, ye0, xe1, ye1], atol=2e-6)
+    np.testing.assert_allclose([s.vx[0], s.vy[0], s.vx[1], s.vy[1]], [vx0, vy0, vx1, vy1], atol=2e-5)
+
+
+# ---------------------------------------------------------------- statics, invariants, order
+def test_hanging_chain_stays_at_rest_with_linear_tension():
+    N = 40
+    ev = evaluate(hanging_state(N))
+    np.testing.assert_allclose(ev["tension"], np.arange(1, N + 1) / N, rtol=0, atol=1e-13)
+    assert np.abs(ev["ax"]).max() < 1e-12 and np.abs(ev["ay"]).max() < 1e-12
+    r = run(initial=hanging_state(N), t_end=2.0)
+    s = r.state
+    np.testing.assert_allclose(s.y, hanging_state(N).y, atol=1e-12)
+    assert np.abs(s.x).max() < 1e-12 and np.abs(s.vy).max() < 1e-12
+    last = r.dataset.isel(snapshot=-1)
+    # (the tension system of the hanging chain has condition number ~ N^2: 1e-12 in the
+    # positions, from the few huge steps the error rule allows at rest, is ~1e-9 here)
+    np.testing.assert_allclose(last["tension"].values, np.arange(1, N + 1) / N, rtol=0, atol=1e-8)
+    assert float(r.dataset["pin_force_y"][-1]) == pytest.approx(1.0, abs=1e-8)  # the whole weight
+    assert float(r.dataset["pin_force_x"][-1]) == pytest.approx(0.0, abs=1e-8)
+
+
+def test_initial_tension_and_chords():
+    N = 200
+    s0 = initial_state(0.25, N)
+    x, y = s0.x, s0.y
+    assert (x[0], y[0], x[-1], y[-1]) == (0.25, 0.0, 0.0, 0.0)
+    ev = evaluate(s0)
+    assert ev["tension"][0] > 0 and np.all(np.diff(ev["tension"]) > 0)  # rises from the free end to the pin
+    # equal arclength sampling shortens the chords by about kappa^2 / (24 N^2)
+    r = run(0.25, N, t_end=1e-3)
+    kappa0 = r.dataset.attrs["kappa_max_0"]
+    assert r.dataset.attrs["link_error_initial"] == pytest.approx(kappa0**2 / (24 * N**2), rel=0.05)
+    exact = initial_state(0.25, N, chords="exact")
+    np.testing.assert_allclose(exact.link_lengths(), 1.0 / N, rtol=1e-12)
+
+
+def test_energy_and_link_drift_within_paper_bounds():
+    r = run(0.5, 100, chords="exact")  # tol 1e-8, to shortly after the snap
+    a = r.dataset.attrs
+    assert a["status"] == "completed" and "snap" in a["stop_reason"]
+    assert a["energy_drift"] < 8e-7
+    assert a["link_drift"] < 5e-4
+    assert a["length_drift"] < 4e-6
+    e = r.dataset["energy"].values
+    assert np.abs(e - a["energy_initial"]).max() <= a["energy_drift"] * (1 + 1e-12)
+
+
+def test_second_order_at_fixed_step():
+    s0 = initial_state(0.5, 6, chords="exact")
+    T = 0.4
+    ref = integrate_fixed(s0, T / 6400, 6400)
+    errs = []
+    for n in (50, 100, 200):
+        s = integrate_fixed(s0, T / n, n)
+        errs.append(max(np.abs(s.x - ref.x).max(), np.abs(s.vx - ref.vx).max(), np.abs(s.vy - ref.vy).max()))
+    orders = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
+    assert np.all(np.abs(orders - 2.0) < 0.15), orders
+
+
+def test_peaks_converge_as_tol_decreases():
+    peaks = {}
+    for tol in (1e-7, 1e-9):
+        a = run(0.3, 50, chords="exact", tol=tol).dataset.attrs
+        peaks[tol] = a
+    for q, rel in (("v_peak", 1e-6), ("a_peak", 1e-5), ("sigma_peak", 1e-5), ("t_snap_v", 1e-7)):
+        assert peaks[1e-9][q] == pytest.approx(peaks[1e-7][q], rel=rel), q
+
+
+def test_snapping_time_approaches_ideal_as_chi_decreases():
+    gaps = [abs(run(chi, 150).dataset.attrs["t_snap_v"] - T_STAR) for chi in (0.4, 0.2, 0.1)]
+    assert gaps[0] > gaps[1] > gaps[2]
+    assert gaps[2] < 2e-3
+
+
+def test_snap_diagnostics_agree():
+    ds = run(0.25, 300).dataset
+    a = ds.attrs
+    # snapping times from speed, acceleration, tension agree (paper: ~5 significant digits at N = 2000)
+    assert abs(a["t_snap_a"] - a["t_snap_v"]) < 1e-3 * a["t_snap_v"]
+    assert abs(a["t_snap_sigma"] - a["t_snap_v"]) < 1e-3 * a["t_snap_v"]
+    assert a["v_peak"] == pytest.approx(float(ds["v_max"].max()))
+    assert a["a_peak"] > 1e3
+    kinds = list(ds["snapshot_kind"].values)
+    assert kinds[0] == "initial" and kinds[-1] == "final" and "peak" in kinds and "after_peak" in kinds
+    assert kinds.count("speed_level") >= 4
+    peak = ds.isel(snapshot=kinds.index("peak"))
+    assert float(peak["speed"].max()) == pytest.approx(a["v_peak"], rel=1e-12)
+    assert float(peak["t_snapshot"]) == pytest.approx(a["t_snap_v"], abs=1e-5)
+    # the curvature profile's maximum matches the per-step record
+    step = int(np.argmin(np.abs(ds["t"].values - float(peak["t_snapshot"]))))
+    assert float(np.nanmax(np.abs(peak["curvature"]))) == pytest.approx(float(ds["kappa_max"][step]), rel=1e-9)
+
+
+def test_thinned_record_keeps_snap_results():
+    full = run(0.5, 40).dataset
+    thin = run(0.5, 40, record_thin=1e-3).dataset
+    assert thin.sizes["step"] < full.sizes["step"] / 5
+    for k in ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "energy_drift"):
+        assert thin.attrs[k] == full.attrs[k]
+
+
+# ---------------------------------------------------------------- the Dataset on disk
+def test_saved_file_is_self_describing_and_reruns(tmp_path):
+    path = tmp_path / "run.nc"
+    r = run(0.5, 20, snapshot_times=[0.5, 1.0], output=path)
+    ds = load_run(path)
+    for name, var in {**ds.data_vars, **ds.coords}.items():
+        if name in schema.ALL_VARS or name in schema.COORDS:
+            assert var.attrs["units"] and var.attrs["long_name"], name
+    for k in list(schema.INPUT_ATTRS) + list(schema.RESULT_ATTRS):
+        assert k in ds.attrs, k
+    assert ds.attrs["status"] == "completed"
+    assert (ds["snapshot_kind"].values == "requested").sum() == 2
+    with xr.open_dataset(path) as raw:
+        assert raw.sizes["step"] == r.dataset.sizes["step"]
+    again = rerun(ds)
+    np.testing.assert_array_equal(again.dataset["v_max"].values, ds["v_max"].values)
+    assert again.dataset.attrs["t_snap_v"] == ds.attrs["t_snap_v"]
+
+
+def test_custom_initial_state_reruns_from_file(tmp_path):
+    path = tmp_path / "pend.nc"
+    run(initial=pendulum_state(0.7), t_end=0.5, output=path)
+    ds = load_run(path)
+    assert ds.attrs["initial"] == "snapshot"
+    np.testing.assert_array_equal(rerun(ds).dataset["v_end"].values, ds["v_end"].values)
+
+
+# ---------------------------------------------------------------- bad input and failures
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"chi": 0.0, "N": 10}, "chi"),
+        ({"chi": 1.0, "N": 10}, "chi"),
+        ({"chi": -0.3, "N": 10}, "chi"),
+        ({"chi": 0.3, "N": 0}, "N"),
+        ({"chi": 0.3, "N": 2.5}, "N"),
+        ({"chi": 0.3, "N": 10, "tol": 0.0}, "tol"),
+        ({"chi": 0.3, "N": 10, "tol": -1e-8}, "tol"),
+        ({"chi": 0.3, "N": 10, "t_end": 0.0}, "t_end"),
+        ({"chi": 0.3, "N": 10, "t_end": -1.0}, "t_end"),
+        ({"chi": 0.3, "N": 10, "method": "rk4"}, "method"),
+        ({"chi": 0.3, "N": 10, "output": "/nonexistent-dir/run.nc"}, "output"),
+    ],
+)
+def test_bad_input_raises(kwargs, name):
+    with pytest.raises(SnappingInputError, match=name):
+        run(**kwargs)
+
+
+def test_unwritable_output_checked_before_running(tmp_path):
+    with pytest.raises(SnappingInputError, match="output"):
+        run(0.3, 10, output=tmp_path)  # a directory
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--chi", "1.5", "--N", "10"],
+        ["--chi", "0.3", "--N", "0"],
+        ["--chi", "0.3", "--N", "10", "--tol", "0"],
+        ["--chi", "0.3", "--N", "10", "--t-end", "-1"],
+        ["--chi", "0.3", "--N", "10", "-o", "/nonexistent-dir/run.nc"],
+    ],
+)
+def test_cli_bad_input_exit_2(argv, capsys):
+    assert main(["simulate", *argv]) == 2
+    err = capsys.readouterr().err
+    assert "error" in err and len(err.strip().splitlines()) == 1
+
+
+def test_numerical_failure_saves_partial_run(tmp_path):
+    path = tmp_path / "fail.nc"
+    with pytest.raises(SimulationError, match="drift") as info:
+        run(0.5, 10, method="euler-richardson-fixed", dt0=0.05, max_link_error=1e-3, output=path)
+    assert info.value.path == str(path)
+    ds = load_run(path)
+    assert ds.attrs["status"] == "failed" and "drift" in ds.attrs["stop_reason"]
+    assert ds.sizes["step"] >= 2 and ds["snapshot_kind"].values[-1] == "final"
+
+
+# ---------------------------------------------------------------- command line
+def test_cli_simulate_json_and_table(tmp_path, capsys):
+    path = tmp_path / "cli.nc"
+    assert main(["simulate", "--chi", "0.5", "--N", "10", "--t-end", "0.2", "-o", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["N"] == 10 and out["status"] == "completed" and out["n_rhs"] > 0
+    assert load_run(path).attrs["t_final"] == pytest.approx(0.2)
+    assert main(["simulate", "--chi", "0.5", "--N", "10", "--t-end", "0.1", "--no-progress"]) == 0
+    table = capsys.readouterr().out
+    for key in ("v_peak", "t_snap_v", "energy_drift", "link_drift", "n_steps", "n_rhs", "wall_time"):
+        assert key in table
+    assert os.path.exists(path)
