@@ -220,8 +220,102 @@ def _cmd_simulate(args) -> int:
 
 
 # ----------------------------------------------------------------------------- fit
-def _add_fit(sub) -> None:  # filled in by the scaling analysis
-    return None
+def _add_fit(sub) -> None:
+    p = sub.add_parser(
+        "fit",
+        help="snapping times, exponent fits with uncertainties, delta_kappa_m, Fig. 3 and Fig. 4",
+        formatter_class=_formatter,
+        description=(
+            "Scaling analysis of run files: t*_chi from the peaks of v_max, a_max, sigma_max;\n"
+            "exponents of y ~ A (t* - t)^beta (with t* = t*_chi and with t* fitted) against the\n"
+            "folded-string -1/3, -4/3, -2/3 and the paper's -5/6, -1/6, each with its uncertainty\n"
+            "(least squares, window choice, t* choice, slope drift), window and verdict; the scale\n"
+            "delta_kappa_m and the whirling-rod predictions of delta_kappa0, delta_kappa_m, delta_c.\n"
+            "Several files (or a sweep file) print one row per run; --plot then shows the collapse.\n"
+            "--plot out.png also writes out_slopes.png (local slopes) and out_delta.png (Fig. 4)."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping fit run.nc\n"
+            "  snapping fit run.nc --json\n"
+            "  snapping fit run.nc --plot fig3.png --window v_max=1e-4,1e-2\n"
+            "  snapping fit run_chi0.1.nc run_chi0.25.nc run_chi0.5.nc --plot collapse.pdf"
+        ),
+    )
+    p.add_argument("files", nargs="+", metavar="RUN.nc", help="run files or a sweep file")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plot", metavar="PATH", default=None, help="write the figures (.png, .pdf or .svg)")
+    p.add_argument("--tol", type=float, default=1e-3, help="flatness tolerance of the local slope (default 1e-3)")
+    p.add_argument("--min-width", type=float, default=1.0, help="smallest fit window in decades (default 1)")
+    p.add_argument(
+        "--window", action="append", default=[], metavar="ROW=LO,HI",
+        help="fix the window of t* - t of a variable or row, e.g. v_max=1e-4,1e-2 (repeatable)",
+    )
+    p.add_argument("--no-joint", action="store_true", help="skip the fits with t* fitted jointly")
+    p.set_defaults(func=_cmd_fit)
+
+
+def _cmd_fit(args) -> int:
+    from pathlib import Path
+
+    from . import scaling
+    from ._validate import SnappingInputError
+
+    windows = {}
+    for w in args.window:
+        try:
+            key, rng = w.split("=", 1)
+            lo, hi = (float(v) for v in rng.split(","))
+        except ValueError:
+            raise SnappingInputError(f"--window={w!r} must look like NAME=LO,HI (e.g. v_max=1e-4,1e-2)") from None
+        windows[key.strip()] = (lo, hi)
+    runs, names = [], []
+    for f in args.files:
+        ds = scaling.load_run(f)
+        for k, r in enumerate(scaling.iter_runs(ds)):
+            runs.append(r)
+            names.append(f if k == 0 else f"{f}[{k}]")
+    if not runs:
+        raise SnappingInputError(f"files={args.files!r} hold no runs")
+    results = []
+    for name, r in zip(names, runs):
+        try:
+            results.append(
+                scaling.fit_run(r, joint=not args.no_joint, windows=windows, tol=args.tol, min_width=args.min_width)
+            )
+        except SnappingInputError as exc:
+            raise SnappingInputError(f"{name}: {exc}") from None
+    if args.json:
+        print_json(results[0].to_dict() if len(results) == 1 else {"runs": [r.to_dict() for r in results]})
+    elif len(results) == 1:
+        res = results[0]
+        s = res.snap
+        print_table(
+            [(f"t* from {k}", p.t, f"± {p.err:.2g}  peak {p.value:.6g}") for k, p in s.peaks.items()]
+            + [("t*_chi (mean)", s.t_star, f"± {s.t_star_err:.2g} (spread {s.spread:.2g})")],
+            title=f"{names[0]}: chi = {res.chi:g}, N = {res.N}",
+        )
+        print()
+        print_table(scaling.report_rows(res), title="Exponents y ~ A (t* - t)^beta")
+        if res.delta is not None:
+            d = res.delta
+            print()
+            print_table(scaling.delta_rows(d), title=f"Scales and whirling-rod peaks (eq. estimates), P = {d.P:.6g}")
+            if d.note:
+                print(f"  delta_kappa_m: {d.note}")
+        print(f"\n  curvature amplification max kappa_max / kappa_max(0) = {res.kappa_amplification:.4g}")
+    else:
+        print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
+    if args.plot:
+        out = Path(args.plot)
+        paths = [
+            scaling.plot_maxima(runs, results, out),
+            scaling.plot_local_slopes(runs, results, out.with_name(f"{out.stem}_slopes{out.suffix}")),
+            scaling.plot_delta(runs, results, out.with_name(f"{out.stem}_delta{out.suffix}")),
+        ]
+        if not args.json:
+            print("\nfigures: " + ", ".join(str(p) for p in paths))
+    return 0
 
 
 # ---------------------------------------------------------------------------- main

@@ -422,3 +422,93 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
     line("delta_kappa0 tends to underestimate the acceleration by ~100x; delta_c is the practical")
     line("estimate from the initial geometry alone (paper, Fig. 4). delta_kappa_m needs a run")
     line("(snapping fit).")
+
+
+# =============================================================================
+# delta_kappa_m: the regularising scale measured on a run (snapping.scaling, issue #4).
+# Appended section; takes arrays extracted from a run, never a Dataset.
+# =============================================================================
+def delta_kappa_m(t, kappa_max, s_kappa_max, *, return_time: bool = False):
+    """The scale delta_kappa_m where the curvature peak's distance from the free end
+    meets the quarter circle of the peak curvature (paper, "Amplification estimates").
+
+    The front (the fold, traced by the arclength of the curvature maximum
+    ``s(kappa_m)``) approaches the free end while the length ``(pi/2)/kappa_m``
+    shrinks slowly; the whirling of the free end starts when
+
+        1 - s(kappa_m) = (pi/2) kappa_m^(-1),
+
+    and delta_kappa_m is their common value there (paper Fig. 4(a), black
+    circles). The first sign change of ``1 - s(kappa_m) - (pi/2)/kappa_m`` from
+    positive to non-positive is located by linear interpolation in time between
+    the two recorded steps around it.
+
+    Parameters
+    ----------
+    t : array_like
+        Recorded times (increasing), e.g. a run's ``t``.
+    kappa_max : array_like
+        Maximum curvature over the chain at those times (``kappa_max``, > 0).
+    s_kappa_max : array_like
+        Arclength from the pin of the curvature maximum (``s_kappa_max``, in [0, 1]).
+    return_time : bool
+        Also return the time of the crossing.
+
+    Returns
+    -------
+    float or (float, float)
+        delta_kappa_m, and the crossing time if ``return_time``.
+
+    Raises
+    ------
+    SnappingInputError
+        Arrays of different lengths or non-finite values, or no crossing in the
+        record (the run stopped before the front reached the end region).
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 1.0, 11)
+    >>> s = 0.5 + 0.5 * t                  # front reaching the end at t = 1
+    >>> kap = np.full_like(t, 4 * np.pi)   # (pi/2)/kappa = 0.125
+    >>> round(delta_kappa_m(t, kap, s), 12)
+    0.125
+    """
+    t = np.asarray(t, dtype=float)
+    k = np.asarray(kappa_max, dtype=float)
+    s = np.asarray(s_kappa_max, dtype=float)
+    if not (t.ndim == k.ndim == s.ndim == 1 and t.size == k.size == s.size):
+        raise V.SnappingInputError(
+            f"t, kappa_max and s_kappa_max must be 1-D arrays of one length; got shapes {t.shape}, {k.shape}, {s.shape}"
+        )
+    ok = np.isfinite(t) & np.isfinite(k) & np.isfinite(s) & (k > 0)
+    t, k, s = t[ok], k[ok], s[ok]
+    if t.size < 2:
+        raise V.SnappingInputError(f"kappa_max has {t.size} finite positive samples; at least 2 are needed")
+    if s.min() < -1e-9 or s.max() > 1.0 + 1e-9:
+        raise V.SnappingInputError(
+            f"s_kappa_max must lie in [0, 1]; got values in [{s.min()!r}, {s.max()!r}]"
+        )
+    d_front = 1.0 - s
+    d_curv = 0.5 * math.pi / k
+    g = d_front - d_curv
+    pos = np.nonzero(g > 0)[0]
+    if pos.size == 0:
+        raise V.SnappingInputError(
+            "1 - s_kappa_max is never larger than (pi/2)/kappa_max: the record has no approach of the "
+            "curvature peak towards the free end"
+        )
+    after = np.nonzero(g[pos[0]:] <= 0)[0]
+    if after.size == 0:
+        raise V.SnappingInputError(
+            f"1 - s_kappa_max never falls to (pi/2)/kappa_max (smallest gap {g.min():.3g} > 0 at "
+            f"t = {t[np.argmin(g)]:.6g}): the run stopped before the curvature peak neared the free end"
+        )
+    j = pos[0] + after[0]
+    i = j - 1
+    f = g[i] / (g[i] - g[j])  # in (0, 1]
+    t_c = t[i] + f * (t[j] - t[i])
+    delta = d_curv[i] + f * (d_curv[j] - d_curv[i])
+    return (float(delta), float(t_c)) if return_time else float(delta)
+
+
+__all__ += ["delta_kappa_m"]

@@ -1,0 +1,286 @@
+"""Tests of snapping.scaling: snapping times, power-law fits and their uncertainty,
+local slopes, the run report, delta_kappa_m, figures and the `snapping fit` command."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.integrate import quad
+
+from snapping import SnappingInputError, estimates, schema, scaling
+from snapping.cli import main
+
+T_STAR_IDEAL = 1.1981402347355922  # 2 E(pi/4 | 2)
+
+
+# ------------------------------------------------------------------------ helpers
+def regularised(tau, A, beta, eps):
+    """y = A (tau^2 + eps^2)^(beta/2): a power law with a smooth regularised tip."""
+    return A * (tau**2 + eps**2) ** (beta / 2)
+
+
+def make_run(chi=0.25, t_star=1.15, eps=1e-5, n=3000, past=True, status="completed"):
+    """A synthetic run following the paper's late-time laws, regularised below eps:
+    v, a_end, sigma with the folded-string prefactors, a_max crossing from -5/6 to
+    -4/3, kappa_max = kappa_m(0) (tau/t*)^(-1/6) and the front 1 - s = (1/2)(tau/t*)^(2/3),
+    so that delta_kappa_m equals delta_c exactly (paper eq. deltacrude)."""
+    tau = np.geomspace(1e-8, t_star, n)
+    t = t_star - tau[::-1]
+    if past:
+        t = np.concatenate([t, t_star + np.geomspace(1e-8, 1e-2, 200)])
+    tau = t_star - t
+    r = np.sqrt(tau**2 + eps**2)
+    a_end = 0.2912 * r ** (-4 / 3)
+    data = {
+        "v_max": 0.8736 * r ** (-1 / 3),
+        "a_end": a_end,
+        "a_max": np.maximum(a_end, 5.0 * r ** (-5 / 6)),
+        "sigma_max": 0.1908 * r ** (-2 / 3),
+        "kappa_max": estimates.kappa_m0(chi) * (r / t_star) ** (-1 / 6),
+        "s_kappa_max": 1 - 0.5 * (r / t_star) ** (2 / 3),
+    }
+    ds = xr.Dataset(
+        {k: (schema.STEP_DIM, v, schema.STEP_VARS[k]) for k, v in data.items()},
+        coords={"t": (schema.STEP_DIM, t, schema.COORDS["t"])},
+    )
+    ds.attrs.update(chi=chi, N=500, status=status)
+    return ds
+
+
+@pytest.fixture(scope="module")
+def folded():
+    """The exact folded string from its first integral s0'^2 = (1 - 4x^2)/(8x), x = 1 - s0:
+    t* - t = int_0^x sqrt(8x'/(1 - 4x'^2)) dx' (u = sqrt(x') removes the singularity)."""
+    f = lambda u: 2.0 * math.sqrt(8.0) * u * u / math.sqrt(1.0 - 4.0 * u**4)  # noqa: E731
+    x = np.geomspace(1e-6, 0.45, 500)
+    tau = np.array([quad(f, 0.0, math.sqrt(xx), epsabs=0.0, epsrel=1e-13)[0] for xx in x])
+    t = T_STAR_IDEAL - tau
+    s0dot = np.sqrt((1 - 4 * x * x) / (8 * x))
+    s0ddot = 0.25 + 1.0 / (16 * x * x)
+    tension = (1 - x) + s0dot**2
+    return t, s0dot, s0ddot, tension
+
+
+# --------------------------------------------------------------------- peak times
+def test_peak_time_is_located_between_samples():
+    t = np.linspace(0.9, 1.1, 81)  # spacing 2.5e-3
+    t0 = 1.0 + 0.37 * 2.5e-3
+    p = scaling.peak_time(t, regularised(t0 - t, 3.0, -1 / 3, 4e-3))
+    assert p.t_sample != pytest.approx(t0, abs=1e-4)  # the best sample is not the answer
+    assert abs(p.t - t0) <= max(p.err, 1e-12)
+    assert p.err < 2.5e-3 / 4
+    assert abs(p.t - t0) < 2.5e-4
+
+
+def test_peak_time_refuses_a_quantity_still_rising():
+    t = np.linspace(0, 1, 50)
+    with pytest.raises(SnappingInputError, match="before the snap"):
+        scaling.peak_time(t, np.exp(t), name="v_max")
+
+
+# ---------------------------------------------------------------------- power laws
+def test_exact_power_law_t_star_given_and_fitted():
+    tau = np.geomspace(1e-7, 1.0, 300)
+    t = 1.2 - tau
+    f = scaling.fit_power_law(t, 0.437 * tau ** (-2 / 3), t_star=1.2)
+    assert f.beta == pytest.approx(-2 / 3, abs=1e-9)
+    assert f.A == pytest.approx(0.437, rel=1e-9)
+    g = scaling.fit_power_law(t, 0.437 * tau ** (-2 / 3))
+    assert g.t_star_fitted
+    assert g.t_star == pytest.approx(1.2, abs=1e-10)
+    assert g.beta == pytest.approx(-2 / 3, abs=1e-7)
+
+
+@pytest.mark.parametrize("beta,noise,seed", [(-1 / 3, 0.01, 0), (-4 / 3, 0.03, 1), (-2 / 3, 0.02, 2)])
+def test_noisy_power_law_within_stated_uncertainty(beta, noise, seed):
+    rng = np.random.default_rng(seed)
+    tau = np.geomspace(1e-6, 1.0, 800)
+    y = 2.0 * tau**beta * np.exp(noise * rng.standard_normal(tau.size))
+    for t_star in (1.0, None):
+        f = scaling.fit_power_law(1.0 - tau, y, t_star=t_star)
+        assert f.beta_err > 0
+        assert abs(f.beta - beta) <= 2 * f.beta_err, f
+        assert abs(math.log(f.A / 2.0)) <= 2 * math.log1p(f.A_err / f.A)
+        assert f.beta_err < 0.05  # and the uncertainty is informative
+
+
+@pytest.mark.parametrize("eps,noise", [(1e-5, 0.0), (1e-4, 0.01)])
+def test_regularised_tip_within_stated_uncertainty(eps, noise):
+    rng = np.random.default_rng(7)
+    t_star = 1.2
+    t = np.sort(np.concatenate([t_star - np.geomspace(1e-8, 1.2, 2500), t_star + np.geomspace(1e-8, 1e-2, 200)]))
+    y = regularised(t_star - t, 0.5, -1 / 3, eps) * np.exp(noise * rng.standard_normal(t.size))
+    given = scaling.fit_power_law(t, y, t_star=t_star)
+    joint = scaling.fit_power_law(t, y)
+    for f in (given, joint):
+        assert f.tau_lo > 3 * eps  # the window stays off the regularised tip
+        assert abs(f.beta + 1 / 3) <= f.beta_err, f
+        assert abs(f.A / 0.5 - 1) <= 2 * f.A_err / f.A
+    assert abs(joint.t_star - t_star) < 0.1 * joint.tau_lo
+
+
+def test_window_override_is_used_and_changes_the_answer():
+    t_star = 1.0
+    tau = np.geomspace(1e-8, 1.0, 2000)
+    y = regularised(tau, 1.0, -1 / 3, 1e-4)
+    f = scaling.fit_power_law(t_star - tau, y, t_star=t_star, window=(1e-5, 1e-3))
+    assert (f.tau_lo, f.tau_hi) == (1e-5, 1e-3) and not f.window_auto
+    assert f.beta > -0.3  # inside the tip the exponent is not -1/3
+    auto = scaling.fit_power_law(t_star - tau, y, t_star=t_star)
+    assert auto.window_auto and abs(auto.beta + 1 / 3) < abs(f.beta + 1 / 3)
+
+
+def test_folded_string_exponents_and_prefactors(folded):
+    t, s0dot, s0ddot, tension = folded
+    ref = [(s0dot, -1 / 3, 12 ** (-1 / 3)), (s0ddot, -4 / 3, 12 ** (-1 / 3) / 3), (tension, -2 / 3, 12 ** (-2 / 3))]
+    for y, beta, A in ref:
+        f = scaling.fit_power_law(t, y, t_star=T_STAR_IDEAL)
+        assert abs(f.beta - beta) < 5e-4, f  # to three decimals
+        assert abs(f.beta - beta) <= f.beta_err
+        assert abs(f.A / A - 1) < 5e-3 and abs(f.A - A) <= 2 * f.A_err
+    for y, beta, _ in ref[:2]:  # t* fitted too: recovers t* and the exponent
+        g = scaling.fit_power_law(t, y)
+        assert abs(g.beta - beta) <= g.beta_err and abs(g.beta - beta) < 5e-4
+        assert abs(g.t_star - T_STAR_IDEAL) < 1e-10
+
+
+def test_folded_string_against_snapping_ideal(folded):
+    ideal = pytest.importorskip("snapping.ideal")
+    t, s0dot, _, _ = folded
+    sc = ideal.asymptotic_scalings()
+    f = scaling.fit_power_law(t, 2 * s0dot, t_star=T_STAR_IDEAL)
+    assert f.A == pytest.approx(sc["free_end_speed"].prefactor_float, rel=5e-3)
+    assert ideal.t_star() == pytest.approx(T_STAR_IDEAL, rel=1e-15)
+
+
+def test_local_slope_curve_matches_the_analytic_slope():
+    eps, beta = 1e-4, -2 / 3
+    tau = np.geomspace(1e-8, 1.0, 3000)
+    ls = scaling.local_slope(1.0 - tau, regularised(tau, 1.0, beta, eps), 1.0, span=0.2)
+    ok = np.isfinite(ls.slope) & (ls.tau > 1e-7) & (ls.tau < 0.5)
+    exact = beta * ls.tau**2 / (ls.tau**2 + eps**2)
+    assert np.max(np.abs(ls.slope[ok] - exact[ok])) < 5e-3
+    assert np.min(ls.slope[ok]) < -0.66 and np.max(ls.slope[ok]) > -0.01  # it does see both regimes
+
+
+def test_bad_fit_inputs_name_the_problem():
+    tau = np.geomspace(1e-6, 1.0, 100)
+    t, y = 1.0 - tau, tau ** (-1 / 3)
+    with pytest.raises(SnappingInputError, match=r"window=\(10.*outside the data"):
+        scaling.fit_power_law(t, y, t_star=1.0, window=(10.0, 100.0))
+    with pytest.raises(SnappingInputError, match="window="):
+        scaling.fit_power_law(t, y, t_star=1.0, window=(1e-2, 1e-4))
+    with pytest.raises(SnappingInputError, match="t_star_err"):
+        scaling.fit_power_law(t, y, t_star=1.0, t_star_err=-1.0)
+    with pytest.raises(SnappingInputError, match="prefer"):
+        scaling.find_window(t, y, 1.0, prefer="best")
+    with pytest.raises(SnappingInputError, match="same length"):
+        scaling.fit_power_law(t, y[:-1], t_star=1.0)
+
+
+# ------------------------------------------------------------------------- runs
+def test_synthetic_run_report_recovers_every_exponent_and_delta_c():
+    ds = make_run()
+    res = scaling.fit_run(ds)
+    assert res.snap.t_star == pytest.approx(1.15, abs=1e-9)
+    expected = {"v_max": -1 / 3, "a_end": -4 / 3, "a_max (late)": -4 / 3, "a_max (intermediate)": -5 / 6,
+                "sigma_max": -2 / 3, "kappa_max": -1 / 6}
+    for name, beta in expected.items():
+        r = res.row(name)
+        assert abs(r.fit.beta - beta) <= 2 * r.fit.beta_err, (name, r.fit)
+        assert r.verdict.startswith("agrees")
+    assert res.row("v_max").fit.A == pytest.approx(0.8736, rel=1e-3)
+    # the paper's linear approximations of front and curvature meet exactly at delta_c
+    d = res.delta
+    assert d.deltas["delta_kappa_m"] == pytest.approx(estimates.delta_crude(0.25), rel=1e-5)
+    assert d.predicted["delta_kappa_m"]["v"] == pytest.approx(estimates.whirling_rod(estimates.available_energy(0.25), d.deltas["delta_c"])["v"], rel=1e-5)
+    rows = scaling.report_rows(res)
+    assert len(rows) == 1 + len(res.rows) and len({len(r) for r in rows}) == 1
+    json.dumps(res.to_dict(), default=float)
+
+
+def test_delta_kappa_m_crossing():
+    t = np.linspace(0.0, 1.0, 101)
+    s = 0.5 + 0.5 * t**2
+    kap = np.full_like(t, 2 * math.pi)  # (pi/2)/kappa = 0.25: crossing at t^2 = 1/2
+    d, tc = estimates.delta_kappa_m(t, kap, s, return_time=True)
+    assert d == pytest.approx(0.25) and tc == pytest.approx(math.sqrt(0.5), abs=1e-4)
+    with pytest.raises(SnappingInputError, match="never falls"):
+        estimates.delta_kappa_m(t[:50], kap[:50], s[:50])
+
+
+def test_run_stopped_before_the_snap_is_refused():
+    ds = make_run(past=False, status="interrupted")
+    ds = ds.isel(step=slice(0, -50))
+    with pytest.raises(SnappingInputError, match=r"before the snap.*status='interrupted'"):
+        scaling.snapping_times(ds)
+    with pytest.raises(SnappingInputError, match="before the snap"):
+        scaling.fit_run(ds)
+
+
+def test_not_a_run_is_refused(tmp_path):
+    with pytest.raises(SnappingInputError, match="not a run Dataset"):
+        scaling.check_run(xr.Dataset({"x": ("a", [1.0, 2.0])}))
+    with pytest.raises(SnappingInputError, match=r"missing variables \['a_max', 'sigma_max'\]"):
+        scaling.check_run(xr.Dataset({"v_max": ("step", [1.0])}, coords={"t": ("step", [0.0])}))
+    p = tmp_path / "notes.nc"
+    p.write_text("not a netCDF file\n")
+    with pytest.raises(SnappingInputError, match="not a readable netCDF run file"):
+        scaling.load_run(p)
+    q = tmp_path / "other.nc"
+    xr.Dataset({"x": ("a", [1.0, 2.0])}).to_netcdf(q)
+    with pytest.raises(SnappingInputError, match="not a run Dataset"):
+        scaling.load_run(q)
+
+
+def test_sweep_splits_into_runs():
+    a, b = make_run(chi=0.25, n=600), make_run(chi=0.5, t_star=1.3, n=600)
+    pieces = [r.reset_coords().assign_attrs({}).expand_dims(chi=[r.attrs["chi"]]) for r in (a, b)]
+    sweep = xr.concat(pieces, dim="chi", join="outer")
+    runs = list(scaling.iter_runs(sweep))
+    assert [r.attrs["chi"] for r in runs] == [0.25, 0.5]
+    assert scaling.snapping_times(runs[1]).t_star == pytest.approx(1.3, abs=1e-9)
+
+
+# ------------------------------------------------------------------------ figures & CLI
+def test_cli_fit_table_json_plots_and_errors(tmp_path, capsys):
+    p1, p2 = tmp_path / "a.nc", tmp_path / "b.nc"
+    make_run(n=800).to_netcdf(p1)
+    make_run(chi=0.5, t_star=1.3, n=800).to_netcdf(p2)
+    assert main(["fit", str(p1), "--no-joint"]) == 0
+    out = capsys.readouterr().out
+    assert "v_max" in out and "delta_kappa_m" in out and "agrees" in out
+    assert main(["fit", str(p1), "--json", "--no-joint"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["rows"][0]["fit"]["beta"] == pytest.approx(-1 / 3, abs=2e-3)
+    fig = tmp_path / "fig3.png"
+    assert main(["fit", str(p1), str(p2), "--plot", str(fig), "--no-joint"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("0.5") >= 1 and "t*_chi" in out
+    for f in (fig, tmp_path / "fig3_slopes.png", tmp_path / "fig3_delta.png"):
+        assert f.stat().st_size > 10_000
+    assert main(["fit", str(p1), "--window", "v_max=10,100"]) == 2
+    assert "outside the data" in capsys.readouterr().err
+    assert main(["fit", str(tmp_path / "missing.nc")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------ a real run
+def test_small_real_run():
+    simulate = pytest.importorskip("snapping.simulate")  # skipped only while the simulator is missing
+    ds = simulate.run(0.25, 200, tol=1e-8).dataset
+    snap = scaling.snapping_times(ds)
+    assert snap.spread < 1e-3 * snap.t_star  # the three peaks give one t*_chi
+    assert abs(snap.t_star - T_STAR_IDEAL) < 0.05  # close to the folded string's
+    res = scaling.fit_run(ds, joint=False)
+    v = res.row("v_max").fit
+    assert abs(v.beta + 1 / 3) <= 2 * v.beta_err and v.beta_err < 0.05
+    d = res.delta.deltas
+    assert math.isfinite(d["delta_kappa_m"]) and d["delta_kappa_m"] < d["delta_kappa0"]
+    # delta_kappa_m predicts the peak speed and acceleration well (paper Fig. 4(c)-(d))
+    ratios = res.delta.ratios()["delta_kappa_m"]
+    assert 0.7 < ratios["v"] < 1.4 and 0.5 < ratios["a"] < 2.0
