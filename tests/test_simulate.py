@@ -282,3 +282,16 @@ def test_cli_simulate_json_and_table(tmp_path, capsys):
     for key in ("v_peak", "t_snap_v", "energy_drift", "link_drift", "n_steps", "n_rhs", "wall_time"):
         assert key in table
     assert os.path.exists(path)
+
+
+# ---------------------------------------------------------------- docstring examples
+@pytest.mark.parametrize(
+    "name", ["snapping.simulate", "snapping.simulate.chain", "snapping.simulate.stepper", "snapping.simulate.dataset"]
+)
+def test_simulate_docstring_examples(name):
+    import doctest
+    import importlib
+
+    module = importlib.import_module(name)
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == 0 and result.attempted > 0

@@ -409,12 +409,15 @@ def run(
 
     Examples
     --------
-    >>> r = run(0.5, 8, t_end=0.05)
+    >>> r = run(0.5, 8, t_end=0.05, chords="exact")
     >>> ds = r.dataset
     >>> ds.attrs["status"], int(ds.attrs["N"]), float(ds.t[-1])
     ('completed', 8, 0.05)
-    >>> bool(ds.attrs["energy_drift"] < 1e-6)
-    True
+    >>> bool(ds.attrs["energy_drift"] < 1e-9), bool(ds.attrs["link_drift"] < 1e-9)
+    (True, True)
+    >>> snap = run(0.5, 50).dataset.attrs                 # to shortly after the snap
+    >>> round(snap["t_snap_v"], 3), snap["stop_reason"]
+    (1.144, 'snap detected: v_max fell below 0.5 of its peak')
     """
     from .. import __version__
 
@@ -441,8 +444,8 @@ def run(
 
         bar = tqdm(total=t_end, file=sys.stderr, disable=None if progress is None else False, unit="t",
                    desc=f"chain N={N}", dynamic_ncols=True,
-                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}] {postfix}" if t_end
-                               else "{desc}: t={n:.5f} [{elapsed}] {postfix}"))
+                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
+                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
     status, reason, code = "completed", "", None
     wall0 = time.perf_counter()
     try:
