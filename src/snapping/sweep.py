@@ -1,0 +1,280 @@
+"""Sweeps: a grid of runs over (chi, N, any run option), in parallel, resumable.
+
+Each run is saved to its own netCDF file as soon as it finishes, written
+atomically (to a temporary file in the same directory, then renamed), so a
+killed sweep never leaves a corrupt file. Rerunning the same sweep skips every
+run whose file is already there and complete. The finished runs combine into one
+Dataset with ``chi`` and ``N`` dimensions (:func:`combine`).
+
+Runs go to local worker processes by default; give a Dask scheduler address (or
+a ``dask.distributed.Client``) to run the same sweep on an existing cluster.
+
+Example
+-------
+>>> from snapping.sweep import Grid
+>>> grid = Grid(chi=[0.25, 0.5], N=[50], options={"tol": 1e-6})
+>>> [p.name for p in grid.paths("out")]
+['run_chi0.25_N50.nc', 'run_chi0.5_N50.nc']
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import _validate as V
+from . import schema
+
+__all__ = ["Grid", "run_sweep", "combine", "atomic_to_netcdf", "is_complete_run"]
+
+
+def atomic_to_netcdf(ds, path) -> Path:
+    """Write ``ds`` to ``path`` as netCDF4 atomically: a temporary file in the same
+    directory, flushed and renamed over ``path``. A reader never sees a half-written file.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        from .simulate.dataset import save
+
+        save(ds, tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def is_complete_run(path) -> bool:
+    """True if ``path`` is a readable run file whose status is 'completed'."""
+    import xarray as xr
+
+    path = Path(path)
+    if not path.is_file():
+        return False
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            return ds.attrs.get("status") == "completed"
+    except Exception:
+        return False
+
+
+def _check_values(name: str, values, check) -> list:
+    if values is None:
+        raise V.SnappingInputError(f"{name} grid is empty: give at least one value")
+    if isinstance(values, (int, float, np.number)):
+        values = [values]
+    values = [check(name, v) for v in values]
+    if not values:
+        raise V.SnappingInputError(f"{name} grid is empty: give at least one value")
+    dup = sorted({v for v in values if values.count(v) > 1})
+    if dup:
+        raise V.SnappingInputError(f"{name} grid has duplicate values {dup}: give each value once")
+    return values
+
+
+@dataclass
+class Grid:
+    """A grid of runs: every combination of ``chi`` and ``N``, with the same ``options``
+    (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``).
+    """
+
+    chi: list
+    N: list
+    options: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.chi = _check_values("chi", self.chi, lambda n, v: V.open_interval(n, v, 0.0, 1.0))
+        self.N = _check_values("N", self.N, lambda n, v: V.integer(n, v, 1))
+        json.dumps(self.options, default=str)  # options must be describable in a file name hash
+
+    def points(self) -> list[dict]:
+        """One dict of run keywords per grid point."""
+        return [dict(chi=c, N=n, **self.options) for c in self.chi for n in self.N]
+
+    def _tag(self) -> str:
+        if not self.options:
+            return ""
+        blob = json.dumps(self.options, sort_keys=True, default=str).encode()
+        return "_" + hashlib.sha1(blob).hexdigest()[:8]
+
+    def path(self, out_dir, chi: float, N: int) -> Path:
+        """The file of the run (chi, N) in ``out_dir``."""
+        return Path(out_dir) / f"run_chi{chi:g}_N{N}{self._tag()}.nc"
+
+    def paths(self, out_dir) -> list[Path]:
+        return [self.path(out_dir, p["chi"], p["N"]) for p in self.points()]
+
+
+def _run_one(params: dict, path: str) -> str:
+    """Worker: run one simulation and save it atomically. Returns the path."""
+    from . import simulate
+
+    result = simulate.run(**params)
+    atomic_to_netcdf(result.dataset, path)
+    return path
+
+
+def _check_out_dir(out_dir) -> Path:
+    out = Path(out_dir)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=out, prefix=".write-test-"):
+            pass
+    except OSError as exc:
+        raise V.SnappingInputError(f"output directory {str(out)!r} cannot be written: {exc.strerror}") from None
+    return out
+
+
+def _client_for(scheduler):
+    try:
+        from dask.distributed import Client
+    except ImportError:  # pragma: no cover - depends on the install
+        raise V.SnappingInputError(
+            "scheduler given but dask.distributed is not installed: pip install 'snapping[distributed]'"
+        ) from None
+    if isinstance(scheduler, Client):
+        return scheduler, False
+    try:
+        return Client(scheduler, timeout="10s"), True
+    except (OSError, TimeoutError) as exc:
+        raise V.SnappingInputError(f"scheduler={scheduler!r} cannot be reached: {exc}") from None
+
+
+def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True) -> list[Path]:
+    """Run every point of ``grid`` not yet done in ``out_dir``; return all run paths.
+
+    Parameters
+    ----------
+    grid : Grid
+        The runs.
+    out_dir : path
+        Directory of the run files (created if missing; checked writable first).
+    workers : int, optional
+        Local worker processes (default: the number of cores, at most the runs to do).
+    scheduler : str or dask.distributed.Client, optional
+        Run on this Dask cluster instead of local processes.
+    progress : bool
+        Show a progress bar counting finished runs.
+
+    Examples
+    --------
+    >>> paths = run_sweep(Grid(chi=[0.5], N=[8], options={"tol": 1e-6}), "/tmp/sw", progress=False)  # doctest: +SKIP
+    """
+    from tqdm.auto import tqdm
+
+    out = _check_out_dir(out_dir)
+    if workers is not None:
+        workers = V.integer("workers", workers, 1)
+    todo = [(p, str(grid.path(out, p["chi"], p["N"]))) for p in grid.points()]
+    todo = [(p, path) for p, path in todo if not is_complete_run(path)]
+    bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
+    failures = []
+    try:
+        if scheduler is not None:
+            from dask.distributed import as_completed as dask_completed
+
+            client, owned = _client_for(scheduler)
+            try:
+                futures = {client.submit(_run_one, p, path, pure=False): p for p, path in todo}
+                for fut in dask_completed(futures):
+                    try:
+                        fut.result()
+                    except Exception as exc:  # keep going: the other runs are independent
+                        failures.append((futures[fut], exc))
+                    bar.update()
+            finally:
+                if owned:
+                    client.close()
+        elif todo:
+            n = min(workers or os.cpu_count() or 1, len(todo))
+            if n == 1:
+                for p, path in todo:
+                    try:
+                        _run_one(p, path)
+                    except Exception as exc:
+                        failures.append((p, exc))
+                    bar.update()
+            else:
+                import multiprocessing as mp
+
+                with ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context("spawn")) as pool:
+                    futures = {pool.submit(_run_one, p, path): p for p, path in todo}
+                    for fut in as_completed(futures):
+                        try:
+                            fut.result()
+                        except Exception as exc:
+                            failures.append((futures[fut], exc))
+                        bar.update()
+    finally:
+        bar.close()
+    if failures:
+        lines = "; ".join(f"chi={p['chi']:g} N={p['N']}: {exc}" for p, exc in failures)
+        raise RuntimeError(f"{len(failures)} of {len(todo)} runs failed ({lines}); rerun to retry only those")
+    return grid.paths(out)
+
+
+_RUN_DIMS = (schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_DIM)
+
+#: Global result attributes that become (chi, N) variables of a combined sweep.
+_SUMMARY_ATTRS = [k for k in schema.RESULT_ATTRS if k not in ("status", "stop_reason", "snapping_version")]
+
+
+def combine(paths) -> "xr.Dataset":
+    """Combine run files into one Dataset with ``chi`` and ``N`` dimensions.
+
+    Per-step and profile variables keep their ``step``/``snapshot``/``node``/``link``
+    dimensions (padded with NaN where runs differ in length); the numeric result
+    attributes of each run (``v_peak``, ``t_snap_v``, ...) become variables over
+    (chi, N).
+    """
+    import xarray as xr
+
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise V.SnappingInputError("combine needs at least one run file")
+    pieces = []
+    for path in paths:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            ds = ds.load()
+        for key in ("chi", "N"):
+            if key not in ds.attrs:
+                raise V.SnappingInputError(f"{str(path)!r} is not a run file: attribute {key!r} is missing")
+        chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
+        summary = {
+            k: ((), float(ds.attrs[k]), {"long_name": schema.RESULT_ATTRS[k], "units": "1"})
+            for k in _SUMMARY_ATTRS
+            if k in ds.attrs and np.isscalar(ds.attrs[k]) and not isinstance(ds.attrs[k], str)
+        }
+        ds = ds.reset_coords().assign(summary)
+        # integer indices on the run dimensions so that runs of different lengths pad with NaN
+        ds = ds.assign_coords({d: np.arange(ds.sizes[d]) for d in _RUN_DIMS if d in ds.dims})
+        ds = ds.drop_vars([v for v in ds.data_vars if ds[v].dtype.kind in "OUS"])
+        ds = ds.expand_dims(chi=[chi], N=[N])
+        keep = {k: ds.attrs[k] for k in ("method", "tol") if k in ds.attrs}
+        ds.attrs = keep
+        pieces.append(ds)
+    opts = dict(join="outer", fill_value=np.nan, data_vars="all", coords="minimal", compat="override")
+    chis = sorted({float(p["chi"].values[0]) for p in pieces})
+    rows = []
+    for c in chis:
+        row = sorted((p for p in pieces if float(p["chi"].values[0]) == c), key=lambda p: int(p["N"].values[0]))
+        Ns = [int(p["N"].values[0]) for p in row]
+        if len(set(Ns)) != len(Ns):
+            raise V.SnappingInputError(f"two run files have the same chi={c:g} and N: {sorted(Ns)}")
+        rows.append(xr.concat(row, dim="N", **opts))
+    combined = xr.concat(rows, dim="chi", **opts)
+    combined.attrs = {k: v for k, v in pieces[0].attrs.items() if all(p.attrs.get(k) == v for p in pieces)}
+    combined["chi"].attrs.update(long_name="initial end-to-end separation", units="1")
+    combined["N"].attrs.update(long_name="number of links", units="1")
+    return combined

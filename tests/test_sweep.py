@@ -1,0 +1,97 @@
+"""Sweeps: parallel, resumable, atomic, combined over (chi, N), on local processes and on Dask."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from snapping import SnappingInputError, simulate
+from snapping import sweep as S
+
+OPTS = {"tol": 1e-7}
+
+
+def test_sweep_runs_combines_and_skips_finished(tmp_path):
+    grid = S.Grid(chi=[0.4, 0.7], N=[8, 12], options=OPTS)
+    paths = S.run_sweep(grid, tmp_path, workers=2, progress=False)
+    assert len(paths) == 4 and all(S.is_complete_run(p) for p in paths)
+    # each file is the same run as a direct call (runs are deterministic)
+    direct = simulate.run(0.7, 12, **OPTS).dataset
+    ds = simulate.load_run(grid.path(tmp_path, 0.7, 12))
+    assert ds.attrs["v_peak"] == direct.attrs["v_peak"]
+    np.testing.assert_array_equal(ds["v_max"].values, direct["v_max"].values)
+    # combined over chi and N, with the per-run results as (chi, N) variables
+    comb = S.combine(paths)
+    assert dict(comb.sizes)["chi"] == 2 and dict(comb.sizes)["N"] == 2
+    assert float(comb["v_peak"].sel(chi=0.7, N=12)) == direct.attrs["v_peak"]
+    n = int(direct.sizes["step"])
+    np.testing.assert_array_equal(comb["v_max"].sel(chi=0.7, N=12).values[:n], direct["v_max"].values)
+    assert comb["v_max"].attrs["units"] == "1"
+    # a rerun does nothing to finished runs; a removed run is redone
+    mtimes = {p: os.stat(p).st_mtime_ns for p in paths}
+    os.remove(paths[0])
+    S.run_sweep(grid, tmp_path, workers=1, progress=False)
+    assert S.is_complete_run(paths[0])
+    assert all(os.stat(p).st_mtime_ns == mtimes[p] for p in paths[1:])
+
+
+def test_a_failed_write_leaves_no_file(tmp_path, monkeypatch):
+    ds = simulate.run(0.5, 4, t_end=0.01).dataset
+    target = tmp_path / "run.nc"
+
+    def boom(*a, **k):
+        raise OSError("disk full")
+
+    monkeypatch.setattr("snapping.simulate.dataset.save", boom)
+    with pytest.raises(OSError):
+        S.atomic_to_netcdf(ds, target)
+    assert not target.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_truncated_file_is_not_complete_and_is_redone(tmp_path):
+    grid = S.Grid(chi=[0.5], N=[5], options=OPTS)
+    path = grid.path(tmp_path, 0.5, 5)
+    path.write_bytes(b"CDF\x01 truncated")
+    assert not S.is_complete_run(path)
+    S.run_sweep(grid, tmp_path, workers=1, progress=False)
+    assert S.is_complete_run(path)
+
+
+def test_sweep_on_a_local_dask_cluster(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cl:
+        with distributed.Client(cl) as client:
+            grid = S.Grid(chi=[0.4, 0.7], N=[5], options=OPTS)
+            paths = S.run_sweep(grid, tmp_path, scheduler=client, progress=False)
+    assert all(S.is_complete_run(p) for p in paths)
+    comb = S.combine(paths)
+    assert list(comb["chi"].values) == [0.4, 0.7]
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(chi=[], N=[5]), "chi grid is empty"),
+        (dict(chi=[0.2], N=[]), "N grid is empty"),
+        (dict(chi=[0.2, 0.2], N=[5]), r"chi grid has duplicate values \[0.2\]"),
+        (dict(chi=[0.2], N=[5, 5]), r"N grid has duplicate values \[5\]"),
+        (dict(chi=[1.2], N=[5]), r"chi=1.2"),
+        (dict(chi=[0.2], N=[0]), r"N=0"),
+    ],
+)
+def test_bad_grids(kwargs, match):
+    with pytest.raises(SnappingInputError, match=match):
+        S.Grid(**kwargs)
+
+
+def test_unwritable_directory_and_unreachable_scheduler(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    grid = S.Grid(chi=[0.5], N=[4], options=OPTS)
+    with pytest.raises(SnappingInputError, match="cannot be written"):
+        S.run_sweep(grid, blocker / "sub", progress=False)
+    pytest.importorskip("dask.distributed")
+    with pytest.raises(SnappingInputError, match="cannot be reached"):
+        S.run_sweep(grid, tmp_path / "ok", scheduler="tcp://127.0.0.1:1", progress=False)
+    assert not any(Path(tmp_path / "ok").glob("*.nc"))
