@@ -237,7 +237,7 @@ def iter_runs(ds):
     Examples
     --------
     >>> import xarray as xr
-    >>> t = np.linspace(0, 1, 4)
+    >>> t = np.linspace(0, 1, 6)
     >>> sweep = xr.Dataset({"t": (("chi", "step"), [t, t]), "v_max": (("chi", "step"), [t, 2 * t])},
     ...                    coords={"chi": [0.1, 0.2]})
     >>> [float(r.attrs["chi"]) for r in iter_runs(sweep)]
