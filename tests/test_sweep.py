@@ -95,3 +95,16 @@ def test_unwritable_directory_and_unreachable_scheduler(tmp_path):
     with pytest.raises(SnappingInputError, match="cannot be reached"):
         S.run_sweep(grid, tmp_path / "ok", scheduler="tcp://127.0.0.1:1", progress=False)
     assert not any(Path(tmp_path / "ok").glob("*.nc"))
+
+
+def test_cli_sweep(tmp_path, capsys):
+    import json
+
+    from snapping.cli import main
+
+    assert main(["sweep", "--chi", "0.5", "--N", "6,9", "--tol", "1e-7", "-o", str(tmp_path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [r["N"] for r in out["runs"]] == [6, 9]
+    assert (tmp_path / "sweep.nc").is_file()
+    assert main(["sweep", "--chi", "0.5,0.5", "--N", "6", "-o", str(tmp_path)]) == 2
+    assert "duplicate" in capsys.readouterr().err

@@ -318,6 +318,77 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- sweep
+def _floats(text: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
+
+
+def _ints(text: str) -> list[int]:
+    try:
+        return [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of integers") from None
+
+
+def _add_sweep(sub) -> None:
+    p = sub.add_parser(
+        "sweep",
+        help="a grid of runs over chi and N, in parallel, resumable",
+        formatter_class=_formatter,
+        description=(
+            "Run every (chi, N) of the grid, each saved atomically to DIR as it finishes;\n"
+            "a rerun skips finished runs. Runs go to local processes, or to a Dask cluster\n"
+            "with --scheduler. Finally the runs are combined into DIR/sweep.nc."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_out\n"
+            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://10.0.0.5:8786 -o sweep_out"
+        ),
+    )
+    p.add_argument("--chi", type=_floats, required=True, help="comma-separated end separations in (0, 1)")
+    p.add_argument("--N", type=_ints, required=True, help="comma-separated numbers of links")
+    p.add_argument("--tol", type=float, default=None, help="stepper tolerance (default: the simulator's, 1e-8)")
+    p.add_argument("--method", default=None, help="time-stepping method (default: euler-richardson)")
+    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
+    p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    p.add_argument("-o", "--output", required=True, help="output directory")
+    p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
+    p.set_defaults(func=_cmd_sweep)
+
+
+def _cmd_sweep(args) -> int:
+    from pathlib import Path
+
+    from . import sweep
+
+    options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
+    grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
+    paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
+                            progress=sys.stderr.isatty())
+    combined = sweep.combine(paths)
+    out = sweep.atomic_to_netcdf(combined, Path(args.output) / "sweep.nc")
+    rows = []
+    for chi in combined["chi"].values:
+        for N in combined["N"].values:
+            sel = combined.sel(chi=chi, N=N)
+            rows.append({k: float(sel[k]) for k in ("v_peak", "a_peak", "sigma_peak", "t_snap_v") if k in sel}
+                        | {"chi": float(chi), "N": int(N)})
+    if args.json:
+        print_json({"sweep": str(out), "runs": rows})
+    else:
+        print(f"{len(paths)} runs in {args.output}; combined: {out}")
+        print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
+        for r in rows:
+            print(f"  {r['chi']:>6g} {r['N']:>7d} {r.get('v_peak', float('nan')):>10.5g} "
+                  f"{r.get('a_peak', float('nan')):>11.5g} {r.get('sigma_peak', float('nan')):>11.5g} "
+                  f"{r.get('t_snap_v', float('nan')):>10.6g}")
+    return 0
+
+
 # ---------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
@@ -339,7 +410,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"snapping {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
-    for add in (_add_ideal, _add_estimate, _add_simulate, _add_fit):
+    for add in (_add_ideal, _add_estimate, _add_simulate, _add_sweep, _add_fit):
         add(sub)
     return parser
 
