@@ -1,0 +1,140 @@
+"""The paper's run figures (Fig. 1 and Fig. 2) drawn from run Datasets.
+
+Every function takes run Datasets (names from :mod:`snapping.schema`) and
+returns a matplotlib Figure; :func:`save` writes it as PNG and PDF. Scaling
+figures (Fig. 3 and 4) live in :mod:`snapping.scaling`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .estimates import Chain, PAPER_CHAIN
+
+__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "save"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, path_stem) -> list[Path]:
+    """Save ``fig`` as ``<stem>.png`` (150 dpi) and ``<stem>.pdf``; returns both paths."""
+    stem = Path(path_stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    out = []
+    for ext in (".png", ".pdf"):
+        p = stem.with_suffix(ext)
+        fig.savefig(p, dpi=150, bbox_inches="tight")
+        out.append(p)
+    _plt().close(fig)
+    return out
+
+
+def _snapshots_before(ds, n: int):
+    """Indices of up to ``n`` snapshots spread over [0, t_snap_v], ending at the snap."""
+    ts = ds["t_snapshot"].values
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    idx = np.flatnonzero(ts <= t_snap + 1e-12) if np.isfinite(t_snap) else np.arange(ts.size)
+    if idx.size <= n:
+        return idx
+    # spread evenly in time, always keeping the first and the last (the snap)
+    targets = np.linspace(ts[idx[0]], ts[idx[-1]], n)
+    pick = sorted({int(idx[np.argmin(np.abs(ts[idx] - tt))]) for tt in targets})
+    return np.asarray(pick)
+
+
+def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8):
+    """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run (in metres)."""
+    plt = _plt()
+    runs = list(runs)
+    fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 4.4), squeeze=False)
+    for ax, ds in zip(axes[0], runs):
+        idx = _snapshots_before(ds, n)
+        colors = plt.cm.viridis(np.linspace(0, 1, max(len(idx), 2)))
+        for c, i in zip(colors, idx):
+            sn = ds.isel(snapshot=int(i))
+            ax.plot(chain.distance(sn["x"].values), -chain.distance(sn["y"].values), color=c, lw=1.2,
+                    label=f"t = {chain.time(float(sn['t_snapshot'])):.3f} s")
+        ax.plot([0], [0], "ks", ms=5)
+        ax.set_aspect("equal")
+        ax.set_title(f"chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("height [m]")
+        ax.legend(fontsize=7, loc="lower left")
+    fig.suptitle(f"Falling chain shapes (length {chain.length:g} m)")
+    fig.tight_layout()
+    return fig
+
+
+def pin_force(ds, chain: Chain = PAPER_CHAIN):
+    """Fig. 1(e): horizontal and vertical components of the force on the pin against time, in N and s."""
+    plt = _plt()
+    t = chain.time(ds["t"].values)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
+    a1.plot(t, chain.force(ds["pin_force_x"].values), color="tab:red")
+    a1.set_ylabel("horizontal force [N]")
+    a2.plot(t, chain.force(ds["pin_force_y"].values), color="tab:red")
+    a2.set_ylabel("vertical force [N]")
+    a2.set_xlabel("time [s]")
+    for a in (a1, a2):
+        a.grid(alpha=0.3)
+    a1.set_title(f"Force on the pin, chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}, "
+                 f"chain {chain.length:g} m, {chain.mass:g} kg")
+    fig.tight_layout()
+    return fig
+
+
+def profiles(ds, n: int = 7):
+    """Fig. 2(a)-(c): speed, acceleration and tension along the chain at several times up to the snap
+    (the last, in purple, is the snap), nondimensional."""
+    plt = _plt()
+    idx = _snapshots_before(ds, n)
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    colors = plt.cm.plasma(np.linspace(0.85, 0.0, max(len(idx), 2)))[::-1]
+    colors[-1] = (0.5, 0.0, 0.5, 1.0)  # the snap in purple, as in the paper
+    s_node, s_link = ds["s_node"].values, ds["s_link"].values
+    for c, i in zip(colors, idx):
+        sn = ds.isel(snapshot=int(i))
+        lab = f"t = {float(sn['t_snapshot']):.4f}"
+        axes[0].plot(s_node, sn["speed"].values, color=c, label=lab)
+        axes[1].semilogy(s_node[:-1], np.maximum(sn["accel"].values[:-1], 1e-3), color=c, label=lab)
+        axes[2].plot(s_link, sn["tension"].values, color=c, label=lab)
+    for a, name in zip(axes, ("speed |v|", "acceleration |a|", "tension sigma")):
+        a.set_xlabel("arclength s from the pin (nondimensional)")
+        a.set_ylabel(f"{name} (nondimensional)")
+        a.grid(alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"Along the chain up to the snap: chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
+    fig.tight_layout()
+    return fig
+
+
+def peak_speed_vs_N(table):
+    """Fig. 2(d): peak speed against N for several chi, with the N^(1/2) line a singularity
+    regularised by discreteness would follow.
+
+    ``table`` maps chi to a list of (N, v_peak)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    for chi, rows in sorted(table.items()):
+        rows = sorted(rows)
+        N = np.array([r[0] for r in rows], float)
+        v = np.array([r[1] for r in rows], float)
+        line, = ax.loglog(N, v, "o-", label=f"chi = {chi:g}")
+        ax.loglog(N, v[0] * np.sqrt(N / N[0]), ":", color=line.get_color(), lw=1)
+    ax.plot([], [], "k:", label="N^(1/2) (discreteness regularised)")
+    ax.set_xlabel("number of links N")
+    ax.set_ylabel("peak speed (nondimensional)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    ax.set_title("Snapping velocity against N")
+    fig.tight_layout()
+    return fig
