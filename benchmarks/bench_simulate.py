@@ -81,9 +81,11 @@ def bench_kernels(sizes, chi: float, target_s: float):
         meas = np.zeros(K.NMEAS)
         n_iter = max(10, int(target_s / (15e-9 * N)))
         t_rhs = _time(lambda n: K.bench_rhs(N, Z, w[0], w[1], w[2], w[3], n), n_iter)
+        t_thomas = _time(lambda n: K.bench_rhs_thomas(N, Z, w[0], w[1], w[2], w[3], n), n_iter)
         t_meas = _time(lambda n: K.bench_measure(N, Z, rinv0, meas, n), n_iter)
         t_both = _time(lambda n: K.bench_rhs_measure(N, Z, w[0], w[1], w[2], w[3], rinv0, meas, n), n_iter)
-        rows.append((N, chi, n_iter, t_rhs * 1e9 / N, t_meas * 1e9 / N, t_both * 1e9 / N, t_rhs * 1e6))
+        rows.append((N, chi, n_iter, t_rhs * 1e9 / N, t_thomas * 1e9 / N, t_meas * 1e9 / N, t_both * 1e9 / N,
+                     t_rhs * 1e6))
     return rows
 
 
@@ -121,11 +123,12 @@ def main(argv=None) -> int:
         print(f"  {k:<14} {v}")
     print()
     print("kernels: nanoseconds per node per evaluation (best of 5), one core")
-    hdr = f"  {'N':>6} {'chi':>5} {'evals':>9} {'rhs':>8} {'record':>8} {'rhs+rec':>8} {'rhs us':>9}"
+    hdr = f"  {'N':>6} {'chi':>5} {'evals':>9} {'rhs':>8} {'thomas':>8} {'record':>8} {'rhs+rec':>8} {'rhs us':>9}"
     print(hdr)
-    for N, chi, n, a, b, c, us in bench_kernels(sizes, args.chi, args.target):
-        print(f"  {N:>6} {chi:>5g} {n:>9} {a:>8.2f} {b:>8.2f} {c:>8.2f} {us:>9.2f}")
-    print("  (rhs: tension solve + accelerations; record: the per-step diagnostics of an accepted step)")
+    for N, chi, n, a, th, b, c, us in bench_kernels(sizes, args.chi, args.target):
+        print(f"  {N:>6} {chi:>5g} {n:>9} {a:>8.2f} {th:>8.2f} {b:>8.2f} {c:>8.2f} {us:>9.2f}")
+    print("  (rhs: tension solve + accelerations, the simulator's kernel; thomas: the same with the textbook\n"
+          "   Thomas sweep; record: the per-step diagnostics of an accepted step; rhs us: microseconds per rhs)")
     if runs:
         print()
         print("full runs to the snap (tol 1e-8, the paper's Euler-Richardson), one core")

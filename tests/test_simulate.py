@@ -295,3 +295,19 @@ def test_simulate_docstring_examples(name):
     module = importlib.import_module(name)
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0 and result.attempted > 0
+
+
+def test_fast_tension_solve_matches_textbook_thomas():
+    from snapping.simulate import kernels as K
+
+    for st in (initial_state(0.25, 3000), hanging_state(3000)):
+        rng = np.random.default_rng(3)
+        st.vx[:-1] = 0.3 * rng.standard_normal(st.N)
+        st.vy[:-1] = 0.3 * rng.standard_normal(st.N)
+        Z1 = st.as_array()
+        Z2 = Z1.copy()
+        w = np.zeros((4, st.N))
+        K.rhs_thomas(st.N, Z2, w[0], w[1], w[2], w[3])
+        for row in (K.RAX, K.RAY, K.RSIG):
+            scale = np.abs(Z2[row]).max()
+            assert np.abs(Z1[row] - Z2[row]).max() <= 1e-10 * scale
