@@ -86,7 +86,7 @@ PLANS = {
 }
 
 #: Rough cost model: right-hand-side evaluations of a run to its snap at tol 1e-8, and ns per node-evaluation.
-_NS_PER_NODE_EVAL = 15.0
+_NS_PER_NODE_EVAL = 10.0
 
 
 def _rhs_evaluations(chi: float, N: int, tol: float) -> float:
