@@ -346,7 +346,7 @@ def _add_sweep(sub) -> None:
         epilog=(
             "examples:\n"
             "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_out\n"
-            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://10.0.0.5:8786 -o sweep_out"
+            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_out"
         ),
     )
     p.add_argument("--chi", type=_floats, required=True, help="comma-separated end separations in (0, 1)")
