@@ -1,0 +1,401 @@
+"""Runs with the exactly inextensible, high-order method (``method="dop853"``, alias ``"fast"``).
+
+The chain in link angles (:mod:`snapping.simulate.angles`: every link has length 1/N to
+round-off) integrated with the compiled Dormand-Prince 8(5,3) pair and its dense
+output (:mod:`snapping.simulate.rk`). Same inputs, same run Dataset (the names of
+:mod:`snapping.schema`), same stop rules and automatic snapshots as the paper's
+Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
+
+* the peaks ``v_peak, a_peak, sigma_peak, kappa_peak`` and the snapping times
+  ``t_snap_*`` are located between steps on the dense output (steps are large);
+* requested snapshots are taken exactly at the requested times (dense output), and
+  the ``peak`` snapshot exactly at ``t_snap_v``;
+* the initial chain has links of length exactly 1/N in the directions of the chosen
+  sampling of the catenary: with ``chords="exact"`` this is the Euler-Richardson
+  initial state itself; with ``chords="arclength"`` (the default) the chords of the
+  sampled catenary, slightly shorter than 1/N, are lengthened to 1/N. Compare with
+  Euler-Richardson runs at ``chords="exact"``.
+
+``tol`` is the relative and absolute tolerance of every angle and angular velocity
+per step (max norm); ``link_error`` is the link-length error of the chain itself,
+``|N |d_k| - 1|`` with ``d_k = (cos theta_k, sin theta_k)/N`` (positions, as float64
+sums of links, carry an extra round-off up to about N ulp).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from .. import _validate as V
+from . import angles as AG
+from . import kernels as K
+from . import rk as R
+from .chain import ChainState, initial_state
+from .dataset import build_dataset, save
+
+__all__ = ["run_highorder", "HIGH_ORDER_METHODS", "resolve_method"]
+
+#: the angle-form methods; ``fast`` always names the project's best exact method
+HIGH_ORDER_METHODS = ("dop853", "fast")
+FAST = "dop853"
+
+SPEED_LEVEL_0 = 1.0
+SPEED_LEVEL_FACTOR = 1.5
+AFTER_PEAK_FRACTIONS = (0.9, 0.7)
+RECORD_CHUNK = 8192
+#: node-evaluations per call into the compiled loop (sets how often the progress bar moves)
+NODE_EVALS_PER_CALL = 20_000_000
+#: relative width (of the bracketing interval) to which peaks are located
+PEAK_XTOL = 1e-10
+_PEAK_MEAS = (K.M_VMAX, K.M_AMAX, K.M_SIGMAX, K.M_KMAX)
+
+
+def resolve_method(method: str) -> str:
+    """The concrete method a name stands for (``"fast"`` -> the best exact method).
+
+    >>> resolve_method("fast")
+    'dop853'
+    """
+    return FAST if method == "fast" else method
+
+
+class _Engine:
+    """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
+
+    def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
+                 dt_min=1e-14):
+        N = y0.size // 2
+        self.N = N
+        n = 2 * N
+        self.Y0 = np.zeros((2, n))
+        self.Y1 = np.zeros((2, n))
+        self.KK = np.zeros((2, R.NSX, n))
+        self.F = np.zeros((2, R.NI, n))
+        self.TS = np.zeros(2)
+        self.HS = np.zeros(2)
+        self.DOK = np.zeros(2)
+        self.ytmp = np.zeros(n)
+        self.w = AG.Work(N)
+        self.rw = AG.Work(N)  # scratch of peak searches and snapshots
+        self.Z = np.zeros((K.NROWS, N + 1))
+        self.rinv0 = np.full(N, float(N) * float(N))
+        self.meas = np.zeros(K.NMEAS)
+        self.rec = np.zeros((RECORD_CHUNK, K.NREC))
+        self.tol = tol
+        self.n_extra = 0
+        # initial state: slot 0 holds it as the end of a zero-length step
+        self.Y1[0] = y0
+        w = self.w
+        AG.angle_rhs(N, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        self.TS[0] = t0
+        self.HS[0] = 0.0
+        AG.measure_angles(N, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas)
+        self.meas0 = self.meas.copy()
+        self.link_error_initial = float(self.meas[K.M_LINKERR])
+        if dt0 is None:
+            dt0 = self._initial_step(y0, self.KK[0, R.NS].copy())
+        self.dt0 = dt0
+        K._write_record(self.rec, 0, t0, 0.0, 0.0, self.meas)
+        c = np.zeros(R.NQ)
+        c[R.Q_T] = t0
+        c[R.Q_H] = dt0
+        c[R.Q_SLOT] = 0
+        c[R.Q_NRHS] = 1 + self.n_extra
+        c[R.Q_NREC] = 1
+        c[R.Q_TOL] = tol
+        c[R.Q_THIN] = thin
+        c[R.Q_MAXLINK] = max_link_error
+        c[R.Q_DTMIN] = dt_min
+        c[R.Q_STEPS_PER_CALL] = max(20, NODE_EVALS_PER_CALL // (R.NS * N))
+        c[R.Q_TEND] = t_end
+        c[R.Q_TRET] = np.inf
+        c[R.Q_VUP] = np.inf
+        c[R.Q_STOPFRAC] = stop_fraction
+        c[R.Q_E0] = self.meas[K.M_ENERGY]
+        c[R.Q_L0] = self.meas[K.M_LENGTH]
+        c[R.Q_LAST_V] = self.meas[K.M_VMAX]
+        c[R.Q_LAST_A] = self.meas[K.M_AMAX]
+        c[R.Q_LAST_S] = self.meas[K.M_SIGMAX]
+        c[R.Q_LAST_K] = self.meas[K.M_KMAX]
+        c[R.Q_DRIFT_LINK] = self.link_error_initial
+        c[R.Q_DT_MIN_ACC] = np.inf
+        c[R.Q_DT_MAX_ACC] = 0.0
+        self.ctl = c
+        pk = np.full((4, R.NPKR), np.nan)
+        for qi, m in enumerate(_PEAK_MEAS):
+            pk[qi, R.PK_SBEST] = self.meas[m]
+            pk[qi, R.PK_TPREV] = t0
+            pk[qi, R.PK_TBEFORE] = t0
+            pk[qi, R.PK_NEED] = 0.0
+            pk[qi, R.PK_BEST] = self.meas[m]
+            pk[qi, R.PK_TBEST] = t0
+        self.pk = pk
+        self.peak_state = None
+        self.chunks: list[np.ndarray] = []
+        self.snapshots: list = [(t0, "initial", self.Z.copy())]
+        self.requested = list(snapshot_times)
+        self.after_fracs = [f for f in AFTER_PEAK_FRACTIONS if f > stop_fraction]
+        self.t0 = t0
+
+    def _initial_step(self, y0, f0) -> float:
+        """Hairer's starting step (Solving ODE I, II.4), in the max norm of the run."""
+        N = self.N
+        sc = self.tol * (1.0 + np.abs(y0))
+        d0 = np.max(np.abs(y0) / sc)
+        d1 = np.max(np.abs(f0) / sc)
+        h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+        y1 = y0 + h0 * f0
+        f1 = np.empty_like(y0)
+        w = self.rw
+        AG.angle_rhs(N, y1, f1, w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        self.n_extra += 1
+        d2 = np.max(np.abs(f1 - f0) / sc) / h0
+        if max(d1, d2) <= 1e-15:
+            h1 = max(1e-6, h0 * 1e-3)
+        else:
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+        return float(min(100.0 * h0, h1))
+
+    # -- helpers
+    @property
+    def t(self) -> float:
+        return float(self.ctl[R.Q_T])
+
+    def drain(self) -> None:
+        n = int(self.ctl[R.Q_NREC])
+        if n:
+            self.chunks.append(self.rec[:n].copy())
+        self.ctl[R.Q_NREC] = 0
+
+    def records(self) -> np.ndarray:
+        self.drain()
+        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, K.NREC))
+
+    def state_at(self, t: float) -> np.ndarray:
+        """The angle state at time t within the last two accepted steps (dense output)."""
+        for slot in (int(self.ctl[R.Q_SLOT]), 1 - int(self.ctl[R.Q_SLOT])):
+            t0, h = self.TS[slot], self.HS[slot]
+            if h > 0.0 and t0 - 1e-14 * max(1.0, abs(t0)) <= t <= t0 + h * (1 + 1e-12) + 1e-300:
+                if self.DOK[slot] == 0.0:
+                    w = self.rw
+                    R.dense_build(self.N, h, self.Y0[slot], self.Y1[slot], self.KK[slot], self.F[slot], self.ytmp,
+                                  w.c, w.s, w.S, w.cp, w.dp, w.sig)
+                    self.ctl[R.Q_NRHS] += R.NSX - R.NS - 1
+                    self.DOK[slot] = 1.0
+                out = np.empty(2 * self.N)
+                x = min(1.0, max(0.0, (t - t0) / h))
+                R.dense_eval(self.N, x, self.Y0[slot], self.F[slot], out)
+                return out
+        raise RuntimeError(f"t={t!r} is outside the stored steps")  # pragma: no cover - internal
+
+    def Z_at(self, t: float):
+        """The position-form state Z and its diagnostics at time t (one evaluation)."""
+        y = self.state_at(t)
+        w = self.rw
+        f = np.empty_like(y)
+        AG.angle_rhs(self.N, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        self.ctl[R.Q_NRHS] += 1
+        Z = np.zeros((K.NROWS, self.N + 1))
+        meas = np.zeros(K.NMEAS)
+        AG.measure_angles(self.N, y, w.c, w.s, w.sig, Z, self.rinv0, meas)
+        return Z, meas
+
+    def refine(self) -> None:
+        """Locate the peaks flagged by the compiled loop on the dense output."""
+        bits = int(self.ctl[R.Q_REFINE])
+        self.ctl[R.Q_REFINE] = 0.0
+        pk = self.pk
+        for qi in range(4):
+            if not bits & (1 << qi):
+                continue
+            ta, tb = float(pk[qi, R.PK_TA]), float(pk[qi, R.PK_TB])
+            m = _PEAK_MEAS[qi]
+            if not tb > ta:
+                continue
+            res = minimize_scalar(lambda tt: -self.Z_at(tt)[1][m], bounds=(ta, tb), method="bounded",
+                                  options={"xatol": PEAK_XTOL * (tb - ta) + 1e-15 * abs(tb)})
+            tq = float(res.x)
+            q = float(-res.fun)
+            if q > pk[qi, R.PK_BEST]:
+                pk[qi, R.PK_BEST] = q
+                pk[qi, R.PK_TBEST] = tq
+            if qi == 0 and (self.peak_state is None or self.peak_state[0] != pk[0, R.PK_TBEST]):
+                tq = float(pk[0, R.PK_TBEST])
+                self.peak_state = (tq, self.Z_at(tq)[0])
+
+    def _set_targets(self) -> None:
+        c = self.ctl
+        while self.requested and self.requested[0] <= self.t:
+            self.requested.pop(0)
+        c[R.Q_TRET] = self.requested[0] if self.requested else np.inf
+        c[R.Q_VDOWN] = self.after_fracs[0] if self.after_fracs else 0.0
+
+    def loop(self, bar) -> int:
+        c = self.ctl
+        if not np.isfinite(c[R.Q_VUP]):
+            c[R.Q_VUP] = SPEED_LEVEL_0
+            while c[R.Q_VUP] <= self.meas0[K.M_VMAX]:
+                c[R.Q_VUP] *= SPEED_LEVEL_FACTOR
+        self._set_targets()
+        w = self.w
+        while True:
+            code = R.advance_rk(self.N, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ytmp,
+                                w.c, w.s, w.S, w.cp, w.dp, w.sig, self.Z, self.rinv0, c, self.rec, self.pk,
+                                self.meas)
+            self.drain()
+            if c[R.Q_REFINE] != 0.0:
+                self.refine()
+            if bar is not None:
+                bar.update(self.t - bar.n)
+                bar.set_postfix_str(f"v_max={self.meas[K.M_VMAX]:.4g} dt={c[R.Q_H]:.3g} steps={int(c[R.Q_NSTEPS])}",
+                                    refresh=False)
+            t = self.t
+            if code == K.RET_T_RETURN:
+                while self.requested and self.requested[0] <= t:
+                    tr = self.requested.pop(0)
+                    self.snapshots.append((tr, "requested", self.Z_at(tr)[0]))
+            elif code == K.RET_V_UP:
+                self.snapshots.append((t, "speed_level", self.Z.copy()))
+                while c[R.Q_VUP] <= self.meas[K.M_VMAX]:
+                    c[R.Q_VUP] *= SPEED_LEVEL_FACTOR
+            elif code == K.RET_V_DOWN:
+                self.snapshots.append((t, "after_peak", self.Z.copy()))
+                vpk = self.pk[0, R.PK_BEST]
+                while self.after_fracs and self.meas[K.M_VMAX] < self.after_fracs[0] * vpk:
+                    self.after_fracs.pop(0)
+            elif code in (K.RET_CALL_LIMIT, K.RET_RECORD_FULL, R.RET_REFINE):
+                pass
+            else:
+                return code
+            self._set_targets()
+
+
+def _failure_message(code: int, eng: _Engine) -> str:
+    t = eng.t
+    if code == K.RET_FAIL_NAN:
+        return f"non-finite values (NaN/inf) in the state at t={t:.9g}"
+    if code == K.RET_FAIL_DT:
+        return f"time-step underflow at t={t:.9g}: dt={eng.ctl[R.Q_H]:.3g} < {eng.ctl[R.Q_DTMIN]:.3g}"
+    if code == K.RET_FAIL_DRIFT:
+        return (f"link-length drift past the bound at t={t:.9g}: relative link error "
+                f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error = {eng.ctl[R.Q_MAXLINK]:.3g}")
+    return f"unknown failure code {code}"
+
+
+_compiled = False
+
+
+def _warm_up() -> None:
+    """Compile (or load from the numba cache) the kernels on a tiny problem, so that
+    compilation is not counted in a run's wall time."""
+    global _compiled
+    if _compiled:
+        return
+    y0 = AG.state_to_angles(initial_state(0.5, 3, chords="exact"))
+    eng = _Engine(y0, 0.0, tol=1e-6, dt0=None, t_end=0.05, stop_fraction=0.0, thin=0.0, max_link_error=0.5,
+                  snapshot_times=(0.01,))
+    eng.loop(None)
+    eng.pk[0, R.PK_TA], eng.pk[0, R.PK_TB] = eng.t - 0.5 * eng.HS[int(eng.ctl[R.Q_SLOT])], eng.t
+    eng.ctl[R.Q_REFINE] = 1.0
+    eng.refine()
+    _compiled = True
+
+
+def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
+                  max_link_error, chords, initial, output, progress):
+    """The body of :func:`snapping.simulate.run` for the angle-form methods (inputs
+    already validated by it). Returns a :class:`snapping.simulate.Run`.
+
+    Examples
+    --------
+    >>> from snapping.simulate import run
+    >>> ds = run(0.5, 50, method="fast", chords="exact").dataset
+    >>> ds.attrs["method"], round(ds.attrs["t_snap_v"], 3), bool(ds.attrs["link_drift"] < 1e-14)
+    ('dop853', 1.144, True)
+    """
+    from .. import __version__
+    from .stepper import Run, SimulationError
+
+    method = resolve_method(method)
+    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+    y0 = AG.state_to_angles(state0)
+    inputs = {
+        "chi": chi, "N": N, "method": method, "tol": tol, "dt0": 0.0, "t_end": 0.0 if t_end is None else t_end,
+        "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
+        "chords": chords, "initial": "catenary" if initial is None else "snapshot", "t_end_max": t_end_max,
+        "max_link_error": max_link_error,
+    }
+    _warm_up()
+    wall0 = time.perf_counter()
+    eng = _Engine(y0, state0.t, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
+                  stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
+                  max_link_error=max_link_error, snapshot_times=snapshot_times)
+    inputs["dt0"] = eng.dt0
+    bar = None
+    if progress or progress is None:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=t_end, file=sys.stderr, disable=None if progress is None else False, unit="t",
+                   desc=f"chain N={N} ({method})", dynamic_ncols=True,
+                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
+                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
+    status, reason, code = "completed", "", None
+    try:
+        code = eng.loop(bar)
+    except KeyboardInterrupt:
+        status, reason = "interrupted", f"interrupted by the user at t={eng.t:.9g}"
+    finally:
+        wall = time.perf_counter() - wall0
+        if bar is not None:
+            bar.close()
+    if code is not None:
+        if code == K.RET_STOP:
+            reason = f"snap detected: v_max fell below {stop_fraction:g} of its peak"
+        elif code == K.RET_END:
+            reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
+        else:
+            status, reason = "failed", _failure_message(code, eng)
+    if eng.peak_state is not None:
+        eng.snapshots.append((eng.peak_state[0], "peak", eng.peak_state[1]))
+    eng.snapshots.append((eng.t, "final", eng.Z.copy()))
+    records = eng.records()
+    c, pk = eng.ctl, eng.pk
+    results = {"status": status, "stop_reason": reason}
+    for qi, name in enumerate(K.PEAK_QUANTITIES):
+        if name != "kappa":
+            results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
+        results[f"{name}_peak"] = float(pk[qi, R.PK_BEST])
+    results.update({
+        "kappa_max_0": float(eng.meas0[K.M_KMAX]),
+        "energy_drift": float(c[R.Q_DRIFT_E]),
+        "link_drift": float(c[R.Q_DRIFT_LINK]),
+        "link_drift_initial": float(c[R.Q_DRIFT_LINK]),
+        "length_drift": float(c[R.Q_DRIFT_LEN]),
+        "link_error_initial": eng.link_error_initial,
+        "t_final": eng.t,
+        "energy_initial": float(eng.meas0[K.M_ENERGY]),
+        "dt_min_accepted": float(c[R.Q_DT_MIN_ACC]) if np.isfinite(c[R.Q_DT_MIN_ACC]) else float("nan"),
+        "dt_max_accepted": float(c[R.Q_DT_MAX_ACC]) if c[R.Q_DT_MAX_ACC] > 0 else float("nan"),
+        "n_steps": int(c[R.Q_NSTEPS]),
+        "n_rejected": int(c[R.Q_NREJ]),
+        "n_rhs": int(c[R.Q_NRHS]),
+        "wall_time": wall,
+        "snapping_version": __version__,
+    })
+    ds = build_dataset(records, eng.snapshots, N, inputs, results)
+    Z = eng.Z
+    final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), eng.t)
+    final.x[-1] = final.y[-1] = final.vx[-1] = final.vy[-1] = 0.0
+    final.extra["angles"] = eng.Y1[int(c[R.Q_SLOT])].copy()
+    path = save(ds, output) if output is not None else None
+    if status == "failed":
+        where = f"; what was computed is saved in {path}" if path else ""
+        raise SimulationError(f"simulation failed: {reason}{where}", dataset=ds, path=path)
+    if status == "interrupted":
+        raise KeyboardInterrupt(reason + (f"; saved in {path}" if path else ""))
+    return Run(ds, final, path)

@@ -1,0 +1,336 @@
+"""A compiled Dormand-Prince 8(5,3) integrator for the chain in link angles.
+
+The explicit embedded Runge-Kutta pair DOP853 (Hairer, Norsett & Wanner, *Solving
+ODE I*, sec. II.10; coefficients from :mod:`scipy.integrate._ivp.dop853_coefficients`
+at import time) with its 7th-order dense output, applied to the angle formulation of
+:mod:`snapping.simulate.angles` (link lengths exact to round-off). The whole step loop
+-- 12 stages, error estimate, step-size control, the per-step diagnostics and record
+of :mod:`snapping.simulate.kernels`, peak detection, stop rules -- is one numba
+function (:func:`advance_rk`); Python only sees it every few thousand steps or when
+something must happen (a snapshot, a peak to refine, a full record buffer).
+
+Error control: per component ``e_i = h |e5_i|^2 / sqrt(e5_i^2 + 0.01 e3_i^2)`` with
+``e5, e3`` the 5th- and 3rd-order embedded estimates scaled by
+``tol (1 + max(|y_i(t)|, |y_i(t + h)|))`` (rtol = atol = tol), and the *maximum* over
+the 2N components (not the RMS: the snap is local to a few links at the free end and
+an RMS over N links would dilute it). A step is accepted when the error is <= 1; the
+next step is ``h min(10, 0.9 err^(-1/8))`` (at most ``h`` after a rejection), a
+rejected one is retried with ``h max(0.2, 0.9 err^(-1/8))``.
+
+Peaks. The maxima over the chain of speed, acceleration, tension and curvature are
+sampled at every accepted step like the Euler-Richardson runs; when a sample that is
+a new record is followed by a smaller one, the peak lies between the neighbouring
+steps, and it is located with the dense output (bounded Brent search on the
+interpolated state; accelerations and tensions there from a tension solve). The run's
+``*_peak`` values and ``t_snap_*`` times are those located maxima.
+
+Cost: 12 right-hand-side evaluations per attempted step (first same as last), 3 more
+for the dense output of a step where it is needed, 1 per point of a peak search; all
+are counted in ``n_rhs``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.integrate._ivp import dop853_coefficients as _dc
+
+from . import angles as AG
+from . import kernels as K
+
+NS = _dc.N_STAGES  # 12
+NSX = _dc.N_STAGES_EXTENDED  # 16
+NI = _dc.INTERPOLATOR_POWER  # 7
+A_RK = np.ascontiguousarray(_dc.A, dtype=np.float64)  # (16, 16), rows 13..15: dense-output stages
+B_RK = np.ascontiguousarray(_dc.B, dtype=np.float64)  # (12,)
+E3_RK = np.ascontiguousarray(_dc.E3, dtype=np.float64)  # (13,)
+E5_RK = np.ascontiguousarray(_dc.E5, dtype=np.float64)  # (13,)
+D_RK = np.ascontiguousarray(_dc.D, dtype=np.float64)  # (4, 16)
+#: number of nonzero A entries of each stage row, and their columns (skip the zeros)
+_NZ = np.zeros(NSX, dtype=np.int64)
+_NZC = np.zeros((NSX, NSX), dtype=np.int64)
+for _s in range(NSX):
+    _cols = [j for j in range(_s) if A_RK[_s, j] != 0.0]
+    _NZ[_s] = len(_cols)
+    _NZC[_s, : len(_cols)] = _cols
+_E5NZ = np.array([j for j in range(NS + 1) if E5_RK[j] != 0.0], dtype=np.int64)
+_E3NZ = np.array([j for j in range(NS + 1) if E3_RK[j] != 0.0], dtype=np.int64)
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+ERR_EXPONENT = -1.0 / 8.0
+
+# ---------------------------------------------------------------- control array
+(Q_T, Q_H, Q_SLOT, Q_NSTEPS, Q_NREJ, Q_NRHS, Q_NREC, Q_TOL, Q_THIN, Q_MAXLINK, Q_DTMIN,
+ Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
+ Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
+ Q_ERR_MAX_ACC, Q_REFINE, Q_DONE) = range(31)
+NQ = 31
+
+# peak tracking: rows v, a, sigma, kappa
+(PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
+NPKR = 8
+
+RET_REFINE = 7  # (the other return codes are those of kernels.advance)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def _stage_state(n, s, h, y0, Kst, out):
+    """out = y0 + h sum_j A[s, j] K_j over the nonzero A[s, j]."""
+    m = _NZ[s]
+    for i in range(n):
+        acc = 0.0
+        for jj in range(m):
+            j = _NZC[s, jj]
+            acc += A_RK[s, j] * Kst[j, i]
+        out[i] = y0[i] + h * acc
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def rk_step(N, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol):
+    """One DOP853 step of size h from y0 (with Kst[0] = f(y0)) into y1; Kst[1..12] are
+    filled (Kst[12] = f(y1), and c, s, sig then belong to y1). Returns the scaled
+    error (accept if <= 1)."""
+    n = 2 * N
+    for st in range(1, NS):
+        _stage_state(n, st, h, y0, Kst, ytmp)
+        AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
+    for i in range(n):
+        acc = 0.0
+        for j in range(NS):
+            acc += B_RK[j] * Kst[j, i]
+        y1[i] = y0[i] + h * acc
+    AG.angle_rhs(N, y1, Kst[NS], c, s, S, cp, dp, sig)
+    err = 0.0
+    for i in range(n):
+        e5 = 0.0
+        for jj in range(_E5NZ.size):
+            j = _E5NZ[jj]
+            e5 += E5_RK[j] * Kst[j, i]
+        e3 = 0.0
+        for jj in range(_E3NZ.size):
+            j = _E3NZ[jj]
+            e3 += E3_RK[j] * Kst[j, i]
+        sc = tol * (1.0 + max(abs(y0[i]), abs(y1[i])))
+        e5 /= sc
+        e3 /= sc
+        d = e5 * e5 + 0.01 * e3 * e3
+        if d > 0.0:
+            e = abs(h) * e5 * e5 / math.sqrt(d)
+            if e > err:
+                err = e
+        elif not (d == 0.0):  # NaN
+            return np.inf
+    return err
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def dense_build(N, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig):
+    """The 7 dense-output coefficient vectors F of a step (3 more evaluations)."""
+    n = 2 * N
+    for st in range(NS + 1, NSX):
+        _stage_state(n, st, h, y0, Kst, ytmp)
+        AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
+    for i in range(n):
+        dy = y1[i] - y0[i]
+        f0 = Kst[0, i]
+        f1 = Kst[NS, i]
+        F[0, i] = dy
+        F[1, i] = h * f0 - dy
+        F[2, i] = 2.0 * dy - h * (f1 + f0)
+        for r in range(4):
+            acc = 0.0
+            for j in range(NSX):
+                acc += D_RK[r, j] * Kst[j, i]
+            F[3 + r, i] = h * acc
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def dense_eval(N, x, y0, F, out):
+    """The dense output at the fraction x in [0, 1] of the step (scipy's Horner form)."""
+    n = 2 * N
+    for i in range(n):
+        v = 0.0
+        for k in range(NI):
+            v += F[NI - 1 - k, i]
+            if k % 2 == 0:
+                v *= x
+            else:
+                v *= 1.0 - x
+        out[i] = v + y0[i]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def _changed(q, last, thin):
+    return abs(q - last) > thin * abs(last)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas):
+    """Advance the angle-form chain with DOP853 until something needs Python.
+
+    Two step slots (arrays indexed [slot]): ``Y0``/``Y1`` start and end states, ``KK``
+    (2, 16, 2N) the stages, ``TS``/``HS`` start time and size, ``DOK`` whether the
+    slot's dense output has been built (cleared when the slot is reused).
+    ``ctl[Q_SLOT]`` is the slot of the last accepted step: its ``Y1`` is the current
+    state, ``KK[slot, 12]`` its derivative, and ``Z``/``meas`` its diagnostics.
+    Returns a ``kernels.RET_*`` code or :data:`RET_REFINE` (``ctl[Q_REFINE]`` is a
+    bit mask of the quantities v, a, sigma, kappa whose peak is to be located on
+    ``[pk[q, PK_TA], pk[q, PK_TB]]``, which the two slots cover).
+    """
+    n = 2 * N
+    tol = ctl[Q_TOL]
+    thin = ctl[Q_THIN]
+    maxlink = ctl[Q_MAXLINK]
+    dtmin = ctl[Q_DTMIN]
+    limit = int(ctl[Q_STEPS_PER_CALL])
+    tend = ctl[Q_TEND]
+    tret = ctl[Q_TRET]
+    vup = ctl[Q_VUP]
+    vdown = ctl[Q_VDOWN]
+    stopfrac = ctl[Q_STOPFRAC]
+    e0 = ctl[Q_E0]
+    l0 = ctl[Q_L0]
+    cap = rec.shape[0]
+    sl = int(ctl[Q_SLOT])
+    t = ctl[Q_T]
+    dt = ctl[Q_H]
+    nrec = int(ctl[Q_NREC])
+    ncall = 0
+    code = K.RET_CALL_LIMIT
+    rejected = False
+    while True:
+        ns = 1 - sl
+        last = False
+        h = dt
+        rem = tend - t
+        if h >= rem * (1.0 - 1e-8):
+            h = rem
+            last = True
+        y0 = Y0[ns]
+        ycur = Y1[sl]
+        for i in range(n):
+            y0[i] = ycur[i]
+            KK[ns, 0, i] = KK[sl, NS, i]
+        err = rk_step(N, h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol)
+        ctl[Q_NRHS] += float(NS)
+        if not (err - err == 0.0):  # NaN/inf in the stages: reject, shrink hard
+            dt = MIN_FACTOR * h
+            ctl[Q_NREJ] += 1.0
+            rejected = True
+            if dt < dtmin:
+                code = K.RET_FAIL_NAN
+                break
+            continue
+        if err > 1.0:
+            dt = h * max(MIN_FACTOR, SAFETY * err ** ERR_EXPONENT)
+            ctl[Q_NREJ] += 1.0
+            rejected = True
+            if dt < dtmin:
+                code = K.RET_FAIL_DT
+                break
+            continue
+        # ---- accept
+        if err == 0.0:
+            fac = MAX_FACTOR
+        else:
+            fac = min(MAX_FACTOR, SAFETY * err ** ERR_EXPONENT)
+        if rejected:
+            fac = min(1.0, fac)
+        rejected = False
+        TS[ns] = t
+        HS[ns] = h
+        DOK[ns] = 0.0
+        t = tend if last else t + h
+        sl = ns
+        dt = h * fac
+        ctl[Q_NSTEPS] += 1.0
+        ncall += 1
+        if h < ctl[Q_DT_MIN_ACC]:
+            ctl[Q_DT_MIN_ACC] = h
+        if h > ctl[Q_DT_MAX_ACC] and not last:
+            ctl[Q_DT_MAX_ACC] = h
+        if err > ctl[Q_ERR_MAX_ACC]:
+            ctl[Q_ERR_MAX_ACC] = err
+        # c, s, sig belong to Y1[sl] (the last evaluation of rk_step)
+        AG.measure_angles(N, Y1[sl], c, s, sig, Z, rinv0, meas)
+        # ---- running peaks (every accepted step)
+        for qi in range(4):
+            if qi == 0:
+                q = meas[K.M_VMAX]
+            elif qi == 1:
+                q = meas[K.M_AMAX]
+            elif qi == 2:
+                q = meas[K.M_SIGMAX]
+            else:
+                q = meas[K.M_KMAX]
+            if q > pk[qi, PK_SBEST]:
+                pk[qi, PK_SBEST] = q
+                pk[qi, PK_TBEFORE] = pk[qi, PK_TPREV]
+                pk[qi, PK_NEED] = 1.0
+                if q > pk[qi, PK_BEST]:
+                    pk[qi, PK_BEST] = q
+                    pk[qi, PK_TBEST] = t
+            elif pk[qi, PK_NEED] != 0.0:
+                pk[qi, PK_NEED] = 0.0
+                pk[qi, PK_TA] = pk[qi, PK_TBEFORE]
+                pk[qi, PK_TB] = t
+                ctl[Q_REFINE] = float(int(ctl[Q_REFINE]) | (1 << qi))
+            pk[qi, PK_TPREV] = t
+        # ---- invariants
+        if meas[K.M_LINKERR] > ctl[Q_DRIFT_LINK]:
+            ctl[Q_DRIFT_LINK] = meas[K.M_LINKERR]
+        dl = abs(meas[K.M_LENGTH] - l0) / l0
+        if dl > ctl[Q_DRIFT_LEN]:
+            ctl[Q_DRIFT_LEN] = dl
+        de = abs(meas[K.M_ENERGY] - e0)
+        if de > ctl[Q_DRIFT_E]:
+            ctl[Q_DRIFT_E] = de
+        # ---- why stop here?
+        vmax = meas[K.M_VMAX]
+        vbest = pk[0, PK_BEST]
+        code = -1
+        if meas[K.M_FINITE] == 0.0:
+            code = K.RET_FAIL_NAN
+        elif meas[K.M_LINKERR] > maxlink:
+            code = K.RET_FAIL_DRIFT
+        elif dt < dtmin:
+            code = K.RET_FAIL_DT
+        elif stopfrac > 0.0 and vmax < stopfrac * vbest:
+            code = K.RET_STOP
+        elif last:
+            code = K.RET_END
+        elif t >= tret:
+            code = K.RET_T_RETURN
+        elif vmax >= vup:
+            code = K.RET_V_UP
+        elif vdown > 0.0 and vmax < vdown * vbest:
+            code = K.RET_V_DOWN
+        elif ctl[Q_REFINE] != 0.0:
+            code = RET_REFINE
+        # ---- record (thinned by relative change; always the last step)
+        if (thin == 0.0 or code == K.RET_STOP or code == K.RET_END or code >= K.RET_FAIL_NAN
+                or _changed(vmax, ctl[Q_LAST_V], thin) or _changed(meas[K.M_AMAX], ctl[Q_LAST_A], thin)
+                or _changed(meas[K.M_SIGMAX], ctl[Q_LAST_S], thin) or _changed(meas[K.M_KMAX], ctl[Q_LAST_K], thin)):
+            K._write_record(rec, nrec, t, h, err * tol, meas)
+            nrec += 1
+            ctl[Q_LAST_V] = vmax
+            ctl[Q_LAST_A] = meas[K.M_AMAX]
+            ctl[Q_LAST_S] = meas[K.M_SIGMAX]
+            ctl[Q_LAST_K] = meas[K.M_KMAX]
+        if code >= 0:
+            break
+        if nrec >= cap:
+            code = K.RET_RECORD_FULL
+            break
+        if ncall >= limit:
+            code = K.RET_CALL_LIMIT
+            break
+    ctl[Q_T] = t
+    ctl[Q_H] = dt
+    ctl[Q_SLOT] = float(sl)
+    ctl[Q_NREC] = float(nrec)
+    return code
