@@ -288,3 +288,18 @@ def test_small_real_run():
     # delta_kappa_m predicts the peak speed and acceleration well (paper Fig. 4(c)-(d))
     ratios = res.delta.ratios()["delta_kappa_m"]
     assert 0.7 < ratios["v"] < 1.4 and 0.5 < ratios["a"] < 2.0
+
+
+def test_ideal_window_exponent_tends_to_the_asymptotic_one():
+    from snapping.scaling import ideal_window_exponent
+
+    # deep in the asymptotic regime every exact quantity follows its asymptotic exponent
+    assert ideal_window_exponent("free_end_speed", 1e-10, 1e-9) == pytest.approx(-1 / 3, abs=1e-4)
+    assert ideal_window_exponent("free_end_acceleration", 1e-10, 1e-9) == pytest.approx(-4 / 3, abs=1e-4)
+    assert ideal_window_exponent("tether_tension", 1e-10, 1e-9) == pytest.approx(-2 / 3, abs=1e-4)
+    # on a late-but-finite window the static weight s0 ~ 1 in the tether tension s0 + s0'^2 flattens it:
+    # d ln sigma / d ln tau = (-2/3) s0'^2 / (s0 + s0'^2) to leading order, i.e. about -0.6 at tau ~ 3e-3
+    b = ideal_window_exponent("tether_tension", 1e-3, 1e-2)
+    assert -0.66 < b < -0.55
+    with pytest.raises(SnappingInputError, match="window"):
+        ideal_window_exponent("tether_tension", 1e-2, 1e-3)

@@ -39,6 +39,7 @@ from .run import (
     delta_comparison,
     delta_rows,
     fit_run,
+    ideal_window_exponent,
     iter_runs,
     load_run,
     local_slopes,
@@ -58,6 +59,7 @@ def __getattr__(name):  # figures import matplotlib lazily
 
 
 __all__ = [
+    "ideal_window_exponent",
     "LocalSlope", "PeakTime", "PowerLawFit", "Window", "find_window", "fit_power_law", "local_slope", "peak_time",
     "DeltaComparison", "ExponentRow", "RowSpec", "RunFit", "SnapTimes", "check_run", "delta_comparison", "delta_rows", "fit_run",
     "iter_runs", "load_run", "local_slopes", "report_rows", "report_specs", "snapping_times", "summary_rows",
