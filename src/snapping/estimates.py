@@ -419,9 +419,9 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
             f"{q['v_m_per_s']:>10.4g} {q['a_m_per_s2']:>12.4g} {q['sigma_N']:>10.4g}"
         )
     line()
-    line("delta_kappa0 tends to underestimate the acceleration by ~100x; delta_c is the practical")
-    line("estimate from the initial geometry alone (paper, Fig. 4). delta_kappa_m needs a run")
-    line("(snapping fit).")
+    line("Against simulations (paper Fig. 4; snapping reproduce): delta_kappa0 underestimates the peak")
+    line("acceleration by one to two orders of magnitude; delta_c, from the initial geometry alone, is")
+    line("within an order of magnitude; delta_kappa_m (needs a run: snapping fit) is the most accurate.")
 
 
 # =============================================================================
