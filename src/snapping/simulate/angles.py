@@ -58,11 +58,55 @@ from . import kernels as K
 
 __all__ = [
     "Work", "angle_rhs", "state_to_angles", "angles_to_state", "angles_to_Z", "measure_angles",
-    "reference_rhs", "link_error_angles",
+    "reference_rhs", "link_error_angles", "sincos",
 ]
 
 #: the minors p_j are rescaled by a power of two every BLOCK rows (as in kernels.rhs)
 BLOCK = 32
+
+
+# fdlibm's Cody-Waite split of pi/2 and its sin/cos kernels on [-pi/4, pi/4] (|error| < 1 ulp)
+_PIO2_1 = 1.57079632673412561417e+00
+_PIO2_2 = 6.07710050650619224932e-11
+_PIO2_3 = 2.02226624871116645580e-21
+_TWO_OVER_PI = 0.63661977236758134308
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+#: beyond this |theta| the three-part reduction loses bits: use libm
+SINCOS_FAST_MAX = 1.0e5
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def sincos(N, th, c, s):
+    """c[j], s[j] = cos(th[j]), sin(th[j]) for j < N, to within ~1 ulp.
+
+    A branch-free polynomial (fdlibm's kernels after a three-part reduction by pi/2)
+    that the compiler vectorises: about 2 ns per angle against about 16 ns for two
+    libm calls. Angles beyond ``SINCOS_FAST_MAX`` in magnitude go to libm.
+    """
+    big = 0.0
+    for j in range(N):
+        big = max(big, abs(th[j]))
+    if big > SINCOS_FAST_MAX:
+        for j in range(N):
+            c[j] = math.cos(th[j])
+            s[j] = math.sin(th[j])
+        return
+    for j in range(N):
+        x = th[j]
+        k = np.floor(x * _TWO_OVER_PI + 0.5)
+        r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3
+        z = r * r
+        sn = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+        cs = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
+        q = k - 4.0 * np.floor(k * 0.25)  # quadrant 0..3
+        swap = q == 1.0 or q == 3.0
+        a = sn if swap else cs
+        b = cs if swap else sn
+        c[j] = -a if (q == 1.0 or q == 2.0) else a
+        s[j] = -b if q >= 2.0 else b
 
 
 class Work:
@@ -91,9 +135,8 @@ def angle_rhs(N, y, f, c, s, S, cp, dp, sig):
     fN = float(N)
     n2 = fN * fN
     inv_n2 = 1.0 / n2
+    sincos(N, y, c, s)
     for j in range(N):
-        c[j] = math.cos(y[j])
-        s[j] = math.sin(y[j])
         f[j] = y[N + j]
     if N == 1:
         w = y[1]

@@ -307,7 +307,7 @@ def _warm_up() -> None:
 
 
 def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-                  max_link_error, chords, initial, output, progress):
+                  max_link_error, chords, initial, output, progress, dt_min=1e-14):
     """The body of :func:`snapping.simulate.run` for the angle-form methods (inputs
     already validated by it). Returns a :class:`snapping.simulate.Run`.
 
@@ -334,7 +334,7 @@ def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, 
     wall0 = time.perf_counter()
     eng = _Engine(y0, state0.t, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
                   stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
-                  max_link_error=max_link_error, snapshot_times=snapshot_times)
+                  max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min)
     inputs["dt0"] = eng.dt0
     bar = None
     if progress or progress is None:

@@ -81,12 +81,17 @@ RET_REFINE = 7  # (the other return codes are those of kernels.advance)
 def _stage_state(n, s, h, y0, Kst, out):
     """out = y0 + h sum_j A[s, j] K_j over the nonzero A[s, j]."""
     m = _NZ[s]
+    j = _NZC[s, 0]
+    a = h * A_RK[s, j]
+    Kj = Kst[j]
     for i in range(n):
-        acc = 0.0
-        for jj in range(m):
-            j = _NZC[s, jj]
-            acc += A_RK[s, j] * Kst[j, i]
-        out[i] = y0[i] + h * acc
+        out[i] = y0[i] + a * Kj[i]
+    for jj in range(1, m):
+        j = _NZC[s, jj]
+        a = h * A_RK[s, j]
+        Kj = Kst[j]
+        for i in range(n):
+            out[i] += a * Kj[i]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
