@@ -26,7 +26,10 @@ __all__ = ["run", "rerun", "Run", "SimulationError", "METHODS", "integrate_fixed
 
 #: ``euler-richardson``: the paper's adaptive scheme (reference);
 #: ``euler-richardson-fixed``: the same step at a fixed dt = dt0 (for order studies).
-METHODS = ("euler-richardson", "euler-richardson-fixed")
+#: ``dop853``: the chain in link angles (links exact to round-off) with a compiled
+#: Dormand-Prince 8(5,3) pair and dense output (:mod:`snapping.simulate.highorder`);
+#: ``fast``: always the project's best exact method (now ``dop853``).
+METHODS = ("euler-richardson", "euler-richardson-fixed", "dop853", "fast")
 
 #: automatic snapshots when v_max first reaches SPEED_LEVEL_0 * SPEED_LEVEL_FACTOR**n
 SPEED_LEVEL_0 = 1.0
@@ -424,6 +427,13 @@ def run(
     (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
      chords, output) = _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times,
                                  record_thin, max_link_error, chords, initial, output)
+    if method in ("dop853", "fast"):  # issue 6: angle form + DOP853, in snapping.simulate.highorder
+        from .highorder import run_highorder
+
+        return run_highorder(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
+                             t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
+                             max_link_error=max_link_error, chords=chords, initial=initial, output=output,
+                             progress=progress)
     state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
     if dt0 is None:
         dt0 = math.sqrt(tol)
