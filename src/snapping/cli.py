@@ -162,11 +162,16 @@ def _add_simulate(sub) -> None:
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
             "  snapping simulate --chi 0.25 --N 2000 --tol 1e-8 --json\n"
-            "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2"
+            "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2\n"
+            "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
+            "\n"
+            "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
+            "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
+            "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit."
         ),
     )
-    p.add_argument("--chi", type=float, required=True, help="end separation / length, in (0, 1)")
-    p.add_argument("--N", type=int, required=True, help="number of links (>= 1)")
+    p.add_argument("--chi", type=float, default=None, help="end separation / length, in (0, 1)")
+    p.add_argument("--N", type=int, default=None, help="number of links (>= 1)")
     p.add_argument("--tol", type=float, default=1e-8, help="stepper tolerance (default 1e-8, the paper's)")
     p.add_argument("--method", default="euler-richardson", choices=["euler-richardson", "euler-richardson-fixed"],
                    help="time stepper (default: the paper's adaptive euler-richardson)")
@@ -180,6 +185,17 @@ def _add_simulate(sub) -> None:
     p.add_argument("--chords", default="arclength", choices=["arclength", "exact"],
                    help="initial nodes at equal arclength (the paper's) or with exact chords 1/N")
     p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file")
+    p.add_argument("--resume", metavar="RUN.nc", default=None,
+                   help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
+    p.add_argument("--checkpoint-every", type=float, default=300.0, metavar="SECONDS",
+                   help="with -o: save the run's full state every this many seconds (default 300; 0: very often)")
+    p.add_argument("--max-link-error", type=float, default=1e-2,
+                   help="fail when a link length is off 1/N by more than this fraction (default 1e-2)")
+    p.add_argument("--max-energy-drift", type=float, default=None,
+                   help="fail when |E(t) - E(0)| exceeds this (default: no bound)")
+    p.add_argument("--dt-min", type=float, default=1e-14, help="fail when the adaptive step falls below this (default 1e-14)")
+    p.add_argument("--max-rejections", type=int, default=100,
+                   help="fail after more than this many consecutive rejected steps (default 100)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (it is off anyway when not a tty)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.set_defaults(func=_cmd_simulate)
@@ -193,13 +209,29 @@ def _cmd_simulate(args) -> int:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
+    progress = False if args.no_progress else None
+    if args.resume is None and (args.chi is None or args.N is None):
+        raise SnappingInputError("the arguments --chi and --N are required (or --resume RUN.nc)")
     try:
-        result = simulate.run(
-            args.chi, args.N, tol=args.tol, method=args.method, dt0=args.dt0, t_end=args.t_end,
-            stop_fraction=args.stop_fraction, snapshot_times=times, record_thin=args.record_thin,
-            chords=args.chords, output=args.output, progress=False if args.no_progress else None,
-        )
+        if args.resume is not None:
+            result = simulate.resume(args.resume, output=args.output, progress=progress,
+                                     checkpoint_every=args.checkpoint_every)
+            args.output = result.path
+            args.chi, args.N = float(result.dataset.attrs["chi"]), int(result.dataset.attrs["N"])
+        else:
+            result = simulate.run(
+                args.chi, args.N, tol=args.tol, method=args.method, dt0=args.dt0, t_end=args.t_end,
+                stop_fraction=args.stop_fraction, snapshot_times=times, record_thin=args.record_thin,
+                chords=args.chords, output=args.output, progress=progress, max_link_error=args.max_link_error,
+                max_energy_drift=args.max_energy_drift, dt_min=args.dt_min, max_rejections=args.max_rejections,
+                checkpoint_every=args.checkpoint_every,
+            )
         summary, failed = result.summary(), None
+    except simulate.RunInterrupted as exc:
+        how = (f"resume with: {simulate.stepper._resume_command(exc.path)}" if exc.path
+               else "nothing was saved (no -o RUN.nc)")
+        print(f"snapping simulate: {exc.args[0].split(';')[0]}; {how}", file=sys.stderr)
+        return exc.exit_status
     except simulate.SimulationError as exc:
         summary, failed = simulate.summary(exc.dataset), exc
     if args.output:
@@ -464,6 +496,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"snapping {args.command}: interrupted", file=sys.stderr)
         return 130
+    except OSError as exc:  # an unwritable or vanished path found while working: one line, exit 2
+        print(f"snapping {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -100,12 +100,22 @@ INPUT_ATTRS: dict[str, str] = {
     "initial": "initial condition: 'catenary' (from chi) or 'snapshot' (the snapshot of kind 'initial' holds it)",
     "t_end_max": "hard end time of an automatic (stop after the snap) run",
     "max_link_error": "relative link-length error at which the run fails",
+    "max_energy_drift": "energy drift |E(t) - E(0)| at which the run fails (0 = no bound)",
+    "dt_min": "time-step floor: the run fails when the adaptive step falls below it",
+    "max_rejections": "consecutive rejected steps at which the run fails",
 }
+
+#: Inputs added after the first files were written, with the value that reproduces an older file.
+INPUT_DEFAULTS: dict[str, float] = {"max_energy_drift": 0.0, "dt_min": 1e-14, "max_rejections": 100}
 
 #: Global attributes: results.
 RESULT_ATTRS: dict[str, str] = {
-    "status": "'completed', 'interrupted' or 'failed'",
+    "status": ("'completed', 'failed', 'interrupted' (stopped by a signal, resumable) or 'checkpoint' "
+               "(saved while running, resumable)"),
     "stop_reason": "why the run stopped",
+    "failure": ("kind of numerical failure: '' (none), 'non_finite', 'step_size', 'link_drift', "
+                "'energy_drift' or 'rejections'"),
+    "failure_node": "index along 'node' of the worst node at a failure (-1: none)",
     "t_snap_v": "snapping time from the peak of the maximum speed",
     "t_snap_a": "snapping time from the peak of the maximum acceleration",
     "t_snap_sigma": "snapping time from the peak of the maximum tension",
@@ -131,3 +141,48 @@ RESULT_ATTRS: dict[str, str] = {
 }
 
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS}
+
+# ---------------------------------------------------------------- checkpoints
+#: Status values of a run file that :func:`snapping.simulate.resume` continues.
+RESUMABLE_STATUS = ("checkpoint", "interrupted")
+
+#: Dimensions of the checkpoint variables (besides ``node`` and ``link``).
+CHECKPOINT_DIMS = {
+    "checkpoint_buffer": "the two state buffers of the compiled loop",
+    "checkpoint_row": "rows x, y, vx, vy, ax, ay, sigma of a kernel state",
+    "checkpoint_ctl": "entries of the compiled loop's control array",
+    "checkpoint_peak": "the tracked peaks v, a, sigma, kappa",
+    "checkpoint_peak_col": "columns of a tracked peak (previous, -1, peak, +1 samples and a flag)",
+    "checkpoint_meas": "entries of the per-step measurement array",
+    "checkpoint_snapshot": "snapshots taken so far",
+    "checkpoint_pending": "requested snapshot times still to come (NaN padded)",
+    "checkpoint_pending_after": "after-peak snapshot fractions still to come (NaN padded)",
+}
+
+#: The complete state of an unfinished run, stored in the run file itself next to the
+#: record so far (the step variables) while ``status`` is one of RESUMABLE_STATUS.
+#: Removed once the run completes or fails. Together with the step variables and the
+#: input attributes they continue the run to the same Dataset, bit for bit.
+CHECKPOINT_VARS: dict[str, dict[str, str]] = {
+    "checkpoint_S": _v("current and next chain state of the compiled loop"),
+    "checkpoint_peak_state": _v("state at the running peak of v_max"),
+    "checkpoint_ctl": _v("control array of the compiled loop (t, dt, counters, drifts, targets)"),
+    "checkpoint_pk": _v("running peak trackers of v_max, a_max, sigma_max, kappa_max"),
+    "checkpoint_meas": _v("measurements of the last accepted step"),
+    "checkpoint_meas0": _v("measurements of the initial state"),
+    "checkpoint_rinv0": _v("1 / (initial chord length)^2 per link"),
+    "checkpoint_snapshot_state": _v("full kernel states of the snapshots so far"),
+    "checkpoint_snapshot_t": _v("times of the snapshots so far"),
+    "checkpoint_requested": _v("requested snapshot times still to come (NaN padded)"),
+    "checkpoint_after_fractions": _v("after-peak snapshot fractions still to come (NaN padded)"),
+}
+#: String variable (no units) holding the kinds of the snapshots so far.
+CHECKPOINT_KIND_VAR = "checkpoint_snapshot_kind"
+
+#: Global attributes of a checkpoint.
+CHECKPOINT_ATTRS: dict[str, str] = {
+    "checkpoint_version": "layout version of the checkpoint variables",
+    "checkpoint_wall_time": "wall-clock seconds spent on the run before this checkpoint",
+    "checkpoint_link_error_initial": "relative error of the initial chords (exact, for the failure bound)",
+    "checkpoint_time": "ISO time at which the checkpoint was written",
+}

@@ -2,8 +2,10 @@
 
 Each run is saved to its own netCDF file as soon as it finishes, written
 atomically (to a temporary file in the same directory, then renamed), so a
-killed sweep never leaves a corrupt file. Rerunning the same sweep skips every
-run whose file is already there and complete. The finished runs combine into one
+killed sweep never leaves a corrupt file. Long runs checkpoint into the same
+file while they run. Rerunning the same sweep skips every run whose file is
+already there and complete, resumes every checkpointed or interrupted one, and
+starts the others afresh. The finished runs combine into one
 Dataset with ``chi`` and ``N`` dimensions (:func:`combine`).
 
 Runs go to local worker processes by default; give a Dask scheduler address (or
@@ -117,11 +119,19 @@ class Grid:
 
 
 def _run_one(params: dict, path: str) -> str:
-    """Worker: run one simulation and save it atomically. Returns the path."""
+    """Worker: run one simulation, checkpointed to ``path`` and saved there atomically.
+
+    A checkpoint of the same run already at ``path`` (a sweep that was
+    interrupted, or whose worker was killed) is resumed; anything else there (a
+    truncated file, another run, a failed run) is replaced by a fresh run.
+    Returns the path.
+    """
     from . import simulate
 
-    result = simulate.run(**params)
-    atomic_to_netcdf(result.dataset, path)
+    if simulate.is_resumable(path, **params):
+        simulate.resume(path, **{k: params[k] for k in ("checkpoint_every",) if k in params})
+    else:
+        simulate.run(**params, output=path)
     return path
 
 

@@ -16,13 +16,39 @@ Example
 
 from .chain import ChainState, curvature_profile, evaluate, initial_state, link_arclength, node_arclength
 from .dataset import build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save
-from .stepper import METHODS, Run, SimulationError, integrate_fixed, rerun, run, summary
+from .stepper import (
+    METHODS,
+    DriftError,
+    EnergyDriftError,
+    NonFiniteError,
+    RejectionError,
+    Run,
+    RunInterrupted,
+    SimulationError,
+    StepSizeError,
+    integrate_fixed,
+    is_resumable,
+    memory_need,
+    rerun,
+    resume,
+    run,
+    summary,
+)
 
 __all__ = [
     "run",
     "rerun",
     "Run",
     "SimulationError",
+    "NonFiniteError",
+    "StepSizeError",
+    "DriftError",
+    "EnergyDriftError",
+    "RejectionError",
+    "RunInterrupted",
+    "resume",
+    "is_resumable",
+    "memory_need",
     "METHODS",
     "ChainState",
     "initial_state",

@@ -98,11 +98,45 @@ def check_writable(path) -> str:
 
 
 def save(ds: xr.Dataset, path) -> str:
-    """Write a run Dataset as netCDF4; returns the path."""
+    """Write a run Dataset as netCDF4, atomically; returns the path.
+
+    The file is written to a temporary file in the same directory, flushed to
+    disk and renamed over ``path`` (``os.replace``): a reader, or a run killed
+    while saving, never sees a half-written file, and an existing file is only
+    replaced by a complete one.
+    """
+    import tempfile
+
     p = os.fspath(path)
-    encoding = {name: {"zlib": True, "complevel": 1} for name in ds.data_vars}
-    ds.to_netcdf(p, format="NETCDF4", engine="netcdf4", encoding=encoding)
+    encoding = {name: {"zlib": True, "complevel": 1} for name in ds.data_vars if ds[name].dtype.kind not in "OUS"}
+    d = os.path.dirname(os.path.abspath(p))
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4", encoding=encoding)
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        if os.path.exists(p):  # keep the permissions of the file it replaces
+            os.chmod(tmp, os.stat(p).st_mode & 0o7777)
+        else:
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, p)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
     return p
+
+
+def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
+    """The per-step record rows (columns ``kernels.RECORD_NAMES``) of a run Dataset:
+    the inverse of :func:`build_dataset` for the step variables (exact)."""
+    cols = [np.asarray(ds[name].values, dtype=float) for name in K.RECORD_NAMES]
+    return np.stack(cols, axis=1) if cols[0].size else np.zeros((0, K.NREC))
 
 
 def load_run(path) -> xr.Dataset:
@@ -150,6 +184,12 @@ def inputs_from_attrs(ds: xr.Dataset) -> dict:
         "t_end_max": float(a["t_end_max"]),
         "max_link_error": float(a["max_link_error"]),
     }
+    for k, default in schema.INPUT_DEFAULTS.items():  # files written before these inputs existed
+        v = a.get(k, default)
+        if k == "max_rejections":
+            out[k] = int(v)
+        else:
+            out[k] = None if float(v) == 0.0 and k == "max_energy_drift" else float(v)
     if str(a.get("initial", "catenary")) == "snapshot":
         out["initial"] = initial_from_dataset(ds)
     return out

@@ -67,8 +67,9 @@ RECORD_NAMES = ("t", "dt", "v_max", "a_max", "sigma_max", "kappa_max", "s_kappa_
 (C_T, C_DT, C_CUR, C_NSTEPS, C_NREJ, C_NRHS, C_NREC, C_TOL, C_FIXED, C_THIN, C_MAXLINK,
  C_DTMIN, C_STEPS_PER_CALL, C_TEND, C_TRET, C_VUP, C_VDOWN, C_STOPFRAC, C_E0, C_L0,
  C_LAST_V, C_LAST_A, C_LAST_S, C_LAST_K, C_DRIFT_LINK, C_DRIFT_LINK0, C_DRIFT_LEN, C_DRIFT_E,
- C_T_PEAKSTATE, C_DT_MIN_ACC, C_DT_MAX_ACC, C_EPS_MAX_ACC) = range(32)
-NCTL = 32
+ C_T_PEAKSTATE, C_DT_MIN_ACC, C_DT_MAX_ACC, C_EPS_MAX_ACC,
+ C_MAXENERGY, C_MAXREJ, C_CONSREJ) = range(35)
+NCTL = 35
 
 # peak tracking: rows v, a, sigma, kappa; columns
 P_TPREV, P_QPREV, P_TM1, P_QM1, P_T0, P_Q0, P_TP1, P_QP1, P_NEED = range(9)
@@ -79,7 +80,7 @@ _PEAK_MEAS = (M_VMAX, M_AMAX, M_SIGMAX, M_KMAX)
 # return codes of :func:`advance`
 RET_CALL_LIMIT, RET_RECORD_FULL, RET_T_RETURN, RET_V_UP, RET_V_DOWN = 0, 1, 2, 3, 4
 RET_STOP, RET_END = 5, 6
-RET_FAIL_NAN, RET_FAIL_DT, RET_FAIL_DRIFT = 10, 11, 12
+RET_FAIL_NAN, RET_FAIL_DT, RET_FAIL_DRIFT, RET_FAIL_ENERGY, RET_FAIL_REJECT = 10, 11, 12, 13, 14
 
 #: growth factor of the time step when the error estimate is exactly zero
 #: (the published rule dt_new = 0.9 dt (tol/eps)^(1/2) is undefined there).
@@ -477,9 +478,9 @@ def advance(N, S, H, dx, dy, cp, dp, rinv0, ctl, rec, pk, PS, meas):
             wx = H[RAX, i] - A[RAX, i]
             wy = H[RAY, i] - A[RAY, i]
             w2 = wx * wx + wy * wy
-            if u2 > m2:
+            if not u2 <= m2:  # (u2 > m2, and a NaN propagates into eps)
                 m2 = u2
-            if w2 > m2:
+            if not w2 <= m2:
                 m2 = w2
         eps = hh * math.sqrt(m2)
         if not (eps - eps == 0.0):
@@ -488,10 +489,15 @@ def advance(N, S, H, dx, dy, cp, dp, rinv0, ctl, rec, pk, PS, meas):
         if not fixed and eps > tol:
             dt = 0.9 * h * math.sqrt(tol / eps)
             ctl[C_NREJ] += 1.0
+            ctl[C_CONSREJ] += 1.0
             if dt < dtmin:
                 code = RET_FAIL_DT
                 break
+            if ctl[C_CONSREJ] > ctl[C_MAXREJ]:
+                code = RET_FAIL_REJECT
+                break
             continue
+        ctl[C_CONSREJ] = 0.0
         # ---- full step into B
         for i in range(N):
             B[RX, i] = A[RX, i] + h * H[RVX, i]
@@ -564,6 +570,8 @@ def advance(N, S, H, dx, dy, cp, dp, rinv0, ctl, rec, pk, PS, meas):
             code = RET_FAIL_NAN
         elif meas[M_LINKERR] > maxlink:
             code = RET_FAIL_DRIFT
+        elif de > ctl[C_MAXENERGY]:
+            code = RET_FAIL_ENERGY
         elif not fixed and dt < dtmin:
             code = RET_FAIL_DT
         elif stopfrac > 0.0 and vmax < stopfrac * pk[0, P_Q0]:

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass
 
@@ -20,9 +22,11 @@ import xarray as xr
 from .. import _validate as V
 from . import kernels as K
 from .chain import ChainState, initial_state
-from .dataset import build_dataset, check_writable, inputs_from_attrs, save
+from .dataset import build_dataset, check_writable, inputs_from_attrs, records_from_dataset, save
 
-__all__ = ["run", "rerun", "Run", "SimulationError", "METHODS", "integrate_fixed"]
+__all__ = ["run", "rerun", "resume", "is_resumable", "memory_need", "Run", "SimulationError", "NonFiniteError",
+           "StepSizeError", "DriftError", "EnergyDriftError", "RejectionError", "RunInterrupted", "METHODS",
+           "integrate_fixed"]
 
 #: ``euler-richardson``: the paper's adaptive scheme (reference);
 #: ``euler-richardson-fixed``: the same step at a fixed dt = dt0 (for order studies).
@@ -38,25 +42,109 @@ SPEED_LEVEL_FACTOR = 1.5
 AFTER_PEAK_FRACTIONS = (0.9, 0.7)
 #: record buffer rows handed back to Python at a time
 RECORD_CHUNK = 8192
-#: node-steps per call into the compiled loop (sets how often the progress bar moves)
+#: node-steps per call into the compiled loop (sets how often the progress bar moves,
+#: and how soon a signal or a due checkpoint is acted on: ~0.1-0.2 s)
 NODE_STEPS_PER_CALL = 10_000_000
+#: default wall-clock seconds between checkpoints of a run with an output file
+CHECKPOINT_EVERY = 300.0
+#: layout version of the checkpoint variables (schema.CHECKPOINT_VARS)
+CHECKPOINT_VERSION = 1
+#: fraction of the available memory a run may plan to use (resource guard)
+MEMORY_MARGIN = 0.8
+#: test hook: called with the engine after every return of the compiled loop; may
+#: return a signal number to act as if that signal had arrived
+_chunk_hook = None
 
 
 class SimulationError(RuntimeError):
     """A run failed numerically (NaN, step-size underflow, link drift past the bound).
 
+    The specific failures are the subclasses :class:`NonFiniteError`,
+    :class:`StepSizeError`, :class:`DriftError` (link lengths),
+    :class:`EnergyDriftError` and :class:`RejectionError`.
+
     Attributes
     ----------
     dataset : xarray.Dataset
-        What was computed until the failure (``status = 'failed'``, ``stop_reason``).
+        What was computed until the failure (``status = 'failed'``, ``stop_reason``,
+        ``failure``, ``failure_node``).
     path : str or None
         Where it was saved, when the run had an output path.
+    t : float
+        Time of the last accepted step.
+    step : int
+        Number of accepted steps.
+    node : int
+        Index along the Dataset's ``node`` dimension of the worst node (0: free end), -1 if unknown.
+    kind : str
+        The ``failure`` attribute ('non_finite', 'step_size', 'link_drift', 'energy_drift', 'rejections').
     """
 
-    def __init__(self, message: str, dataset: xr.Dataset | None = None, path: str | None = None):
+    kind = ""
+
+    def __init__(self, message: str, dataset: xr.Dataset | None = None, path: str | None = None, *,
+                 t: float = float("nan"), step: int = -1, node: int = -1):
         super().__init__(message)
         self.dataset = dataset
         self.path = path
+        self.t = t
+        self.step = step
+        self.node = node
+
+
+class NonFiniteError(SimulationError):
+    """NaN or infinite values in the state, accelerations or error estimate."""
+
+    kind = "non_finite"
+
+
+class StepSizeError(SimulationError):
+    """The adaptive time step fell below the floor ``dt_min``."""
+
+    kind = "step_size"
+
+
+class DriftError(SimulationError):
+    """A link length drifted from 1/N past ``max_link_error`` (plus the initial chord error)."""
+
+    kind = "link_drift"
+
+
+class EnergyDriftError(DriftError):
+    """The total energy drifted from its initial value past ``max_energy_drift``."""
+
+    kind = "energy_drift"
+
+
+class RejectionError(SimulationError):
+    """More than ``max_rejections`` consecutive steps were rejected."""
+
+    kind = "rejections"
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped at a step boundary on SIGINT or SIGTERM (a ``KeyboardInterrupt``).
+
+    Attributes
+    ----------
+    signum : int
+        The signal (``signal.SIGINT`` or ``signal.SIGTERM``); exit status ``128 + signum``.
+    dataset : xarray.Dataset
+        The run so far (``status = 'interrupted'``), with its checkpoint.
+    path : str or None
+        Where it was saved (resume with :func:`resume` or ``snapping simulate --resume``).
+    """
+
+    def __init__(self, message: str, signum: int, dataset: xr.Dataset | None = None, path: str | None = None):
+        super().__init__(message)
+        self.signum = signum
+        self.dataset = dataset
+        self.path = path
+
+    @property
+    def exit_status(self) -> int:
+        """128 + the signal number (130 for SIGINT, 143 for SIGTERM)."""
+        return 128 + int(self.signum)
 
 
 @dataclass
@@ -120,6 +208,20 @@ def _parabola_vertex(tm, qm, t0, q0, tp, qp) -> float:
     return tv if tm <= tv <= tp else t0
 
 
+def _validate_guards(max_energy_drift, dt_min, max_rejections, checkpoint_every):
+    """The failure bounds and the checkpoint interval."""
+    if max_energy_drift is not None:
+        max_energy_drift = V.positive("max_energy_drift", max_energy_drift)
+    dt_min = V.positive("dt_min", dt_min)
+    max_rejections = V.integer("max_rejections", max_rejections, 0)
+    if checkpoint_every is not None:
+        checkpoint_every = V.real("checkpoint_every", checkpoint_every)
+        if checkpoint_every < 0:
+            raise V.SnappingInputError(f"checkpoint_every={checkpoint_every!r} is out of range: must be >= 0 seconds "
+                                       "(or None: no periodic checkpoints)")
+    return max_energy_drift, dt_min, max_rejections, checkpoint_every
+
+
 def _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
               max_link_error, chords, initial, output):
     if initial is None:
@@ -145,6 +247,8 @@ def _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapsho
     t_end_max = V.positive("t_end_max", t_end_max)
     if snapshot_times is None:
         snapshot_times = ()
+    if isinstance(snapshot_times, (str, bytes)):
+        raise V.SnappingInputError(f"snapshot_times={snapshot_times!r} is not a sequence of times")
     try:
         vals = np.atleast_1d(np.asarray(snapshot_times, dtype=float)).ravel()
     except (TypeError, ValueError):
@@ -184,7 +288,7 @@ class _Engine:
     """Buffers and control state of one run (the compiled loop's arguments)."""
 
     def __init__(self, state: ChainState, *, tol, dt0, fixed, t_end, stop_fraction, thin, max_link_error,
-                 snapshot_times, dt_min=1e-14):
+                 snapshot_times, dt_min=1e-14, max_energy_drift=None, max_rejections=100):
         N = state.N
         self.N = N
         self.S = np.zeros((2, K.NROWS, N + 1))
@@ -195,8 +299,15 @@ class _Engine:
         l0 = state.link_lengths()
         self.link_error_initial = float(np.max(np.abs(N * l0 - 1.0)))
         self.rinv0 = 1.0 / (l0 * l0)
+        if not (np.all(l0 > 0.0) and self.link_error_initial < 0.5):
+            raise V.SnappingInputError(
+                f"initial state: link lengths must be close to 1/N={1.0 / N:.6g} (largest relative error "
+                f"{self.link_error_initial:.3g}, at most 0.5 allowed)")
         self.meas = np.zeros(K.NMEAS)
         K.measure(N, self.S[0], self.rinv0, self.meas)
+        if self.meas[K.M_FINITE] == 0.0 or not np.all(np.isfinite(self.S[0])):
+            raise V.SnappingInputError("initial state: non-finite accelerations, tension or energy "
+                                       "(positions or velocities far too large)")
         self.meas0 = self.meas.copy()
         self.rec = np.zeros((RECORD_CHUNK, K.NREC))
         K._write_record(self.rec, 0, state.t, 0.0, 0.0, self.meas)
@@ -224,6 +335,9 @@ class _Engine:
         c[K.C_T_PEAKSTATE] = np.nan
         c[K.C_DT_MIN_ACC] = np.inf
         c[K.C_DT_MAX_ACC] = 0.0
+        c[K.C_MAXENERGY] = np.inf if max_energy_drift is None else max_energy_drift
+        c[K.C_MAXREJ] = max_rejections
+        c[K.C_CONSREJ] = 0.0
         self.ctl = c
         pk = np.full((4, K.NPK), np.nan)
         for qi, m in enumerate(K._PEAK_MEAS):
@@ -255,7 +369,80 @@ class _Engine:
 
     def records(self) -> np.ndarray:
         self.drain()
-        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, K.NREC))
+        if len(self.chunks) > 1:
+            self.chunks = [np.concatenate(self.chunks)]
+        return self.chunks[0] if self.chunks else np.zeros((0, K.NREC))
+
+    def snapshots_now(self) -> list:
+        """The snapshots so far plus the running peak of v_max and the current state ('final')."""
+        snaps = list(self.snapshots)
+        if math.isfinite(self.ctl[K.C_T_PEAKSTATE]):
+            snaps.append((float(self.ctl[K.C_T_PEAKSTATE]), "peak", self.PS.copy()))
+        snaps.append((self.t, "final", self.current().copy()))
+        return snaps
+
+    # -- checkpoints
+    def checkpoint_vars(self) -> dict:
+        """The checkpoint variables (schema.CHECKPOINT_VARS), to add to the run Dataset so far."""
+        from .. import schema
+
+        def pad(vals):
+            return np.asarray(list(vals) + [np.nan], dtype=float)
+
+        nd, ld = schema.NODE_DIM, schema.LINK_DIM
+        row = "checkpoint_row"
+        snaps = self.snapshots
+        out = {
+            "checkpoint_S": (("checkpoint_buffer", row, nd), self.S.copy()),
+            "checkpoint_peak_state": ((row, nd), self.PS.copy()),
+            "checkpoint_ctl": (("checkpoint_ctl",), self.ctl.copy()),
+            "checkpoint_pk": (("checkpoint_peak", "checkpoint_peak_col"), self.pk.copy()),
+            "checkpoint_meas": (("checkpoint_meas",), self.meas.copy()),
+            "checkpoint_meas0": (("checkpoint_meas",), self.meas0.copy()),
+            "checkpoint_rinv0": ((ld,), self.rinv0.copy()),
+            "checkpoint_snapshot_state": (("checkpoint_snapshot", row, nd), np.stack([z for _, _, z in snaps])),
+            "checkpoint_snapshot_t": (("checkpoint_snapshot",), np.array([t for t, _, _ in snaps], dtype=float)),
+            "checkpoint_requested": (("checkpoint_pending",), pad(self.requested)),
+            "checkpoint_after_fractions": (("checkpoint_pending_after",), pad(self.after_fracs)),
+        }
+        out = {k: (dims, v, dict(schema.CHECKPOINT_VARS[k])) for k, (dims, v) in out.items()}
+        out[schema.CHECKPOINT_KIND_VAR] = (("checkpoint_snapshot",), np.array([k for _, k, _ in snaps], dtype=str),
+                                           {"long_name": "kinds of the snapshots so far"})
+        return out
+
+    def restore(self, ds) -> None:
+        """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
+        from .. import schema
+
+        def get(name, shape):
+            a = np.array(ds[name].values, dtype=float)
+            if shape is not None and a.shape != shape:
+                raise V.SnappingInputError(f"checkpoint variable {name!r} has shape {a.shape}, expected {shape}")
+            return a
+
+        N = self.N
+        self.S[...] = get("checkpoint_S", self.S.shape)
+        self.PS[...] = get("checkpoint_peak_state", self.PS.shape)
+        ctl = get("checkpoint_ctl", None)
+        if ctl.shape != (K.NCTL,):
+            raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {K.NCTL}")
+        self.ctl[...] = ctl
+        self.pk[...] = get("checkpoint_pk", self.pk.shape)
+        self.meas[...] = get("checkpoint_meas", self.meas.shape)
+        self.meas0[...] = get("checkpoint_meas0", self.meas0.shape)
+        self.rinv0 = get("checkpoint_rinv0", (N,))
+        self.link_error_initial = float(ds.attrs["checkpoint_link_error_initial"])
+        st = get("checkpoint_snapshot_state", None)
+        ts = get("checkpoint_snapshot_t", None)
+        kinds = [str(k) for k in np.asarray(ds[schema.CHECKPOINT_KIND_VAR].values)]
+        if st.ndim != 3 or st.shape[1:] != (K.NROWS, N + 1) or not (len(ts) == len(kinds) == st.shape[0]):
+            raise V.SnappingInputError("checkpoint snapshots are inconsistent")
+        self.snapshots = [(float(t), k, z.copy()) for t, k, z in zip(ts, kinds, st)]
+        self.requested = [float(v) for v in get("checkpoint_requested", None) if np.isfinite(v)]
+        self.after_fracs = [float(v) for v in get("checkpoint_after_fractions", None) if np.isfinite(v)]
+        recs = records_from_dataset(ds)
+        self.chunks = [recs] if len(recs) else []
+        self.ctl[K.C_NREC] = 0
 
     def _set_targets(self) -> None:
         c = self.ctl
@@ -264,8 +451,12 @@ class _Engine:
         c[K.C_TRET] = self.requested[0] if self.requested else np.inf
         c[K.C_VDOWN] = self.after_fracs[0] if self.after_fracs else 0.0
 
-    def loop(self, bar) -> int:
-        """Run the compiled loop until a stop or failure code; returns it."""
+    def loop(self, bar, poll=None) -> int:
+        """Run the compiled loop until a stop or failure code; returns it.
+
+        ``poll()`` is called at every clean step boundary (each return of the
+        compiled loop, after its snapshot is taken); a non-None result stops the
+        loop and is returned (``RET_SIGNAL``)."""
         c = self.ctl
         if not np.isfinite(c[K.C_VUP]):
             c[K.C_VUP] = SPEED_LEVEL_0
@@ -300,17 +491,64 @@ class _Engine:
             else:
                 return code
             self._set_targets()
+            if poll is not None:
+                stop = poll()
+                if stop is not None:
+                    return stop
 
 
-def _failure_message(code: int, eng: _Engine) -> str:
+#: Python-side return code of :meth:`_Engine.loop`: stopped by a signal (or the test hook)
+RET_SIGNAL = -1
+
+_FAILURES = {
+    K.RET_FAIL_NAN: NonFiniteError,
+    K.RET_FAIL_DT: StepSizeError,
+    K.RET_FAIL_DRIFT: DriftError,
+    K.RET_FAIL_ENERGY: EnergyDriftError,
+    K.RET_FAIL_REJECT: RejectionError,
+}
+
+
+def _worst_node(code: int, eng: _Engine) -> int:
+    """Index (along ``node``, 0 = free end) of the node behind a failure."""
+    N = eng.N
+    Z = eng.current()
+    if code == K.RET_FAIL_NAN:  # the state, then the half step's positions/velocities, then the rest
+        for A in (Z[:, :N], eng.H[: K.RVY + 1, :N], eng.H[:, :N]):
+            bad = ~np.all(np.isfinite(A), axis=0)
+            if bad.any():
+                return int(np.argmax(bad))
+        return -1
+    if code == K.RET_FAIL_DRIFT:
+        err = np.abs(N * np.hypot(np.diff(Z[K.RX]), np.diff(Z[K.RY])) - 1.0)
+        return int(np.argmax(err))
+    if code == K.RET_FAIL_ENERGY:
+        return int(np.argmax(np.hypot(Z[K.RAX, :N], Z[K.RAY, :N])))
+    # step size / rejections: the node that set the error estimate of the last attempt
+    H = eng.H
+    dv = np.hypot(H[K.RVX, :N] - Z[K.RVX, :N], H[K.RVY, :N] - Z[K.RVY, :N])
+    da = np.hypot(H[K.RAX, :N] - Z[K.RAX, :N], H[K.RAY, :N] - Z[K.RAY, :N])
+    m = np.maximum(dv, da)
+    return int(np.argmax(np.where(np.isfinite(m), m, np.inf)))
+
+
+def _failure_message(code: int, eng: _Engine, node: int = -1) -> str:
     t = eng.t
+    c = eng.ctl
+    where = f" (step {int(c[K.C_NSTEPS])}, worst node {node}: s={(eng.N - node) / eng.N:.6g})" if node >= 0 else ""
     if code == K.RET_FAIL_NAN:
-        return f"non-finite values (NaN/inf) in the state at t={t:.9g}"
+        return f"non-finite values (NaN/inf) in the state at t={t:.9g}{where}"
     if code == K.RET_FAIL_DT:
-        return f"time-step underflow at t={t:.9g}: dt={eng.ctl[K.C_DT]:.3g} < {eng.ctl[K.C_DTMIN]:.3g}"
+        return f"time-step underflow at t={t:.9g}: dt={c[K.C_DT]:.3g} < dt_min={c[K.C_DTMIN]:.3g}{where}"
     if code == K.RET_FAIL_DRIFT:
         return (f"link-length drift past the bound at t={t:.9g}: relative link error "
-                f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error + link_error_initial = {eng.ctl[K.C_MAXLINK]:.3g}")
+                f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error + link_error_initial = {c[K.C_MAXLINK]:.3g}{where}")
+    if code == K.RET_FAIL_ENERGY:
+        de = abs(eng.meas[K.M_ENERGY] - c[K.C_E0])
+        return f"energy drift past the bound at t={t:.9g}: |E - E0| = {de:.3g} > max_energy_drift={c[K.C_MAXENERGY]:.3g}{where}"
+    if code == K.RET_FAIL_REJECT:
+        return (f"{int(c[K.C_CONSREJ])} consecutive rejected steps at t={t:.9g} > max_rejections="
+                f"{int(c[K.C_MAXREJ])} (last dt={c[K.C_DT]:.3g}){where}")
     return f"unknown failure code {code}"
 
 
@@ -331,6 +569,10 @@ def run(
     initial: ChainState | None = None,
     output=None,
     progress: bool | None = False,
+    max_energy_drift: float | None = None,
+    dt_min: float = 1e-14,
+    max_rejections: int = 100,
+    checkpoint_every: float | None = CHECKPOINT_EVERY,
 ) -> Run:
     """Simulate the falling chain released from the paper's catenary, to the snap and a bit after.
 
@@ -396,6 +638,17 @@ def run(
         also written when the run fails or is interrupted).
     progress : bool or None
         tqdm progress bar on stderr (None: only on a terminal).
+    max_energy_drift : float, optional
+        The run fails when |E(t) - E(0)| exceeds this (default: no bound).
+    dt_min : float
+        The run fails when the adaptive time step falls below this floor.
+    max_rejections : int
+        The run fails after more than this many consecutive rejected steps.
+    checkpoint_every : float or None
+        With ``output``: save the full state of the run to ``output`` (status
+        'checkpoint', atomically) every this many seconds of wall time (0: at every
+        return of the compiled loop; None: only when stopped). A checkpointed or
+        interrupted file continues with :func:`resume` to the same Dataset, bit for bit.
 
     Returns
     -------
@@ -405,10 +658,19 @@ def run(
     Raises
     ------
     SnappingInputError
-        Bad input, before anything runs.
+        Bad input, before anything runs; also a run whose record and snapshots
+        would not fit in the available memory (see :func:`memory_need`).
     SimulationError
-        NaN, step-size underflow or link drift past ``max_link_error``; what was
-        computed is in ``exc.dataset`` (and in ``output``), status 'failed'.
+        A numerical failure, as one of its subclasses: :class:`NonFiniteError`
+        (NaN/inf), :class:`StepSizeError` (dt below ``dt_min``), :class:`DriftError`
+        (link drift past ``max_link_error``), :class:`EnergyDriftError` (past
+        ``max_energy_drift``), :class:`RejectionError` (more than
+        ``max_rejections`` consecutive rejections). It carries ``t``, ``step`` and
+        the worst ``node``; what was computed is in ``exc.dataset`` (and in
+        ``output``), status 'failed', ``stop_reason`` and ``failure`` saying why.
+    RunInterrupted
+        SIGINT or SIGTERM arrived: the run stopped at a step boundary and was saved
+        (status 'interrupted') with its checkpoint; a ``KeyboardInterrupt``.
 
     Examples
     --------
@@ -422,64 +684,133 @@ def run(
     >>> round(snap["t_snap_v"], 3), snap["stop_reason"]
     (1.144, 'snap detected: v_max fell below 0.5 of its peak')
     """
-    from .. import __version__
-
     (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
      chords, output) = _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times,
                                  record_thin, max_link_error, chords, initial, output)
+    max_energy_drift, dt_min, max_rejections, checkpoint_every = _validate_guards(
+        max_energy_drift, dt_min, max_rejections, checkpoint_every)
+    progress = _check_progress(progress)
     if method in ("dop853", "fast"):  # issue 6: angle form + DOP853, in snapping.simulate.highorder
         from .highorder import run_highorder
 
         return run_highorder(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
                              t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
                              max_link_error=max_link_error, chords=chords, initial=initial, output=output,
-                             progress=progress)
-    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+                             progress=progress, dt_min=dt_min)
     if dt0 is None:
         dt0 = math.sqrt(tol)
-    fixed = method == "euler-richardson-fixed"
+    _check_memory(N, chi=chi, tol=tol, method=method, dt0=dt0, t_end=t_end, t_end_max=t_end_max,
+                  snapshot_times=snapshot_times, record_thin=record_thin)
+    inputs, eng = _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
+                         max_link_error, chords, initial, max_energy_drift, dt_min, max_rejections)
+    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
+
+
+def _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
+           chords, initial, max_energy_drift, dt_min, max_rejections):
+    """The input attributes and the engine of a run (validated arguments)."""
+    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
     inputs = {
         "chi": chi, "N": N, "method": method, "tol": tol, "dt0": dt0, "t_end": 0.0 if t_end is None else t_end,
         "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
         "chords": chords, "initial": "catenary" if initial is None else "snapshot", "t_end_max": t_end_max,
-        "max_link_error": max_link_error,
+        "max_link_error": max_link_error, "max_energy_drift": 0.0 if max_energy_drift is None else max_energy_drift,
+        "dt_min": dt_min, "max_rejections": max_rejections,
     }
     _warm_up()
-    eng = _Engine(state0, tol=tol, dt0=dt0, fixed=fixed, t_end=(t_end if t_end is not None else t_end_max),
+    eng = _Engine(state0, tol=tol, dt0=dt0, fixed=method == "euler-richardson-fixed",
+                  t_end=(t_end if t_end is not None else t_end_max),
                   stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
-                  max_link_error=max_link_error, snapshot_times=snapshot_times)
-    bar = None
-    if progress or progress is None:
-        from tqdm.auto import tqdm
+                  max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min,
+                  max_energy_drift=max_energy_drift, max_rejections=max_rejections)
+    return inputs, eng
 
-        bar = tqdm(total=t_end, file=sys.stderr, disable=None if progress is None else False, unit="t",
-                   desc=f"chain N={N}", dynamic_ncols=True,
-                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
-                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
-    status, reason, code = "completed", "", None
-    wall0 = time.perf_counter()
+
+def _check_progress(progress):
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise V.SnappingInputError(f"progress={progress!r} must be True, False or None")
+    return progress
+
+
+# ---------------------------------------------------------------- resource guard
+def _available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (MemAvailable, else free pages); None if unknown."""
     try:
-        code = eng.loop(bar)
-    except KeyboardInterrupt:
-        status, reason = "interrupted", f"interrupted by the user at t={eng.t:.9g}"
-    finally:
-        wall = time.perf_counter() - wall0
-        if bar is not None:
-            bar.close()
-    if code is not None:
-        if code == K.RET_STOP:
-            reason = f"snap detected: v_max fell below {stop_fraction:g} of its peak"
-        elif code == K.RET_END:
-            reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
-        else:
-            status, reason = "failed", _failure_message(code, eng)
-    # ---- snapshots at the peak and at the end
-    if math.isfinite(eng.ctl[K.C_T_PEAKSTATE]):
-        eng.snapshots.append((float(eng.ctl[K.C_T_PEAKSTATE]), "peak", eng.PS.copy()))
-    eng.snapshots.append((eng.t, "final", eng.current().copy()))
-    records = eng.records()
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: str = "euler-richardson",
+                dt0: float | None = None, t_end: float | None = None, t_end_max: float = 10.0,
+                snapshot_times=(), record_thin: float = 0.0) -> dict:
+    """Estimated peak memory of a run: per-step record, snapshots and state buffers.
+
+    The number of steps is exact for the fixed-step method (``t_end / dt0``) and,
+    for the adaptive one, the calibrated cost model of the benchmark (right-hand-side
+    evaluations ~ 4e5 (0.25/chi)^0.9 (N/400)^0.35 (1e-8/tol)^0.5, an upper bound on
+    the steps). With ``record_thin > 0`` at most ~4 ln(1e8)/ln(1 + record_thin)
+    rows are recorded. Each recorded row takes 16 float64 three times over (the
+    record, its concatenation and the Dataset); each snapshot (N + 1) x 23 float64.
+
+    Returns
+    -------
+    dict
+        ``bytes`` (total), ``steps``, ``records``, ``snapshots``, and the parts
+        ``record_bytes``, ``snapshot_bytes``, ``state_bytes``.
+
+    Examples
+    --------
+    >>> need = memory_need(100, chi=0.25, method="euler-richardson-fixed", dt0=1e-3, t_end=1.0)
+    >>> need["steps"], need["records"]
+    (1000, 1001)
+    """
+    N = int(N)
+    if method == "euler-richardson-fixed" and dt0:
+        steps = math.ceil((t_end if t_end else t_end_max) / dt0 * (1.0 - 1e-8))
+    else:
+        c = 0.25 if chi is None or not math.isfinite(chi) else chi
+        steps = math.ceil(4.0e5 * (0.25 / c) ** 0.9 * (max(N, 1) / 400.0) ** 0.35 * (1e-8 / tol) ** 0.5
+                          * (max(1.0, t_end / 1.5) if t_end else 1.0))
+    records = steps + 1
+    if record_thin > 0.0:
+        records = min(records, int(4 * math.log(1e8) / math.log1p(record_thin)) + 1000)
+    snaps = len(snapshot_times) + 40
+    record_bytes = 3 * records * K.NREC * 8
+    snapshot_bytes = snaps * (N + 1) * 23 * 8
+    state_bytes = (6 * K.NROWS + 14) * (N + 1) * 8 + RECORD_CHUNK * K.NREC * 8
+    return {"bytes": record_bytes + snapshot_bytes + state_bytes, "steps": steps, "records": records,
+            "snapshots": snaps, "record_bytes": record_bytes, "snapshot_bytes": snapshot_bytes,
+            "state_bytes": state_bytes}
+
+
+def _check_memory(N, **kw) -> None:
+    need = memory_need(N, **kw)
+    avail = _available_memory()
+    if avail is None or need["bytes"] <= MEMORY_MARGIN * avail:
+        return
+    gib = 2.0 ** 30
+    raise V.SnappingInputError(
+        f"the run would need about {need['bytes'] / gib:.3g} GiB of memory (record: ~{need['records']:.3g} steps "
+        f"x {K.NREC * 8} B x 3 = {need['record_bytes'] / gib:.3g} GiB; snapshots: {need['snapshots']} x {N + 1} "
+        f"nodes = {need['snapshot_bytes'] / gib:.3g} GiB; state: {need['state_bytes'] / gib:.3g} GiB) but only "
+        f"{avail / gib:.3g} GiB is available (a run may use {MEMORY_MARGIN:.0%} of it); thin the record with "
+        f"record_thin (e.g. 1e-3, --record-thin 1e-3), or use fewer snapshot_times, a smaller N or a larger tol/dt0")
+
+
+# ---------------------------------------------------------------- the driver: signals, checkpoints, results
+def _results(eng: _Engine, status: str, reason: str, wall: float, failure: str = "", node: int = -1) -> dict:
+    from .. import __version__
+
     c, pk = eng.ctl, eng.pk
-    results = {"status": status, "stop_reason": reason}
+    results = {"status": status, "stop_reason": reason, "failure": failure, "failure_node": int(node)}
     for qi, name in enumerate(K.PEAK_QUANTITIES):
         tv = _parabola_vertex(*(float(pk[qi, j]) for j in (K.P_TM1, K.P_QM1, K.P_T0, K.P_Q0, K.P_TP1, K.P_QP1)))
         if name != "kappa":
@@ -502,15 +833,116 @@ def run(
         "wall_time": wall,
         "snapping_version": __version__,
     })
-    ds = build_dataset(records, eng.snapshots, N, inputs, results)
-    Z = eng.current()
-    final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), eng.t)
-    path = save(ds, output) if output is not None else None
+    return results
+
+
+def _checkpoint_dataset(eng: _Engine, inputs: dict, results: dict) -> xr.Dataset:
+    ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs, results)
+    ds = ds.assign(eng.checkpoint_vars())
+    ds.attrs.update({
+        "checkpoint_version": CHECKPOINT_VERSION,
+        "checkpoint_wall_time": float(results["wall_time"]),
+        "checkpoint_link_error_initial": eng.link_error_initial,
+        "checkpoint_time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    })
+    return ds
+
+
+def _resume_command(path) -> str:
+    import shlex
+
+    return f"snapping simulate --resume {shlex.quote(str(path))}"
+
+
+def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
+    """Run ``eng`` to its end, with progress bar, signal handling and checkpoints; build and save the result."""
+    t_end = inputs["t_end"] or None
+    N = eng.N
+    bar = None
+    if progress or progress is None:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=t_end, initial=eng.t, file=sys.stderr, disable=None if progress is None else False,
+                   unit="t", desc=f"chain N={N}", dynamic_ncols=True,
+                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
+                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
+    got = {"signum": None, "last": time.monotonic()}
+    wall0 = time.perf_counter()
+
+    def on_signal(signum, frame):
+        got["signum"] = signum
+
+    def poll():
+        if _chunk_hook is not None:
+            r = _chunk_hook(eng)
+            if r:
+                got["signum"] = int(r)
+        if got["signum"] is not None:
+            return RET_SIGNAL
+        if output is not None and checkpoint_every is not None and time.monotonic() - got["last"] >= checkpoint_every:
+            wall = wall_before + time.perf_counter() - wall0
+            res = _results(eng, "checkpoint", f"running; checkpoint at t={eng.t:.9g}, step {int(eng.ctl[K.C_NSTEPS])}; "
+                           f"if the run was killed, continue with: {_resume_command(output)}", wall)
+            save(_checkpoint_dataset(eng, inputs, res), output)
+            got["last"] = time.monotonic()
+        return None
+
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            try:
+                handlers[sig] = signal.signal(sig, on_signal)
+            except (ValueError, OSError):  # pragma: no cover - exotic embedding
+                pass
+    try:
+        status, reason, code = "completed", "", None
+        try:
+            code = eng.loop(bar, poll)
+        except KeyboardInterrupt:  # no handler of ours (e.g. one raised by another handler)
+            got["signum"] = signal.SIGINT
+            code = RET_SIGNAL
+        finally:
+            wall = wall_before + time.perf_counter() - wall0
+            if bar is not None:
+                bar.close()
+        failure, node = "", -1
+        if code == RET_SIGNAL:
+            status = "interrupted"
+            try:
+                name = signal.Signals(got["signum"]).name
+            except ValueError:
+                name = f"signal {got['signum']}"
+            reason = f"interrupted by {name} at t={eng.t:.9g}, step {int(eng.ctl[K.C_NSTEPS])}"
+            if output is not None:
+                reason += f"; continue with: {_resume_command(output)}"
+            ds = _checkpoint_dataset(eng, inputs, _results(eng, status, reason, wall))
+            path = save(ds, output) if output is not None else None
+            raise RunInterrupted(f"{reason}" + (f" (saved in {path})" if path else " (not saved: no output file)"),
+                                 int(got["signum"]), dataset=ds, path=path)
+        if code == K.RET_STOP:
+            reason = f"snap detected: v_max fell below {inputs['stop_fraction']:g} of its peak"
+        elif code == K.RET_END:
+            reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
+        else:
+            status = "failed"
+            node = _worst_node(code, eng)
+            reason = _failure_message(code, eng, node)
+            failure = _FAILURES.get(code, SimulationError).kind
+        ds = build_dataset(eng.records(), eng.snapshots_now(), N, inputs,
+                           _results(eng, status, reason, wall, failure, node))
+        final = None
+        if status == "completed":
+            Z = eng.current()
+            final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), eng.t)
+        path = save(ds, output) if output is not None else None
+    finally:
+        for sig, h in handlers.items():
+            signal.signal(sig, h)
     if status == "failed":
         where = f"; what was computed is saved in {path}" if path else ""
-        raise SimulationError(f"simulation failed: {reason}{where}", dataset=ds, path=path)
-    if status == "interrupted":
-        raise KeyboardInterrupt(reason + (f"; saved in {path}" if path else ""))
+        cls = _FAILURES.get(code, SimulationError)
+        raise cls(f"simulation failed: {reason}{where}", dataset=ds, path=path, t=eng.t,
+                  step=int(eng.ctl[K.C_NSTEPS]), node=node)
     return Run(ds, final, path)
 
 
@@ -527,6 +959,137 @@ def rerun(ds: xr.Dataset, **overrides) -> Run:
     kw = inputs_from_attrs(ds)
     kw.update(overrides)
     return run(**kw)
+
+
+def _open_checkpoint(path) -> xr.Dataset:
+    """Load a run file that :func:`resume` can continue, or raise SnappingInputError saying why not."""
+    from .. import schema
+
+    p = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not p:
+        raise V.SnappingInputError(f"path={path!r} is not a file path")
+    if not os.path.isfile(p):
+        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
+    try:
+        with xr.open_dataset(p, engine="netcdf4") as f:
+            ds = f.load()
+    except Exception as exc:  # netCDF4/HDF5 raise OSError, ValueError, KeyError, ...
+        msg = (str(exc).strip().splitlines() or [""])[0][:160]
+        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF run file ({type(exc).__name__}: {msg})") from None
+    status = str(ds.attrs.get("status", ""))
+    if status not in schema.RESUMABLE_STATUS:
+        if status in ("completed", "failed"):
+            raise V.SnappingInputError(f"path={p!r} is a {status} run (status={status!r}): there is nothing to "
+                                       f"resume, only runs with status in {schema.RESUMABLE_STATUS} continue")
+        raise V.SnappingInputError(f"path={p!r} is not a snapping run checkpoint (status={status!r}; "
+                                   f"expected one of {schema.RESUMABLE_STATUS})")
+    missing = [k for k in (*schema.CHECKPOINT_VARS, schema.CHECKPOINT_KIND_VAR, *schema.STEP_VARS)
+               if k not in ds.variables]
+    missing += [k for k in (*schema.CHECKPOINT_ATTRS, "chi", "N", "method", "tol") if k not in ds.attrs]
+    if missing:
+        raise V.SnappingInputError(f"path={p!r} is not a complete checkpoint: missing {missing[:5]}")
+    if int(ds.attrs["checkpoint_version"]) != CHECKPOINT_VERSION:
+        raise V.SnappingInputError(f"path={p!r}: checkpoint version {ds.attrs['checkpoint_version']} is not "
+                                   f"supported by this version (expects {CHECKPOINT_VERSION})")
+    return ds
+
+
+def is_resumable(path, **expected) -> bool:
+    """True if ``path`` is a checkpoint :func:`resume` can continue and, for each keyword
+    given (``chi``, ``N``, ``tol``, any input of :func:`run`), its input equals that value.
+
+    >>> is_resumable("no/such/run.nc")
+    False
+    """
+    try:
+        ds = _open_checkpoint(path)
+        kw = inputs_from_attrs(ds)
+    except (V.SnappingInputError, KeyError, ValueError, TypeError):
+        return False
+    for k, v in expected.items():
+        if v is None or k in ("output", "progress", "checkpoint_every"):
+            continue
+        have = kw.get(k)
+        if k == "snapshot_times":
+            if tuple(float(x) for x in np.atleast_1d(np.asarray(v, dtype=float))) != tuple(have or ()):
+                return False
+        elif isinstance(v, float) or isinstance(have, float):
+            try:
+                if float(v) != float(have):
+                    return False
+            except (TypeError, ValueError):
+                return False
+        elif v != have:
+            return False
+    return True
+
+
+def resume(path, *, output=None, progress: bool | None = False, checkpoint_every: float | None = CHECKPOINT_EVERY) -> Run:
+    """Continue an interrupted or checkpointed run file to its end.
+
+    The run continues from the complete state stored in the file (positions and
+    velocities of every node, t, dt, the stepper's counters, the record so far,
+    the snapshots and the peak trackers; :data:`snapping.schema.CHECKPOINT_VARS`),
+    and gives the same accepted steps and the same Dataset, bit for bit, as a run
+    that was never interrupted (``wall_time`` aside: it adds up the sessions).
+
+    Parameters
+    ----------
+    path : path
+        A run file with status 'checkpoint' or 'interrupted'.
+    output : path, optional
+        Where to write the run (default: ``path`` itself, replaced atomically).
+    progress, checkpoint_every
+        As for :func:`run`.
+
+    Returns
+    -------
+    Run
+
+    Raises
+    ------
+    SnappingInputError
+        Not a readable run checkpoint (a completed or failed run, another
+        program's file, a truncated file), or an unwritable ``output``.
+    SimulationError, RunInterrupted
+        As for :func:`run`.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> p = os.path.join(tempfile.mkdtemp(), "run.nc")
+    >>> resume(p)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: path='...run.nc' does not exist or is not a file
+    """
+    ds = _open_checkpoint(path)
+    out = check_writable(path if output is None else output)
+    _, _, _, checkpoint_every = _validate_guards(None, 1.0, 0, checkpoint_every)
+    progress = _check_progress(progress)
+    try:
+        kw = inputs_from_attrs(ds)
+        (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
+         chords, _) = _validate(kw["chi"], kw["N"], kw["tol"], kw["method"], kw["dt0"], kw["t_end"],
+                                kw["stop_fraction"], kw["t_end_max"], kw["snapshot_times"], kw["record_thin"],
+                                kw["max_link_error"], kw["chords"], kw.get("initial"), None)
+        max_energy_drift, dt_min, max_rejections, _ = _validate_guards(
+            kw["max_energy_drift"], kw["dt_min"], kw["max_rejections"], None)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the inputs stored in the checkpoint are not valid "
+                                   f"({type(exc).__name__}: {exc})") from None
+    _check_memory(N, chi=chi, tol=tol, method=method, dt0=dt0, t_end=t_end, t_end_max=t_end_max,
+                  snapshot_times=snapshot_times, record_thin=record_thin)
+    inputs, eng = _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
+                         max_link_error, chords, kw.get("initial"), max_energy_drift, dt_min, max_rejections)
+    try:
+        eng.restore(ds)
+    except (KeyError, ValueError, TypeError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise V.SnappingInputError(f"path={os.fspath(path)!r}: {exc}") from None
+        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the checkpoint is damaged ({exc})") from None
+    return _drive(eng, inputs, output=out, progress=progress, checkpoint_every=checkpoint_every,
+                  wall_before=float(ds.attrs["checkpoint_wall_time"]))
 
 
 def integrate_fixed(state: ChainState, dt: float, n_steps: int) -> ChainState:
