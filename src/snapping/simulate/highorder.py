@@ -52,6 +52,8 @@ RECORD_CHUNK = 8192
 NODE_EVALS_PER_CALL = 20_000_000
 #: relative width (of the bracketing interval) to which peaks are located
 PEAK_XTOL = 1e-10
+#: beta of the PI step-size controller (0: the classical I controller)
+PI_BETA = 0.0
 _PEAK_MEAS = (K.M_VMAX, K.M_AMAX, K.M_SIGMAX, K.M_KMAX)
 
 
@@ -125,6 +127,8 @@ class _Engine:
         c[R.Q_DRIFT_LINK] = self.link_error_initial
         c[R.Q_DT_MIN_ACC] = np.inf
         c[R.Q_DT_MAX_ACC] = 0.0
+        c[R.Q_ERROLD] = 1e-4
+        c[R.Q_BETA] = PI_BETA
         self.ctl = c
         pk = np.full((4, R.NPKR), np.nan)
         for qi, m in enumerate(_PEAK_MEAS):

@@ -67,14 +67,16 @@ ERR_EXPONENT = -1.0 / 8.0
 (Q_T, Q_H, Q_SLOT, Q_NSTEPS, Q_NREJ, Q_NRHS, Q_NREC, Q_TOL, Q_THIN, Q_MAXLINK, Q_DTMIN,
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
- Q_ERR_MAX_ACC, Q_REFINE, Q_DONE) = range(31)
-NQ = 31
+ Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL) = range(34)
+NQ = 34
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
 NPKR = 8
 
 RET_REFINE = 7  # (the other return codes are those of kernels.advance)
+#: internal codes of :func:`after_attempt`: step rejected / accepted, go on
+GO_REJECTED, GO_ON = -2, -1
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
@@ -174,6 +176,148 @@ def _changed(q, last, thin):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
+def step_size(ctl):
+    """(h, last): the next step size, clipped to land on ``ctl[Q_TEND]``."""
+    h = ctl[Q_H]
+    rem = ctl[Q_TEND] - ctl[Q_T]
+    if h >= rem * (1.0 - 1e-8):
+        return rem, True
+    return h, False
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas):
+    """Everything after the stages of an attempted step of size h into slot ``ns``
+    (whose ``Y1`` holds the new state and c, s, sig its trigonometry and tension):
+    rejection and step-size control, or acceptance with the diagnostics, the record,
+    peak detection, invariants and the stop rules. Returns :data:`GO_REJECTED`,
+    :data:`GO_ON` or a return code for Python. Shared by the single-run loop
+    :func:`advance_rk` and the ensemble loop (:mod:`snapping.simulate.ensemble`)."""
+    ctl[Q_NRHS] += float(NS)
+    dtmin = ctl[Q_DTMIN]
+    if not (err - err == 0.0):  # NaN/inf in the stages: reject, shrink hard
+        ctl[Q_H] = MIN_FACTOR * h
+        ctl[Q_NREJ] += 1.0
+        ctl[Q_REJECTED] = 1.0
+        if ctl[Q_H] < dtmin:
+            return K.RET_FAIL_NAN
+        return GO_REJECTED
+    if err > 1.0:
+        ctl[Q_H] = h * max(MIN_FACTOR, SAFETY * err ** ERR_EXPONENT)
+        ctl[Q_NREJ] += 1.0
+        ctl[Q_REJECTED] = 1.0
+        if ctl[Q_H] < dtmin:
+            return K.RET_FAIL_DT
+        return GO_REJECTED
+    # ---- accept
+    # (PI control, Gustafsson / Hairer's DOP853: beta = ctl[Q_BETA]; 0 is the I controller)
+    beta = ctl[Q_BETA]
+    if err == 0.0:
+        fac = MAX_FACTOR
+    else:
+        fac = min(MAX_FACTOR, SAFETY * err ** (ERR_EXPONENT + 0.2 * beta) * ctl[Q_ERROLD] ** beta)
+    ctl[Q_ERROLD] = max(err, 1e-4)
+    if ctl[Q_REJECTED] != 0.0:
+        fac = min(1.0, fac)
+    ctl[Q_REJECTED] = 0.0
+    t = ctl[Q_T]
+    TS[ns] = t
+    HS[ns] = h
+    DOK[ns] = 0.0
+    t = ctl[Q_TEND] if last else t + h
+    ctl[Q_T] = t
+    ctl[Q_SLOT] = float(ns)
+    dt = h * fac
+    ctl[Q_H] = dt
+    ctl[Q_NSTEPS] += 1.0
+    ctl[Q_NCALL] += 1.0
+    if h < ctl[Q_DT_MIN_ACC]:
+        ctl[Q_DT_MIN_ACC] = h
+    if h > ctl[Q_DT_MAX_ACC] and not last:
+        ctl[Q_DT_MAX_ACC] = h
+    if err > ctl[Q_ERR_MAX_ACC]:
+        ctl[Q_ERR_MAX_ACC] = err
+    AG.measure_angles(N, Y1[ns], c, s, sig, Z, rinv0, meas)
+    # ---- running peaks (every accepted step)
+    for qi in range(4):
+        if qi == 0:
+            q = meas[K.M_VMAX]
+        elif qi == 1:
+            q = meas[K.M_AMAX]
+        elif qi == 2:
+            q = meas[K.M_SIGMAX]
+        else:
+            q = meas[K.M_KMAX]
+        if q > pk[qi, PK_SBEST]:
+            pk[qi, PK_SBEST] = q
+            pk[qi, PK_TBEFORE] = pk[qi, PK_TPREV]
+            pk[qi, PK_NEED] = 1.0
+            if q > pk[qi, PK_BEST]:
+                pk[qi, PK_BEST] = q
+                pk[qi, PK_TBEST] = t
+        elif pk[qi, PK_NEED] != 0.0:
+            pk[qi, PK_NEED] = 0.0
+            pk[qi, PK_TA] = pk[qi, PK_TBEFORE]
+            pk[qi, PK_TB] = t
+            ctl[Q_REFINE] = float(int(ctl[Q_REFINE]) | (1 << qi))
+        pk[qi, PK_TPREV] = t
+    # ---- invariants
+    if meas[K.M_LINKERR] > ctl[Q_DRIFT_LINK]:
+        ctl[Q_DRIFT_LINK] = meas[K.M_LINKERR]
+    l0 = ctl[Q_L0]
+    dl = abs(meas[K.M_LENGTH] - l0) / l0
+    if dl > ctl[Q_DRIFT_LEN]:
+        ctl[Q_DRIFT_LEN] = dl
+    de = abs(meas[K.M_ENERGY] - ctl[Q_E0])
+    if de > ctl[Q_DRIFT_E]:
+        ctl[Q_DRIFT_E] = de
+    # ---- why stop here?
+    vmax = meas[K.M_VMAX]
+    vbest = pk[0, PK_BEST]
+    stopfrac = ctl[Q_STOPFRAC]
+    vdown = ctl[Q_VDOWN]
+    code = GO_ON
+    if meas[K.M_FINITE] == 0.0:
+        code = K.RET_FAIL_NAN
+    elif meas[K.M_LINKERR] > ctl[Q_MAXLINK]:
+        code = K.RET_FAIL_DRIFT
+    elif dt < dtmin:
+        code = K.RET_FAIL_DT
+    elif stopfrac > 0.0 and vmax < stopfrac * vbest:
+        code = K.RET_STOP
+    elif last:
+        code = K.RET_END
+    elif t >= ctl[Q_TRET]:
+        code = K.RET_T_RETURN
+    elif vmax >= ctl[Q_VUP]:
+        code = K.RET_V_UP
+    elif vdown > 0.0 and vmax < vdown * vbest:
+        code = K.RET_V_DOWN
+    elif ctl[Q_REFINE] != 0.0:
+        code = RET_REFINE
+    # ---- record (thinned by relative change; always the last step)
+    thin = ctl[Q_THIN]
+    nrec = int(ctl[Q_NREC])
+    if (thin == 0.0 or code == K.RET_STOP or code == K.RET_END or code >= K.RET_FAIL_NAN
+            or _changed(vmax, ctl[Q_LAST_V], thin) or _changed(meas[K.M_AMAX], ctl[Q_LAST_A], thin)
+            or _changed(meas[K.M_SIGMAX], ctl[Q_LAST_S], thin) or _changed(meas[K.M_KMAX], ctl[Q_LAST_K], thin)):
+        K._write_record(rec, nrec, t, h, err * ctl[Q_TOL], meas)
+        nrec += 1
+        ctl[Q_NREC] = float(nrec)
+        ctl[Q_LAST_V] = vmax
+        ctl[Q_LAST_A] = meas[K.M_AMAX]
+        ctl[Q_LAST_S] = meas[K.M_SIGMAX]
+        ctl[Q_LAST_K] = meas[K.M_KMAX]
+    if code >= 0:
+        return code
+    if nrec >= rec.shape[0]:
+        return K.RET_RECORD_FULL
+    if ctl[Q_NCALL] >= ctl[Q_STEPS_PER_CALL]:
+        return K.RET_CALL_LIMIT
+    return GO_ON
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
 def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas):
     """Advance the angle-form chain with DOP853 until something needs Python.
 
@@ -188,154 +332,17 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
     """
     n = 2 * N
     tol = ctl[Q_TOL]
-    thin = ctl[Q_THIN]
-    maxlink = ctl[Q_MAXLINK]
-    dtmin = ctl[Q_DTMIN]
-    limit = int(ctl[Q_STEPS_PER_CALL])
-    tend = ctl[Q_TEND]
-    tret = ctl[Q_TRET]
-    vup = ctl[Q_VUP]
-    vdown = ctl[Q_VDOWN]
-    stopfrac = ctl[Q_STOPFRAC]
-    e0 = ctl[Q_E0]
-    l0 = ctl[Q_L0]
-    cap = rec.shape[0]
-    sl = int(ctl[Q_SLOT])
-    t = ctl[Q_T]
-    dt = ctl[Q_H]
-    nrec = int(ctl[Q_NREC])
-    ncall = 0
-    code = K.RET_CALL_LIMIT
-    rejected = False
+    ctl[Q_NCALL] = 0.0
     while True:
+        sl = int(ctl[Q_SLOT])
         ns = 1 - sl
-        last = False
-        h = dt
-        rem = tend - t
-        if h >= rem * (1.0 - 1e-8):
-            h = rem
-            last = True
+        h, last = step_size(ctl)
         y0 = Y0[ns]
         ycur = Y1[sl]
         for i in range(n):
             y0[i] = ycur[i]
             KK[ns, 0, i] = KK[sl, NS, i]
         err = rk_step(N, h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol)
-        ctl[Q_NRHS] += float(NS)
-        if not (err - err == 0.0):  # NaN/inf in the stages: reject, shrink hard
-            dt = MIN_FACTOR * h
-            ctl[Q_NREJ] += 1.0
-            rejected = True
-            if dt < dtmin:
-                code = K.RET_FAIL_NAN
-                break
-            continue
-        if err > 1.0:
-            dt = h * max(MIN_FACTOR, SAFETY * err ** ERR_EXPONENT)
-            ctl[Q_NREJ] += 1.0
-            rejected = True
-            if dt < dtmin:
-                code = K.RET_FAIL_DT
-                break
-            continue
-        # ---- accept
-        if err == 0.0:
-            fac = MAX_FACTOR
-        else:
-            fac = min(MAX_FACTOR, SAFETY * err ** ERR_EXPONENT)
-        if rejected:
-            fac = min(1.0, fac)
-        rejected = False
-        TS[ns] = t
-        HS[ns] = h
-        DOK[ns] = 0.0
-        t = tend if last else t + h
-        sl = ns
-        dt = h * fac
-        ctl[Q_NSTEPS] += 1.0
-        ncall += 1
-        if h < ctl[Q_DT_MIN_ACC]:
-            ctl[Q_DT_MIN_ACC] = h
-        if h > ctl[Q_DT_MAX_ACC] and not last:
-            ctl[Q_DT_MAX_ACC] = h
-        if err > ctl[Q_ERR_MAX_ACC]:
-            ctl[Q_ERR_MAX_ACC] = err
-        # c, s, sig belong to Y1[sl] (the last evaluation of rk_step)
-        AG.measure_angles(N, Y1[sl], c, s, sig, Z, rinv0, meas)
-        # ---- running peaks (every accepted step)
-        for qi in range(4):
-            if qi == 0:
-                q = meas[K.M_VMAX]
-            elif qi == 1:
-                q = meas[K.M_AMAX]
-            elif qi == 2:
-                q = meas[K.M_SIGMAX]
-            else:
-                q = meas[K.M_KMAX]
-            if q > pk[qi, PK_SBEST]:
-                pk[qi, PK_SBEST] = q
-                pk[qi, PK_TBEFORE] = pk[qi, PK_TPREV]
-                pk[qi, PK_NEED] = 1.0
-                if q > pk[qi, PK_BEST]:
-                    pk[qi, PK_BEST] = q
-                    pk[qi, PK_TBEST] = t
-            elif pk[qi, PK_NEED] != 0.0:
-                pk[qi, PK_NEED] = 0.0
-                pk[qi, PK_TA] = pk[qi, PK_TBEFORE]
-                pk[qi, PK_TB] = t
-                ctl[Q_REFINE] = float(int(ctl[Q_REFINE]) | (1 << qi))
-            pk[qi, PK_TPREV] = t
-        # ---- invariants
-        if meas[K.M_LINKERR] > ctl[Q_DRIFT_LINK]:
-            ctl[Q_DRIFT_LINK] = meas[K.M_LINKERR]
-        dl = abs(meas[K.M_LENGTH] - l0) / l0
-        if dl > ctl[Q_DRIFT_LEN]:
-            ctl[Q_DRIFT_LEN] = dl
-        de = abs(meas[K.M_ENERGY] - e0)
-        if de > ctl[Q_DRIFT_E]:
-            ctl[Q_DRIFT_E] = de
-        # ---- why stop here?
-        vmax = meas[K.M_VMAX]
-        vbest = pk[0, PK_BEST]
-        code = -1
-        if meas[K.M_FINITE] == 0.0:
-            code = K.RET_FAIL_NAN
-        elif meas[K.M_LINKERR] > maxlink:
-            code = K.RET_FAIL_DRIFT
-        elif dt < dtmin:
-            code = K.RET_FAIL_DT
-        elif stopfrac > 0.0 and vmax < stopfrac * vbest:
-            code = K.RET_STOP
-        elif last:
-            code = K.RET_END
-        elif t >= tret:
-            code = K.RET_T_RETURN
-        elif vmax >= vup:
-            code = K.RET_V_UP
-        elif vdown > 0.0 and vmax < vdown * vbest:
-            code = K.RET_V_DOWN
-        elif ctl[Q_REFINE] != 0.0:
-            code = RET_REFINE
-        # ---- record (thinned by relative change; always the last step)
-        if (thin == 0.0 or code == K.RET_STOP or code == K.RET_END or code >= K.RET_FAIL_NAN
-                or _changed(vmax, ctl[Q_LAST_V], thin) or _changed(meas[K.M_AMAX], ctl[Q_LAST_A], thin)
-                or _changed(meas[K.M_SIGMAX], ctl[Q_LAST_S], thin) or _changed(meas[K.M_KMAX], ctl[Q_LAST_K], thin)):
-            K._write_record(rec, nrec, t, h, err * tol, meas)
-            nrec += 1
-            ctl[Q_LAST_V] = vmax
-            ctl[Q_LAST_A] = meas[K.M_AMAX]
-            ctl[Q_LAST_S] = meas[K.M_SIGMAX]
-            ctl[Q_LAST_K] = meas[K.M_KMAX]
+        code = after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas)
         if code >= 0:
-            break
-        if nrec >= cap:
-            code = K.RET_RECORD_FULL
-            break
-        if ncall >= limit:
-            code = K.RET_CALL_LIMIT
-            break
-    ctl[Q_T] = t
-    ctl[Q_H] = dt
-    ctl[Q_SLOT] = float(sl)
-    ctl[Q_NREC] = float(nrec)
-    return code
+            return code
