@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer"]
+__all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer", "float_array", "file_path"]
 
 
 class SnappingInputError(ValueError):
@@ -73,3 +73,32 @@ def integer(name: str, value, minimum: int = 1, maximum: int | None = None) -> i
     if n < minimum or (maximum is not None and n > maximum):
         raise SnappingInputError(f"{name}={n} is out of range: must be an integer in [{minimum}, {hi}]")
     return n
+
+
+def _short(value) -> str:
+    r = repr(value)
+    return r if len(r) <= 60 else r[:57] + "..."
+
+
+def float_array(name: str, value):
+    """Return ``value`` as a float ndarray, or raise naming ``name`` (strings, objects, ragged lists)."""
+    import numpy as np
+
+    if isinstance(value, (str, bytes, dict)):
+        raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers") from None
+
+
+def file_path(name: str, value) -> str:
+    """Return ``value`` as a non-empty path string, or raise naming ``name``."""
+    import os
+
+    if isinstance(value, bytes) or not isinstance(value, (str, os.PathLike)):
+        raise SnappingInputError(f"{name}={_short(value)} is not a file path")
+    p = os.fspath(value)
+    if not isinstance(p, str) or not p:
+        raise SnappingInputError(f"{name}={_short(value)} is not a file path")
+    return p

@@ -301,6 +301,12 @@ def _cmd_fit(args) -> int:
         except ValueError:
             raise SnappingInputError(f"--window={w!r} must look like NAME=LO,HI (e.g. v_max=1e-4,1e-2)") from None
         windows[key.strip()] = (lo, hi)
+    if args.plot:  # before the (slow) fits
+        from .simulate.dataset import check_writable
+
+        if Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
+            raise SnappingInputError(f"--plot={args.plot!r}: the figure suffix must be .png, .pdf or .svg")
+        check_writable(args.plot)
     runs, names = [], []
     for f in args.files:
         ds = scaling.load_run(f)

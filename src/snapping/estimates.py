@@ -134,7 +134,7 @@ def catenary_shape(s, chi: float):
     [0.0, 0.25, 0.0, 0.0]
     """
     a = catenary_parameter(chi)
-    s = np.asarray(s, dtype=float)
+    s = V.float_array("s", s)
     if s.size and (not np.all(np.isfinite(s)) or s.min() < 0.0 or s.max() > 1.0):
         raise V.SnappingInputError(f"s must lie in [0, 1]; got values in [{s.min()!r}, {s.max()!r}]")
     u = s - 0.5
@@ -339,6 +339,8 @@ def design_estimate(
     >>> round(est.si["t_star_s"], 4)   # 2E(pi/4|2) sqrt(l/g) in s
     0.3867
     """
+    if not isinstance(chain, Chain):
+        raise V.SnappingInputError(f"chain={chain!r} is not a snapping.estimates.Chain")
     given = [name for name, v in (("chi", chi), ("separation", separation), ("curvature", curvature)) if v is not None]
     if len(given) != 1:
         raise V.SnappingInputError(
@@ -473,9 +475,9 @@ def delta_kappa_m(t, kappa_max, s_kappa_max, *, return_time: bool = False):
     >>> round(delta_kappa_m(t, kap, s), 12)
     0.125
     """
-    t = np.asarray(t, dtype=float)
-    k = np.asarray(kappa_max, dtype=float)
-    s = np.asarray(s_kappa_max, dtype=float)
+    t = V.float_array("t", t)
+    k = V.float_array("kappa_max", kappa_max)
+    s = V.float_array("s_kappa_max", s_kappa_max)
     if not (t.ndim == k.ndim == s.ndim == 1 and t.size == k.size == s.size):
         raise V.SnappingInputError(
             f"t, kappa_max and s_kappa_max must be 1-D arrays of one length; got shapes {t.shape}, {k.shape}, {s.shape}"

@@ -42,8 +42,14 @@ def atomic_to_netcdf(ds, path) -> Path:
     """Write ``ds`` to ``path`` as netCDF4 atomically: a temporary file in the same
     directory, flushed and renamed over ``path``. A reader never sees a half-written file.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from .simulate.dataset import check_writable
+
+    path = Path(V.file_path("path", path))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise V.SnappingInputError(f"path={str(path)!r}: directory cannot be created ({exc.strerror or exc})") from None
+    check_writable(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
     os.close(fd)
     try:
@@ -76,6 +82,8 @@ def _check_values(name: str, values, check) -> list:
         raise V.SnappingInputError(f"{name} grid is empty: give at least one value")
     if isinstance(values, (int, float, np.number)):
         values = [values]
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__iter__"):
+        raise V.SnappingInputError(f"{name}={values!r} is not a list of values")
     values = [check(name, v) for v in values]
     if not values:
         raise V.SnappingInputError(f"{name} grid is empty: give at least one value")
@@ -98,7 +106,17 @@ class Grid:
     def __post_init__(self):
         self.chi = _check_values("chi", self.chi, lambda n, v: V.open_interval(n, v, 0.0, 1.0))
         self.N = _check_values("N", self.N, lambda n, v: V.integer(n, v, 1))
+        if not isinstance(self.options, dict):
+            raise V.SnappingInputError(f"options={self.options!r} must be a dict of keywords of simulate.run")
         json.dumps(self.options, default=str)  # options must be describable in a file name hash
+        from .simulate.stepper import check_inputs
+
+        if "output" in self.options:
+            raise V.SnappingInputError("options must not contain 'output': the sweep names each run's file")
+
+        for chi in self.chi:  # every run's inputs, checked before any starts
+            for N in self.N:
+                check_inputs(chi, N, **self.options)
 
     def points(self) -> list[dict]:
         """One dict of run keywords per grid point."""
@@ -136,7 +154,7 @@ def _run_one(params: dict, path: str) -> str:
 
 
 def _check_out_dir(out_dir) -> Path:
-    out = Path(out_dir)
+    out = Path(V.file_path("out_dir", out_dir))
     try:
         out.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=out, prefix=".write-test-"):
@@ -250,13 +268,16 @@ def combine(paths) -> "xr.Dataset":
     """
     import xarray as xr
 
-    paths = [Path(p) for p in paths]
+    if isinstance(paths, (str, os.PathLike)) or not hasattr(paths, "__iter__"):
+        raise V.SnappingInputError(f"paths={paths!r} must be a list of run files")
+    paths = [Path(V.file_path("paths", p)) for p in paths]
     if not paths:
         raise V.SnappingInputError("combine needs at least one run file")
     pieces = []
     for path in paths:
-        with xr.open_dataset(path, engine="netcdf4") as ds:
-            ds = ds.load()
+        from .simulate.dataset import load_run
+
+        ds = load_run(path)
         for key in ("chi", "N"):
             if key not in ds.attrs:
                 raise V.SnappingInputError(f"{str(path)!r} is not a run file: attribute {key!r} is missing")

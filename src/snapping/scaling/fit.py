@@ -56,8 +56,8 @@ _MIN_POINTS = 5
 
 # --------------------------------------------------------------------------- inputs
 def _arrays(t, y, name: str = "y") -> tuple[np.ndarray, np.ndarray]:
-    t = np.asarray(t, dtype=float)
-    y = np.asarray(y, dtype=float)
+    t = V.float_array("t", t)
+    y = V.float_array(name, y)
     if t.ndim != 1 or y.ndim != 1:
         raise V.SnappingInputError(f"t and {name} must be 1-D arrays; got shapes {t.shape} and {y.shape}")
     if t.shape != y.shape:

@@ -212,9 +212,11 @@ def load_run(path) -> "xr.Dataset":
     """
     import xarray as xr
 
-    p = Path(path)
+    p = Path(V.file_path("path", path))
     if not p.exists():
         raise V.SnappingInputError(f"path={str(path)!r} does not exist")
+    if not p.is_file():
+        raise V.SnappingInputError(f"path={str(path)!r} is not a file")
     try:
         with xr.open_dataset(p) as ds:
             ds = ds.load()
@@ -633,9 +635,17 @@ def fit_run(
     RunFit
     """
     check_run(ds)
+    for k in ("tol", "min_width"):  # chosen by the user: refuse rather than fail every row quietly
+        if k in fit_kw:
+            fit_kw[k] = V.positive(k, fit_kw[k])
+    specs = report_specs() if specs is None else specs
+    if windows:
+        known = {s.name for s in specs} | {s.var for s in specs}
+        unknown = sorted(set(windows) - known)
+        if unknown:
+            raise V.SnappingInputError(f"windows has unknown rows or variables {unknown} (known: {sorted(known)})")
     snap = snapping_times(ds)
     t = _t(ds)
-    specs = report_specs() if specs is None else specs
     rows = []
     for spec in specs:
         if spec.var not in ds.variables:

@@ -50,7 +50,8 @@ class ChainState:
     extra: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
-        arrs = [np.array(a, dtype=float).ravel() for a in (self.x, self.y, self.vx, self.vy)]
+        arrs = [V.float_array(n, a).ravel().copy() for n, a in zip(("x", "y", "vx", "vy"),
+                                                                   (self.x, self.y, self.vx, self.vy))]
         n = arrs[0].size
         if n < 2 or any(a.size != n for a in arrs):
             raise V.SnappingInputError(
@@ -211,6 +212,8 @@ def evaluate(state: ChainState) -> dict[str, np.ndarray]:
     >>> np.round(ev["tension"], 12).tolist(), float(abs(ev["ay"]).max()) < 1e-12
     ([0.25, 0.5, 0.75, 1.0], True)
     """
+    if not isinstance(state, ChainState):
+        raise V.SnappingInputError(f"state={type(state).__name__} is not a ChainState")
     Z = state.as_array()
     return {"ax": Z[K.RAX].copy(), "ay": Z[K.RAY].copy(), "tension": Z[K.RSIG, :-1].copy()}
 
@@ -228,8 +231,10 @@ def curvature_profile(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     >>> np.round(curvature_profile(x, y), 6).tolist()
     [nan, 1.333333, 1.333333, 1.333333, nan]
     """
-    x = np.asarray(x, dtype=float)
-    y = np.asarray(y, dtype=float)
+    x = V.float_array("x", x).ravel()
+    y = V.float_array("y", y).ravel()
+    if x.shape != y.shape or x.size < 2:
+        raise V.SnappingInputError(f"x and y must have the same length N + 1 >= 2; got {x.size} and {y.size}")
     N = x.size - 1
     theta = np.unwrap(np.arctan2(np.diff(y), np.diff(x)))
     kappa = np.full(N + 1, np.nan)

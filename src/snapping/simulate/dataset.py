@@ -84,9 +84,9 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
 
 def check_writable(path) -> str:
     """Raise :class:`SnappingInputError` unless ``path`` can be written (checked before a run)."""
-    p = os.fspath(path)
-    if not p:
-        raise V.SnappingInputError("output='' is not a file path")
+    import tempfile
+
+    p = V.file_path("output", path)
     if os.path.isdir(p):
         raise V.SnappingInputError(f"output={p!r} is a directory, not a writable file path")
     parent = os.path.dirname(os.path.abspath(p))
@@ -94,6 +94,12 @@ def check_writable(path) -> str:
         raise V.SnappingInputError(f"output={p!r}: directory {parent!r} does not exist")
     if not os.access(parent, os.W_OK) or (os.path.exists(p) and not os.access(p, os.W_OK)):
         raise V.SnappingInputError(f"output={p!r} is not writable")
+    try:  # the file is written next to itself and renamed: the directory must take a new file
+        fd, probe = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".probe", dir=parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise V.SnappingInputError(f"output={p!r} is not writable ({exc.strerror or exc})") from None
     return p
 
 
@@ -107,7 +113,9 @@ def save(ds: xr.Dataset, path) -> str:
     """
     import tempfile
 
-    p = os.fspath(path)
+    if not isinstance(ds, xr.Dataset):
+        raise V.SnappingInputError(f"ds={type(ds).__name__} is not an xarray.Dataset")
+    p = check_writable(path)
     encoding = {name: {"zlib": True, "complevel": 1} for name in ds.data_vars if ds[name].dtype.kind not in "OUS"}
     d = os.path.dirname(os.path.abspath(p))
     fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
@@ -149,12 +157,25 @@ def load_run(path) -> xr.Dataset:
     >>> int(load_run(p).attrs["N"])
     4
     """
-    with xr.open_dataset(os.fspath(path), engine="netcdf4") as ds:
-        return ds.load()
+    p = V.file_path("path", path)
+    if not os.path.isfile(p):
+        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
+    try:
+        with xr.open_dataset(p, engine="netcdf4") as f:
+            ds = f.load()
+    except Exception as exc:  # netCDF4/HDF5 raise OSError, ValueError, KeyError, ...
+        msg = (str(exc).strip().splitlines() or [""])[0][:160]
+        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF run file ({type(exc).__name__}: {msg})") from None
+    if "t" not in ds.variables or "N" not in ds.attrs:
+        raise V.SnappingInputError(f"path={p!r} is not a snapping run file (no time 't' or attribute 'N'; "
+                                   f"variables: {sorted(map(str, ds.variables))[:6]})")
+    return ds
 
 
 def initial_from_dataset(ds: xr.Dataset) -> ChainState:
     """The initial state stored in a run (its snapshot of kind 'initial')."""
+    if not isinstance(ds, xr.Dataset) or "snapshot_kind" not in ds.variables:
+        raise V.SnappingInputError("ds is not a run Dataset with snapshots (no 'snapshot_kind')")
     kinds = [str(k) for k in ds["snapshot_kind"].values]
     if "initial" not in kinds:
         raise V.SnappingInputError("the run has no snapshot of kind 'initial'")
@@ -169,6 +190,19 @@ def inputs_from_attrs(ds: xr.Dataset) -> dict:
     Runs are deterministic (no fastmath, fixed operation order), so
     ``run(**inputs_from_attrs(ds))`` recomputes the same numbers.
     """
+    if not isinstance(ds, xr.Dataset):
+        raise V.SnappingInputError(f"ds={type(ds).__name__} is not a run Dataset (expected an xarray.Dataset)")
+    missing = [k for k in ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "snapshot_times",
+                           "record_thin", "chords", "t_end_max", "max_link_error") if k not in ds.attrs]
+    if missing:
+        raise V.SnappingInputError(f"ds is not a snapping run: input attributes {missing} are missing")
+    try:
+        return _inputs_from_attrs(ds)
+    except (TypeError, ValueError) as exc:
+        raise V.SnappingInputError(f"ds has input attributes that cannot be read back ({exc})") from None
+
+
+def _inputs_from_attrs(ds: xr.Dataset) -> dict:
     a = ds.attrs
     out = {
         "chi": None if not np.isfinite(float(a["chi"])) else float(a["chi"]),

@@ -49,6 +49,8 @@ NODE_STEPS_PER_CALL = 10_000_000
 CHECKPOINT_EVERY = 300.0
 #: layout version of the checkpoint variables (schema.CHECKPOINT_VARS)
 CHECKPOINT_VERSION = 1
+#: largest stepper tolerance accepted
+MAX_TOL = 0.1
 #: fraction of the available memory a run may plan to use (resource guard)
 MEMORY_MARGIN = 0.8
 #: test hook: called with the engine after every return of the compiled loop; may
@@ -235,7 +237,10 @@ def _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapsho
         N = initial.N
         chi = float("nan") if chi is None else V.open_interval("chi", chi, 0.0, 1.0)
     tol = V.positive("tol", tol)
-    if method not in METHODS:
+    if tol > MAX_TOL:
+        raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in (0, {MAX_TOL:g}] (the error estimate is a "
+                                   "velocity, of order 1)")
+    if not isinstance(method, str) or method not in METHODS:
         raise V.SnappingInputError(f"method={method!r} is not one of {METHODS}")
     if dt0 is not None:
         dt0 = V.positive("dt0", dt0)
@@ -261,7 +266,7 @@ def _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapsho
     if not 0.0 <= record_thin < 1.0:
         raise V.SnappingInputError(f"record_thin={record_thin!r} is out of range: must lie in [0, 1)")
     max_link_error = V.open_interval("max_link_error", max_link_error, 0.0, 1.0)
-    if chords not in ("arclength", "exact"):
+    if not isinstance(chords, str) or chords not in ("arclength", "exact"):
         raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")
     if output is not None:
         output = check_writable(output)
@@ -298,11 +303,11 @@ class _Engine:
         self.work = np.zeros((4, N))
         l0 = state.link_lengths()
         self.link_error_initial = float(np.max(np.abs(N * l0 - 1.0)))
-        self.rinv0 = 1.0 / (l0 * l0)
         if not (np.all(l0 > 0.0) and self.link_error_initial < 0.5):
             raise V.SnappingInputError(
                 f"initial state: link lengths must be close to 1/N={1.0 / N:.6g} (largest relative error "
                 f"{self.link_error_initial:.3g}, at most 0.5 allowed)")
+        self.rinv0 = 1.0 / (l0 * l0)
         self.meas = np.zeros(K.NMEAS)
         K.measure(N, self.S[0], self.rinv0, self.meas)
         if self.meas[K.M_FINITE] == 0.0 or not np.all(np.isfinite(self.S[0])):
@@ -726,6 +731,33 @@ def _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_t
     return inputs, eng
 
 
+def check_inputs(chi=None, N=None, **options) -> None:
+    """Check the inputs of :func:`run` without running it (a sweep checks every run
+    before the first starts); raises :class:`SnappingInputError` like :func:`run`.
+
+    >>> check_inputs(0.3, 10, tol=-1.0)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: tol=-1.0 is out of range: must be > 0
+    """
+    import inspect
+
+    params = inspect.signature(run).parameters
+    unknown = sorted(k for k in options if k not in params or k in ("chi", "N"))
+    if unknown:
+        raise V.SnappingInputError(f"unknown keywords {unknown} of simulate.run (valid: "
+                                   f"{sorted(k for k in params if k not in ('chi', 'N'))})")
+    kw = {k: p.default for k, p in params.items() if k not in ("chi", "N")}
+    kw.update(options)
+    (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, _, _, _) = _validate(
+        chi, N, kw["tol"], kw["method"], kw["dt0"], kw["t_end"], kw["stop_fraction"], kw["t_end_max"],
+        kw["snapshot_times"], kw["record_thin"], kw["max_link_error"], kw["chords"], kw["initial"], kw["output"])
+    _validate_guards(kw["max_energy_drift"], kw["dt_min"], kw["max_rejections"], kw["checkpoint_every"])
+    _check_progress(kw["progress"])
+    _check_memory(N, chi=chi, tol=tol, method=method, dt0=math.sqrt(tol) if dt0 is None else dt0, t_end=t_end,
+                  t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin)
+
+
 def _check_progress(progress):
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
         raise V.SnappingInputError(f"progress={progress!r} must be True, False or None")
@@ -772,7 +804,7 @@ def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: 
     >>> need["steps"], need["records"]
     (1000, 1001)
     """
-    N = int(N)
+    N = V.integer("N", N, 1)
     if method == "euler-richardson-fixed" and dt0:
         steps = math.ceil((t_end if t_end else t_end_max) / dt0 * (1.0 - 1e-8))
     else:
@@ -1100,6 +1132,8 @@ def integrate_fixed(state: ChainState, dt: float, n_steps: int) -> ChainState:
     >>> round(s.t, 12)
     0.01
     """
+    if not isinstance(state, ChainState):
+        raise V.SnappingInputError(f"state={type(state).__name__} is not a ChainState")
     dt = V.positive("dt", dt)
     n_steps = V.integer("n_steps", n_steps, 1)
     r = run(initial=state, method="euler-richardson-fixed", dt0=dt, t_end=state.t + n_steps * dt,
