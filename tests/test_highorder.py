@@ -219,3 +219,33 @@ def test_cli_lists_methods_and_runs_fast(capsys):
         assert m in out
     assert main(["simulate", "--chi", "0.5", "--N", "20", "--method", "fast", "--json", "--no-progress"]) == 0
     assert '"method": "dop853"' in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------- ensembles
+def test_ensemble_members_equal_single_runs():
+    from snapping.simulate import run_ensemble
+
+    chis = [0.3, 0.5, 0.5]
+    dss = run_ensemble(chis, 40, chords="exact", snapshot_times=(0.5,))
+    for chi, ds in zip(chis, dss):
+        single = run(chi, 40, chords="exact", method="fast", snapshot_times=(0.5,)).dataset.attrs
+        a = ds.attrs
+        assert a["status"] == "completed" and a["chi"] == chi and a["method"] == "dop853"
+        for q in ("v_peak", "a_peak", "sigma_peak", "t_snap_v", "t_snap_a"):
+            assert a[q] == pytest.approx(single[q], rel=1e-8), q
+        assert abs(a["n_steps"] - single["n_steps"]) <= 0.05 * single["n_steps"]
+        assert a["link_drift"] < 1e-14 and a["energy_drift"] < 1e-9
+        assert 0.5 in ds["t_snapshot"].values
+    np.testing.assert_array_equal(dss[1]["v_max"].values, dss[2]["v_max"].values)  # lanes are independent
+
+
+def test_ensemble_bad_input():
+    from snapping import SnappingInputError
+    from snapping.simulate import run_ensemble
+
+    with pytest.raises(SnappingInputError, match="chi"):
+        run_ensemble([0.3, 1.5], 10)
+    with pytest.raises(SnappingInputError, match="method"):
+        run_ensemble([0.3], 10, method="euler-richardson")
+    with pytest.raises(SnappingInputError, match="empty"):
+        run_ensemble([], 10)

@@ -159,8 +159,16 @@ def _add_simulate(sub) -> None:
             "peaks, snapping times, invariant drifts and cost. -o writes the run as netCDF4."
         ),
         epilog=(
+            "methods (--method):\n"
+            "  euler-richardson        the paper's adaptive 2nd-order scheme, position form (reference)\n"
+            "  euler-richardson-fixed  the same step at the fixed dt = --dt0 (order studies)\n"
+            "  dop853                  link-angle form (links exact to round-off), compiled 8th-order\n"
+            "                          Dormand-Prince with dense output: 20-40x fewer evaluations\n"
+            "  fast                    always the project's best exact method (now dop853)\n"
+            "\n"
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
+            "  snapping simulate --chi 0.1 --N 5000 --method fast --chords exact\n"
             "  snapping simulate --chi 0.25 --N 2000 --tol 1e-8 --json\n"
             "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2\n"
             "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
@@ -173,8 +181,9 @@ def _add_simulate(sub) -> None:
     p.add_argument("--chi", type=float, default=None, help="end separation / length, in (0, 1)")
     p.add_argument("--N", type=int, default=None, help="number of links (>= 1)")
     p.add_argument("--tol", type=float, default=1e-8, help="stepper tolerance (default 1e-8, the paper's)")
-    p.add_argument("--method", default="euler-richardson", choices=["euler-richardson", "euler-richardson-fixed"],
-                   help="time stepper (default: the paper's adaptive euler-richardson)")
+    p.add_argument("--method", default="euler-richardson",
+                   choices=["euler-richardson", "euler-richardson-fixed", "dop853", "fast"],
+                   help="time stepper (default: euler-richardson; every method is listed below)")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")
     p.add_argument("--stop-fraction", type=float, default=0.5,

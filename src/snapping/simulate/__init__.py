@@ -16,6 +16,7 @@ Example
 
 from .chain import ChainState, curvature_profile, evaluate, initial_state, link_arclength, node_arclength
 from .dataset import build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save
+from .ensemble import run_ensemble
 from .stepper import (
     METHODS,
     DriftError,
@@ -37,6 +38,7 @@ from .stepper import (
 
 __all__ = [
     "run",
+    "run_ensemble",
     "rerun",
     "Run",
     "SimulationError",

@@ -95,18 +95,22 @@ def sincos(N, th, c, s):
             s[j] = math.sin(th[j])
         return
     for j in range(N):
-        x = th[j]
-        k = np.floor(x * _TWO_OVER_PI + 0.5)
-        r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3
-        z = r * r
-        sn = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
-        cs = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-        q = k - 4.0 * np.floor(k * 0.25)  # quadrant 0..3
-        swap = q == 1.0 or q == 3.0
-        a = sn if swap else cs
-        b = cs if swap else sn
-        c[j] = -a if (q == 1.0 or q == 2.0) else a
-        s[j] = -b if q >= 2.0 else b
+        c[j], s[j] = sincos1(th[j])
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+def sincos1(x):
+    """(cos x, sin x) by the branch-free polynomial of :func:`sincos` (|x| <= SINCOS_FAST_MAX)."""
+    k = np.floor(x * _TWO_OVER_PI + 0.5)
+    r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3
+    z = r * r
+    sn = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    cs = 1.0 - 0.5 * z + z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
+    q = k - 4.0 * np.floor(k * 0.25)  # quadrant 0..3
+    swap = q == 1.0 or q == 3.0
+    a = sn if swap else cs
+    b = cs if swap else sn
+    return (-a if (q == 1.0 or q == 2.0) else a), (-b if q >= 2.0 else b)
 
 
 class Work:

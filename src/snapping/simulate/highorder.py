@@ -239,44 +239,57 @@ class _Engine:
         c[R.Q_TRET] = self.requested[0] if self.requested else np.inf
         c[R.Q_VDOWN] = self.after_fracs[0] if self.after_fracs else 0.0
 
-    def loop(self, bar) -> int:
+    def start(self) -> None:
+        """Targets of the first call into the compiled loop."""
         c = self.ctl
         if not np.isfinite(c[R.Q_VUP]):
             c[R.Q_VUP] = SPEED_LEVEL_0
             while c[R.Q_VUP] <= self.meas0[K.M_VMAX]:
                 c[R.Q_VUP] *= SPEED_LEVEL_FACTOR
         self._set_targets()
+
+    def handle(self, code: int, bar=None):
+        """Act on a return code of the compiled loop (peaks, snapshots, progress); returns
+        None to go on, or the final code."""
+        c = self.ctl
+        self.drain()
+        if c[R.Q_REFINE] != 0.0:
+            self.refine()
+        if bar is not None:
+            bar.update(self.t - bar.n)
+            bar.set_postfix_str(f"v_max={self.meas[K.M_VMAX]:.4g} dt={c[R.Q_H]:.3g} steps={int(c[R.Q_NSTEPS])}",
+                                refresh=False)
+        t = self.t
+        if code == K.RET_T_RETURN:
+            while self.requested and self.requested[0] <= t:
+                tr = self.requested.pop(0)
+                self.snapshots.append((tr, "requested", self.Z_at(tr)[0]))
+        elif code == K.RET_V_UP:
+            self.snapshots.append((t, "speed_level", self.Z.copy()))
+            while c[R.Q_VUP] <= self.meas[K.M_VMAX]:
+                c[R.Q_VUP] *= SPEED_LEVEL_FACTOR
+        elif code == K.RET_V_DOWN:
+            self.snapshots.append((t, "after_peak", self.Z.copy()))
+            vpk = self.pk[0, R.PK_BEST]
+            while self.after_fracs and self.meas[K.M_VMAX] < self.after_fracs[0] * vpk:
+                self.after_fracs.pop(0)
+        elif code in (K.RET_CALL_LIMIT, K.RET_RECORD_FULL, R.RET_REFINE):
+            pass
+        else:
+            return code
+        self._set_targets()
+        return None
+
+    def loop(self, bar) -> int:
+        self.start()
         w = self.w
         while True:
             code = R.advance_rk(self.N, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ytmp,
-                                w.c, w.s, w.S, w.cp, w.dp, w.sig, self.Z, self.rinv0, c, self.rec, self.pk,
+                                w.c, w.s, w.S, w.cp, w.dp, w.sig, self.Z, self.rinv0, self.ctl, self.rec, self.pk,
                                 self.meas)
-            self.drain()
-            if c[R.Q_REFINE] != 0.0:
-                self.refine()
-            if bar is not None:
-                bar.update(self.t - bar.n)
-                bar.set_postfix_str(f"v_max={self.meas[K.M_VMAX]:.4g} dt={c[R.Q_H]:.3g} steps={int(c[R.Q_NSTEPS])}",
-                                    refresh=False)
-            t = self.t
-            if code == K.RET_T_RETURN:
-                while self.requested and self.requested[0] <= t:
-                    tr = self.requested.pop(0)
-                    self.snapshots.append((tr, "requested", self.Z_at(tr)[0]))
-            elif code == K.RET_V_UP:
-                self.snapshots.append((t, "speed_level", self.Z.copy()))
-                while c[R.Q_VUP] <= self.meas[K.M_VMAX]:
-                    c[R.Q_VUP] *= SPEED_LEVEL_FACTOR
-            elif code == K.RET_V_DOWN:
-                self.snapshots.append((t, "after_peak", self.Z.copy()))
-                vpk = self.pk[0, R.PK_BEST]
-                while self.after_fracs and self.meas[K.M_VMAX] < self.after_fracs[0] * vpk:
-                    self.after_fracs.pop(0)
-            elif code in (K.RET_CALL_LIMIT, K.RET_RECORD_FULL, R.RET_REFINE):
-                pass
-            else:
-                return code
-            self._set_targets()
+            final = self.handle(code, bar)
+            if final is not None:
+                return final
 
 
 def _failure_message(code: int, eng: _Engine) -> str:
@@ -357,6 +370,16 @@ def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, 
         wall = time.perf_counter() - wall0
         if bar is not None:
             bar.close()
+    return _finish(eng, inputs, code, status, reason, wall, output, stop_fraction, t_end)
+
+
+def _finish(eng: _Engine, inputs: dict, code, status: str, reason: str, wall: float, output, stop_fraction, t_end,
+            raise_on_failure: bool = True):
+    """The run Dataset of a finished engine (saved to ``output`` if given); a Run."""
+    from .. import __version__
+    from .stepper import Run, SimulationError
+
+    N = eng.N
     if code is not None:
         if code == K.RET_STOP:
             reason = f"snap detected: v_max fell below {stop_fraction:g} of its peak"
@@ -397,7 +420,7 @@ def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, 
     final.x[-1] = final.y[-1] = final.vx[-1] = final.vy[-1] = 0.0
     final.extra["angles"] = eng.Y1[int(c[R.Q_SLOT])].copy()
     path = save(ds, output) if output is not None else None
-    if status == "failed":
+    if status == "failed" and raise_on_failure:
         where = f"; what was computed is saved in {path}" if path else ""
         raise SimulationError(f"simulation failed: {reason}{where}", dataset=ds, path=path)
     if status == "interrupted":

@@ -49,9 +49,12 @@ E3_RK = np.ascontiguousarray(_dc.E3, dtype=np.float64)  # (13,)
 E5_RK = np.ascontiguousarray(_dc.E5, dtype=np.float64)  # (13,)
 D_RK = np.ascontiguousarray(_dc.D, dtype=np.float64)  # (4, 16)
 #: number of nonzero A entries of each stage row, and their columns (skip the zeros)
-_NZ = np.zeros(NSX, dtype=np.int64)
-_NZC = np.zeros((NSX, NSX), dtype=np.int64)
-for _s in range(NSX):
+#: (row NSX: the nonzero weights B of the solution, as a 17th row of A_RK)
+A_RK = np.vstack([np.hstack([A_RK, np.zeros((NSX, 1))]), np.zeros((1, NSX + 1))])
+A_RK[NSX, :NS] = B_RK
+_NZ = np.zeros(NSX + 1, dtype=np.int64)
+_NZC = np.zeros((NSX + 1, NSX + 1), dtype=np.int64)
+for _s in range(NSX + 1):
     _cols = [j for j in range(_s) if A_RK[_s, j] != 0.0]
     _NZ[_s] = len(_cols)
     _NZC[_s, : len(_cols)] = _cols
