@@ -197,6 +197,9 @@ def _py_cases():
         add(f"simulate.load_run({v!r})", lambda F, v=v: simulate.load_run(v))
         add(f"scaling.load_run({v!r})", lambda F, v=v: scaling.load_run(v))
     add("resume(output=proc)", lambda F: simulate.resume(F["completed"], output=F["proc"]))
+    add("resume(foreign, output=completed)", lambda F: simulate.resume(F["foreign"], output=F["completed"]))
+    add("run(chi=nan, output=completed)", lambda F: simulate.run(NAN, 10, output=F["completed"]))
+    add("run(tol=-1, output=foreign)", lambda F: simulate.run(0.3, 10, tol=-1.0, output=F["foreign"]))
     foreign = lambda F: xr.open_dataset(F["foreign"]).load()  # noqa: E731
     for name, fn in (("rerun", simulate.rerun), ("inputs_from_attrs", simulate.inputs_from_attrs),
                      ("initial_from_dataset", simulate.initial_from_dataset), ("check_run", scaling.check_run),
@@ -302,6 +305,10 @@ def _cli_cases():
               "completed", "failed"):
         add("simulate", "--resume", f"{{{k}}}")
     add("simulate", "--resume", "{completed}", "-o", "{proc}")
+    for k in ("completed", "foreign", "failed"):  # a bad input never touches the file named by -o
+        add("simulate", "--chi", "nan", "--N", "10", "-o", f"{{{k}}}")
+        add("simulate", "--chi", "0.3", "--N", "10", "--tol", "-1", "-o", f"{{{k}}}")
+    add("simulate", "--resume", "{failed}", "-o", "{completed}")
     for v in ("abc", "nan", "2", "0.3,0.3", ""):
         add("sweep", "--chi", v, "--N", "10", "-o", "{root}/sw")
     for v in ("0", "abc", "-5"):

@@ -414,8 +414,13 @@ def _cmd_sweep(args) -> int:
 
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
-    paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
-                            progress=sys.stderr.isatty())
+    try:
+        paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
+                                progress=sys.stderr.isatty())
+    except KeyboardInterrupt:
+        print(f"snapping sweep: interrupted; finished and checkpointed runs are kept in {args.output}: "
+              "run the same command again to resume only the missing runs", file=sys.stderr)
+        return 130
     combined = sweep.combine(paths)
     out = sweep.atomic_to_netcdf(combined, Path(args.output) / "sweep.nc")
     rows = []
