@@ -39,23 +39,33 @@ def save(fig, path_stem) -> list[Path]:
 
 
 def _snapshots_before(ds, n: int):
-    """Indices of up to ``n`` snapshots spread over [0, t_snap_v], ending at the snap."""
+    """Indices of up to ``n`` snapshots from t = 0 up to and including the snap.
+
+    The snap is the snapshot of kind 'peak' (the state at the largest sampled
+    maximum speed) when the run has one, else the last snapshot at or before
+    ``t_snap_v``. The automatic snapshots are taken at geometric levels of the
+    maximum speed, so they crowd towards the snap; thinning keeps the first and
+    the last and spreads the rest evenly in index.
+    """
     ts = ds["t_snapshot"].values
-    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
-    idx = np.flatnonzero(ts <= t_snap + 1e-12) if np.isfinite(t_snap) else np.arange(ts.size)
+    kinds = [str(k) for k in ds["snapshot_kind"].values] if "snapshot_kind" in ds else []
+    if "peak" in kinds:
+        last = kinds.index("peak")
+    else:
+        t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+        before = np.flatnonzero(ts <= t_snap) if np.isfinite(t_snap) else np.arange(ts.size)
+        last = int(before[-1]) if before.size else ts.size - 1
+    idx = np.arange(last + 1)
     if idx.size <= n:
         return idx
-    # spread evenly in time, always keeping the first and the last (the snap)
-    targets = np.linspace(ts[idx[0]], ts[idx[-1]], n)
-    pick = sorted({int(idx[np.argmin(np.abs(ts[idx] - tt))]) for tt in targets})
-    return np.asarray(pick)
+    return np.unique(np.round(np.linspace(0, last, n)).astype(int))
 
 
 def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8):
     """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run (in metres)."""
     plt = _plt()
     runs = list(runs)
-    fig, axes = plt.subplots(1, len(runs), figsize=(4.2 * len(runs), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(runs), figsize=(5.2 * len(runs), 4.4), squeeze=False)
     for ax, ds in zip(axes[0], runs):
         idx = _snapshots_before(ds, n)
         colors = plt.cm.viridis(np.linspace(0, 1, max(len(idx), 2)))
@@ -68,7 +78,7 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8):
         ax.set_title(f"chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
         ax.set_xlabel("x [m]")
         ax.set_ylabel("height [m]")
-        ax.legend(fontsize=7, loc="lower left")
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     fig.suptitle(f"Falling chain shapes (length {chain.length:g} m)")
     fig.tight_layout()
     return fig
