@@ -249,3 +249,13 @@ def test_ensemble_bad_input():
         run_ensemble([0.3], 10, method="euler-richardson")
     with pytest.raises(SnappingInputError, match="empty"):
         run_ensemble([], 10)
+
+
+@pytest.mark.parametrize("name", ["angles", "rk", "highorder", "ensemble"])
+def test_docstring_examples(name):
+    import doctest
+    import importlib
+
+    module = importlib.import_module(f"snapping.simulate.{name}")
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == 0
