@@ -577,9 +577,11 @@ def ideal_window_exponent(quantity: str, tau_lo: float, tau_hi: float) -> float:
     if not 0.0 < tau_lo < tau_hi:
         raise V.SnappingInputError(f"window [{tau_lo!r}, {tau_hi!r}] of t* - t must satisfy 0 < lo < hi")
     tau = np.logspace(math.log10(tau_lo), math.log10(min(tau_hi, ideal.t_star())), 200)
-    y = getattr(ideal.kink_state(tau=tau), quantity)
-    X, Y = np.log(tau), np.log(np.abs(y))
-    return float(np.polyfit(X, Y, 1)[0])
+    y = np.abs(getattr(ideal.kink_state(tau=tau), quantity))
+    ok = y > 0  # the free end starts at rest (tau = t*)
+    if ok.sum() < 2:
+        return math.nan
+    return float(np.polyfit(np.log(tau[ok]), np.log(y[ok]), 1)[0])
 
 
 def _verdict(fit: PowerLawFit, spec: RowSpec) -> tuple[float, str]:
