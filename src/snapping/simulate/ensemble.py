@@ -136,84 +136,335 @@ def rhs_lanes(N, L, y, f, c, s, S, cp, dp, sig, pm, pmm, qv, cpv, snx, snn):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
-def _stage_lanes(n, L, st, hL, y0, KE, out, hv):
-    """out = y0 + h_lane sum_j A[st, j] K_j for every lane (flat passes over i * L + lane)."""
-    m = R._NZ[st]
-    W = out.shape[1]
-    o = out.reshape(-1)
-    y = y0.reshape(-1)
-    for jj in range(m):
-        j = R._NZC[st, jj]
-        a = R.A_RK[st, j]
-        for lane in range(L):
-            hv[lane] = hL[lane] * a
-        Kj = KE[j].reshape(-1)
-        if jj == 0:
-            for i in range(n):
-                b = i * W
-                for lane in range(L):
-                    o[b + lane] = y[b + lane] + hv[lane] * Kj[b + lane]
-        else:
-            for i in range(n):
-                b = i * W
-                for lane in range(L):
-                    o[b + lane] += hv[lane] * Kj[b + lane]
+def _rhs_tiles(N, y, f, c, s, S, cp, dp, sig):
+    """:func:`angles.angle_rhs` (the same arithmetic) for the ``W = y.shape[1]`` (a
+    multiple of 4) interleaved chains of ``y, f`` (2N, W); work ``c ... sig`` (N, W).
+    The recurrences run on tiles of 4 lanes held in scalars (one SIMD register each)."""
+    W = y.shape[1]
+    fN = float(N)
+    n2 = fN * fN
+    inv_n2 = 1.0 / n2
+    yf = y.reshape(-1)
+    ff = f.reshape(-1)
+    cf = c.reshape(-1)
+    sf = s.reshape(-1)
+    nW = N * W
+    big = 0.0
+    for i in range(nW):
+        big = max(big, abs(yf[i]))
+    if big > AG.SINCOS_FAST_MAX:
+        for i in range(nW):
+            cf[i] = math.cos(yf[i])
+            sf[i] = math.sin(yf[i])
+    else:
+        for i in range(nW):
+            cf[i], sf[i] = AG.sincos1(yf[i])
+    for i in range(nW):
+        ff[i] = yf[nW + i]
+    if N == 1:
+        for lane in range(W):
+            w = y[1, lane]
+            sig[0, lane] = w * w - s[0, lane]
+            f[1, lane] = -c[0, lane]
+        return
+    for g in range(W // 4):
+        l = 4 * g
+        cprev0 = 0.0
+        pm0 = 1.0
+        pmm0 = 0.0
+        q0 = 0.0
+        cprev1 = 0.0
+        pm1 = 1.0
+        pmm1 = 0.0
+        q1 = 0.0
+        cprev2 = 0.0
+        pm2 = 1.0
+        pmm2 = 0.0
+        q2 = 0.0
+        cprev3 = 0.0
+        pm3 = 1.0
+        pmm3 = 0.0
+        q3 = 0.0
+        j0 = 0
+        while j0 < N - 1:
+            j1 = min(j0 + BLOCK, N - 1)
+            for j in range(j0, j1):
+                cj = c[j, l]
+                sj = s[j, l]
+                cn = c[j + 1, l]
+                sn = s[j + 1, l]
+                C = cn * cj + sn * sj
+                S[j, l] = sn * cj - cn * sj
+                w = y[N + j, l]
+                r = -(w * w) * inv_n2
+                p = -2.0 * pm0 - (cprev0 * cprev0) * pmm0
+                q0 = r * pm0 - cprev0 * q0
+                inv = 1.0 / p
+                cp[j, l] = C * pm0 * inv
+                dp[j, l] = q0 * inv
+                pmm0 = pm0
+                pm0 = p
+                cprev0 = C
+                cj = c[j, l + 1]
+                sj = s[j, l + 1]
+                cn = c[j + 1, l + 1]
+                sn = s[j + 1, l + 1]
+                C = cn * cj + sn * sj
+                S[j, l + 1] = sn * cj - cn * sj
+                w = y[N + j, l + 1]
+                r = -(w * w) * inv_n2
+                p = -2.0 * pm1 - (cprev1 * cprev1) * pmm1
+                q1 = r * pm1 - cprev1 * q1
+                inv = 1.0 / p
+                cp[j, l + 1] = C * pm1 * inv
+                dp[j, l + 1] = q1 * inv
+                pmm1 = pm1
+                pm1 = p
+                cprev1 = C
+                cj = c[j, l + 2]
+                sj = s[j, l + 2]
+                cn = c[j + 1, l + 2]
+                sn = s[j + 1, l + 2]
+                C = cn * cj + sn * sj
+                S[j, l + 2] = sn * cj - cn * sj
+                w = y[N + j, l + 2]
+                r = -(w * w) * inv_n2
+                p = -2.0 * pm2 - (cprev2 * cprev2) * pmm2
+                q2 = r * pm2 - cprev2 * q2
+                inv = 1.0 / p
+                cp[j, l + 2] = C * pm2 * inv
+                dp[j, l + 2] = q2 * inv
+                pmm2 = pm2
+                pm2 = p
+                cprev2 = C
+                cj = c[j, l + 3]
+                sj = s[j, l + 3]
+                cn = c[j + 1, l + 3]
+                sn = s[j + 1, l + 3]
+                C = cn * cj + sn * sj
+                S[j, l + 3] = sn * cj - cn * sj
+                w = y[N + j, l + 3]
+                r = -(w * w) * inv_n2
+                p = -2.0 * pm3 - (cprev3 * cprev3) * pmm3
+                q3 = r * pm3 - cprev3 * q3
+                inv = 1.0 / p
+                cp[j, l + 3] = C * pm3 * inv
+                dp[j, l + 3] = q3 * inv
+                pmm3 = pm3
+                pm3 = p
+                cprev3 = C
+            sc = math.ldexp(1.0, -math.frexp(pm0)[1])
+            pm0 *= sc
+            pmm0 *= sc
+            q0 *= sc
+            sc = math.ldexp(1.0, -math.frexp(pm1)[1])
+            pm1 *= sc
+            pmm1 *= sc
+            q1 *= sc
+            sc = math.ldexp(1.0, -math.frexp(pm2)[1])
+            pm2 *= sc
+            pmm2 *= sc
+            q2 *= sc
+            sc = math.ldexp(1.0, -math.frexp(pm3)[1])
+            pm3 *= sc
+            pmm3 *= sc
+            q3 *= sc
+            j0 = j1
+        jl = N - 1
+        w = y[N + jl, l]
+        r = -(w * w) * inv_n2 + s[jl, l] / fN
+        p = -pm0 - (cprev0 * cprev0) * pmm0
+        q0 = r * pm0 - cprev0 * q0
+        snx0 = q0 / p
+        sig[jl, l] = snx0
+        snn0 = 0.0
+        w = y[N + jl, l + 1]
+        r = -(w * w) * inv_n2 + s[jl, l + 1] / fN
+        p = -pm1 - (cprev1 * cprev1) * pmm1
+        q1 = r * pm1 - cprev1 * q1
+        snx1 = q1 / p
+        sig[jl, l + 1] = snx1
+        snn1 = 0.0
+        w = y[N + jl, l + 2]
+        r = -(w * w) * inv_n2 + s[jl, l + 2] / fN
+        p = -pm2 - (cprev2 * cprev2) * pmm2
+        q2 = r * pm2 - cprev2 * q2
+        snx2 = q2 / p
+        sig[jl, l + 2] = snx2
+        snn2 = 0.0
+        w = y[N + jl, l + 3]
+        r = -(w * w) * inv_n2 + s[jl, l + 3] / fN
+        p = -pm3 - (cprev3 * cprev3) * pmm3
+        q3 = r * pm3 - cprev3 * q3
+        snx3 = q3 / p
+        sig[jl, l + 3] = snx3
+        snn3 = 0.0
+        j = N - 2
+        sj = dp[j, l] - cp[j, l] * snx0
+        sig[j, l] = sj
+        f[N + j + 1, l] = -n2 * sj * S[j, l] - fN * c[j + 1, l]
+        snn0 = snx0
+        snx0 = sj
+        sj = dp[j, l + 1] - cp[j, l + 1] * snx1
+        sig[j, l + 1] = sj
+        f[N + j + 1, l + 1] = -n2 * sj * S[j, l + 1] - fN * c[j + 1, l + 1]
+        snn1 = snx1
+        snx1 = sj
+        sj = dp[j, l + 2] - cp[j, l + 2] * snx2
+        sig[j, l + 2] = sj
+        f[N + j + 1, l + 2] = -n2 * sj * S[j, l + 2] - fN * c[j + 1, l + 2]
+        snn2 = snx2
+        snx2 = sj
+        sj = dp[j, l + 3] - cp[j, l + 3] * snx3
+        sig[j, l + 3] = sj
+        f[N + j + 1, l + 3] = -n2 * sj * S[j, l + 3] - fN * c[j + 1, l + 3]
+        snn3 = snx3
+        snx3 = sj
+        for j in range(N - 3, -1, -1):
+            sj = dp[j, l] - cp[j, l] * snx0
+            sig[j, l] = sj
+            f[N + j + 1, l] = n2 * (snn0 * S[j + 1, l] - sj * S[j, l])
+            snn0 = snx0
+            snx0 = sj
+            sj = dp[j, l + 1] - cp[j, l + 1] * snx1
+            sig[j, l + 1] = sj
+            f[N + j + 1, l + 1] = n2 * (snn1 * S[j + 1, l + 1] - sj * S[j, l + 1])
+            snn1 = snx1
+            snx1 = sj
+            sj = dp[j, l + 2] - cp[j, l + 2] * snx2
+            sig[j, l + 2] = sj
+            f[N + j + 1, l + 2] = n2 * (snn2 * S[j + 1, l + 2] - sj * S[j, l + 2])
+            snn2 = snx2
+            snx2 = sj
+            sj = dp[j, l + 3] - cp[j, l + 3] * snx3
+            sig[j, l + 3] = sj
+            f[N + j + 1, l + 3] = n2 * (snn3 * S[j + 1, l + 3] - sj * S[j, l + 3])
+            snn3 = snx3
+            snx3 = sj
+        f[N, l] = n2 * snn0 * S[0, l]
+        f[N, l + 1] = n2 * snn1 * S[0, l + 1]
+        f[N, l + 2] = n2 * snn2 * S[0, l + 2]
+        f[N, l + 3] = n2 * snn3 * S[0, l + 3]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
-def _err_lanes(n, L, hL, y0, y1, KE, e5w, e3w, tolL, errL):
-    """The scaled error of every lane (rk.rk_step's max norm), e5 and e3 in flat passes."""
-    W = e5w.shape[1]
-    o5 = e5w.reshape(-1)
-    o3 = e3w.reshape(-1)
-    for jj in range(R._E5NZ.size):
-        j = R._E5NZ[jj]
-        a = R.E5_RK[j]
-        Kj = KE[j].reshape(-1)
-        for i in range(n):
-            b = i * W
-            for lane in range(L):
-                if jj == 0:
-                    o5[b + lane] = a * Kj[b + lane]
-                else:
-                    o5[b + lane] += a * Kj[b + lane]
-    for jj in range(R._E3NZ.size):
-        j = R._E3NZ[jj]
-        a = R.E3_RK[j]
-        Kj = KE[j].reshape(-1)
-        for i in range(n):
-            b = i * W
-            for lane in range(L):
-                if jj == 0:
-                    o3[b + lane] = a * Kj[b + lane]
-                else:
-                    o3[b + lane] += a * Kj[b + lane]
-    for lane in range(L):
+def _err_tiles(n, hL, y0, y1, KE, tolL, errL):
+    """The scaled error of every lane (rk.rk_step's max norm and summation order)."""
+    W = y0.shape[1]
+    for lane in range(W):
         errL[lane] = 0.0
     for i in range(n):
-        for lane in range(L):
-            sc = tolL[lane] * (1.0 + max(abs(y0[i, lane]), abs(y1[i, lane])))
-            e5 = e5w[i, lane] / sc
-            e3 = e3w[i, lane] / sc
+        for g in range(W // 4):
+            l = 4 * g
+            e50 = 0.0
+            e30 = 0.0
+            e51 = 0.0
+            e31 = 0.0
+            e52 = 0.0
+            e32 = 0.0
+            e53 = 0.0
+            e33 = 0.0
+            for jj in range(R._E5NZ.size):
+                j = R._E5NZ[jj]
+                a = R.E5_RK[j]
+                e50 += a * KE[j, i, l]
+                e51 += a * KE[j, i, l + 1]
+                e52 += a * KE[j, i, l + 2]
+                e53 += a * KE[j, i, l + 3]
+            for jj in range(R._E3NZ.size):
+                j = R._E3NZ[jj]
+                a = R.E3_RK[j]
+                e30 += a * KE[j, i, l]
+                e31 += a * KE[j, i, l + 1]
+                e32 += a * KE[j, i, l + 2]
+                e33 += a * KE[j, i, l + 3]
+            sc = tolL[l] * (1.0 + max(abs(y0[i, l]), abs(y1[i, l])))
+            e5 = e50 / sc
+            e3 = e30 / sc
             d = e5 * e5 + 0.01 * e3 * e3
             if d > 0.0:
-                e = abs(hL[lane]) * e5 * e5 / math.sqrt(d)
-                if e > errL[lane]:
-                    errL[lane] = e
+                e = abs(hL[l]) * e5 * e5 / math.sqrt(d)
+                if e > errL[l]:
+                    errL[l] = e
             elif not (d == 0.0):
-                errL[lane] = np.inf
+                errL[l] = np.inf
+            sc = tolL[l + 1] * (1.0 + max(abs(y0[i, l + 1]), abs(y1[i, l + 1])))
+            e5 = e51 / sc
+            e3 = e31 / sc
+            d = e5 * e5 + 0.01 * e3 * e3
+            if d > 0.0:
+                e = abs(hL[l + 1]) * e5 * e5 / math.sqrt(d)
+                if e > errL[l + 1]:
+                    errL[l + 1] = e
+            elif not (d == 0.0):
+                errL[l + 1] = np.inf
+            sc = tolL[l + 2] * (1.0 + max(abs(y0[i, l + 2]), abs(y1[i, l + 2])))
+            e5 = e52 / sc
+            e3 = e32 / sc
+            d = e5 * e5 + 0.01 * e3 * e3
+            if d > 0.0:
+                e = abs(hL[l + 2]) * e5 * e5 / math.sqrt(d)
+                if e > errL[l + 2]:
+                    errL[l + 2] = e
+            elif not (d == 0.0):
+                errL[l + 2] = np.inf
+            sc = tolL[l + 3] * (1.0 + max(abs(y0[i, l + 3]), abs(y1[i, l + 3])))
+            e5 = e53 / sc
+            e3 = e33 / sc
+            d = e5 * e5 + 0.01 * e3 * e3
+            if d > 0.0:
+                e = abs(hL[l + 3]) * e5 * e5 / math.sqrt(d)
+                if e > errL[l + 3]:
+                    errL[l + 3] = e
+            elif not (d == 0.0):
+                errL[l + 3] = np.inf
+
+
+#: elements per chunk of the flat stage sums (a chunk of the sum stays in L1)
+CHUNK = 1024
+
+
+@njit(cache=True, fastmath=False, boundscheck=False)
+def _stage_flat(st, hx, y0, KE, out):
+    """out = y0 + h_lane sum_j A[st, j] K_j for every lane, with the arithmetic of
+    rk._stage_state; ``hx`` holds each element's lane step (h of its lane). Flat,
+    vectorisable passes over chunks of CHUNK elements, each term read once."""
+    nW = out.size
+    o = out.reshape(-1)
+    y = y0.reshape(-1)
+    m = R._NZ[st]
+    for c0 in range(0, nW, CHUNK):
+        c1 = min(c0 + CHUNK, nW)
+        oc = o[c0:c1]
+        hc = hx[c0:c1]
+        j = R._NZC[st, 0]
+        a = R.A_RK[st, j]
+        Kc = KE[j].reshape(-1)[c0:c1]
+        yc = y[c0:c1]
+        for i in range(c1 - c0):
+            oc[i] = yc[i] + (hc[i] * a) * Kc[i]
+        for jj in range(1, m):
+            j = R._NZC[st, jj]
+            a = R.A_RK[st, j]
+            Kc = KE[j].reshape(-1)[c0:c1]
+            for i in range(c1 - c0):
+                oc[i] += (hc[i] * a) * Kc[i]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
 def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, cM, sM, sigM, rinv0,
-                  yE0, KE, yEt, yE1, e3w, cE, sE, SE, cpE, dpE, sigE, hL, lastL, errL, v1, v2, v3, v4, v5, v6,
-                  codes):
+                  yE0, KE, yEt, yE1, cE, sE, SE, cpE, dpE, sigE, hL, lastL, errL, tolL, hx, codes):
     """Advance the members ``act[:L]`` (one lane each) together until one of them needs
     Python; ``codes[m]`` then holds the return code of each member m that does (-1:
-    none). The per-member arrays (first index m) are those of a single run's engine."""
+    none). The per-member arrays (first index m) are those of a single run's engine;
+    the lane buffers have ``W = yE0.shape[1] >= L`` columns, a multiple of 4 (the
+    lanes past L repeat lane 0 and are ignored)."""
     n = 2 * N
+    W = yE0.shape[1]
     for lane in range(L):
         ctls[act[lane], R.Q_NCALL] = 0.0
+        tolL[lane] = ctls[act[lane], R.Q_TOL]
+    first = True
     while True:
         for lane in range(L):
             m = act[lane]
@@ -221,18 +472,30 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
             h, last = R.step_size(ctls[m])
             hL[lane] = h
             lastL[lane] = 1.0 if last else 0.0
+            Y1m = Y1s[m, sl]
+            K12 = KKs[m, sl, R.NS]
             for i in range(n):
-                yE0[i, lane] = Y1s[m, sl, i]
-                KE[0, i, lane] = KKs[m, sl, R.NS, i]
+                yE0[i, lane] = Y1m[i]
+                KE[0, i, lane] = K12[i]
+        if first:  # the padding lanes: a copy of lane 0 (finite; its results are not used)
+            first = False
+            for lane in range(L, W):
+                hL[lane] = hL[0]
+                tolL[lane] = tolL[0]
+                for i in range(n):
+                    yE0[i, lane] = yE0[i, 0]
+                    KE[0, i, lane] = KE[0, i, 0]
+        for i in range(n):  # each element's lane step, for the flat stage sums
+            b = i * W
+            for lane in range(W):
+                hx[b + lane] = hL[lane]
         for st in range(1, R.NS):
-            _stage_lanes(n, L, st, hL, yE0, KE, yEt, errL)
-            rhs_lanes(N, L, yEt, KE[st], cE, sE, SE, cpE, dpE, sigE, v1, v2, v3, v4, v5, v6)
-        _stage_lanes(n, L, R.NSX, hL, yE0, KE, yE1, errL)  # (row NSX of _NZ: the weights B)
-        rhs_lanes(N, L, yE1, KE[R.NS], cE, sE, SE, cpE, dpE, sigE, v1, v2, v3, v4, v5, v6)
-        # ---- error of each lane (as rk.rk_step), in flat passes
-        for lane in range(L):
-            v1[lane] = ctls[act[lane], R.Q_TOL]
-        _err_lanes(n, L, hL, yE0, yE1, KE, yEt, e3w, v1, errL)
+            _stage_flat(st, hx, yE0, KE, yEt)
+            _rhs_tiles(N, yEt, KE[st], cE, sE, SE, cpE, dpE, sigE)
+        _stage_flat(R.NSX, hx, yE0, KE, yE1)  # (row NSX of _NZ: the weights B)
+        _rhs_tiles(N, yE1, KE[R.NS], cE, sE, SE, cpE, dpE, sigE)
+        # ---- error of each lane (as rk.rk_step)
+        _err_tiles(n, hL, yE0, yE1, KE, tolL, errL)
         # ---- each member's own bookkeeping
         stop = False
         for lane in range(L):
@@ -240,12 +503,15 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
             err = errL[lane]
             ns = 1 - int(ctls[m, R.Q_SLOT])
             if err - err == 0.0 and err <= 1.0:  # accepted: the step goes into the member's slot
+                Y0m = Y0s[m, ns]
+                Y1m = Y1s[m, ns]
                 for i in range(n):
-                    Y0s[m, ns, i] = yE0[i, lane]
-                    Y1s[m, ns, i] = yE1[i, lane]
+                    Y0m[i] = yE0[i, lane]
+                    Y1m[i] = yE1[i, lane]
                 for j in range(R.NS + 1):
+                    Kj = KKs[m, ns, j]
                     for i in range(n):
-                        KKs[m, ns, j, i] = KE[j, i, lane]
+                        Kj[i] = KE[j, i, lane]
                 for j in range(N):
                     cM[m, j] = cE[j, lane]
                     sM[m, j] = sE[j, lane]
@@ -261,12 +527,11 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
 
 class _Lanes:
     """Stacked per-member arrays (the members' engines hold views into them) and the
-    interleaved lane buffers."""
+    interleaved lane buffers (as many lanes as active members, rounded up to 4)."""
 
     def __init__(self, engines):
         M = len(engines)
         N = engines[0].N
-        n = 2 * N
         self.M, self.N = M, N
         self.engines = engines
         names = ("Y0", "Y1", "KK", "F", "TS", "HS", "DOK", "ctl", "rec", "pk", "meas", "Z")
@@ -279,22 +544,29 @@ class _Lanes:
         self.s = np.zeros((M, N))
         self.sig = np.zeros((M, N))
         self.rinv0 = engines[0].rinv0
-        self.yE0 = np.zeros((n, M))
-        self.KE = np.zeros((R.NS + 1, n, M))
-        self.yEt = np.zeros((n, M))
-        self.yE1 = np.zeros((n, M))
-        self.e3w = np.zeros((n, M))
-        self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE = (np.zeros((N, M)) for _ in range(6))
-        self.hL, self.lastL, self.errL = np.zeros(M), np.zeros(M), np.zeros(M)
-        self.v = [np.zeros(M) for _ in range(6)]
         self.codes = np.full(M, -1, dtype=np.int64)
+        self.W = 0
+
+    def _buffers(self, W: int) -> None:
+        n, N = 2 * self.N, self.N
+        self.W = W
+        self.yE0 = np.zeros((n, W))
+        self.KE = np.zeros((R.NS + 1, n, W))
+        self.yEt = np.zeros((n, W))
+        self.yE1 = np.zeros((n, W))
+        self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE = (np.zeros((N, W)) for _ in range(6))
+        self.hL, self.lastL, self.errL, self.tolL = (np.zeros(W) for _ in range(4))
+        self.hx = np.zeros(n * W)
 
     def advance(self, act: np.ndarray) -> None:
+        W = 4 * ((act.size + 3) // 4)
+        if W != self.W:
+            self._buffers(W)
         self.codes[:] = -1
         advance_lanes(self.N, act.size, act, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ctl, self.rec,
                       self.pk, self.meas, self.Z, self.c, self.s, self.sig, self.rinv0, self.yE0, self.KE, self.yEt,
-                      self.yE1, self.e3w, self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE, self.hL, self.lastL,
-                      self.errL, *self.v, self.codes)
+                      self.yE1, self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE, self.hL, self.lastL,
+                      self.errL, self.tolL, self.hx, self.codes)
 
 
 def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end: float | None = None,
