@@ -157,6 +157,10 @@ CHECKPOINT_DIMS = {
     "checkpoint_snapshot": "snapshots taken so far",
     "checkpoint_pending": "requested snapshot times still to come (NaN padded)",
     "checkpoint_pending_after": "after-peak snapshot fractions still to come (NaN padded)",
+    "checkpoint_slot": "the two step slots of the DOP853 loop (last and previous accepted step)",
+    "checkpoint_stage": "the 16 Runge-Kutta stages of a DOP853 step (12, and 4 of the dense output)",
+    "checkpoint_dense": "the 7 coefficient vectors of a DOP853 step's dense output",
+    "checkpoint_angle": "the 2N angle-form unknowns (link angles, then angular velocities)",
 }
 
 #: The complete state of an unfinished run, stored in the run file itself next to the
@@ -175,6 +179,24 @@ CHECKPOINT_VARS: dict[str, dict[str, str]] = {
     "checkpoint_snapshot_t": _v("times of the snapshots so far"),
     "checkpoint_requested": _v("requested snapshot times still to come (NaN padded)"),
     "checkpoint_after_fractions": _v("after-peak snapshot fractions still to come (NaN padded)"),
+}
+#: The complete state of an unfinished angle-form run (``method = 'dop853'``): the same
+#: role as CHECKPOINT_VARS, with the step slots of the DOP853 loop instead of
+#: ``checkpoint_S`` (the other names are shared and mean the same, in the DOP853 layout).
+CHECKPOINT_VARS_DOP853: dict[str, dict[str, str]] = {
+    "checkpoint_Y0": _v("start states (angles, angular velocities) of the two stored steps"),
+    "checkpoint_Y1": _v("end states (angles, angular velocities) of the two stored steps"),
+    "checkpoint_stages": _v("Runge-Kutta stages of the two stored steps (stage 12: derivative at the end, FSAL)"),
+    "checkpoint_dense": _v("dense-output coefficients of the two stored steps"),
+    "checkpoint_step_t": _v("start times of the two stored steps"),
+    "checkpoint_step_h": _v("sizes of the two stored steps"),
+    "checkpoint_dense_ok": _v("1 where the dense output of a stored step has been built, else 0"),
+    "checkpoint_Z": _v("positions, velocities, accelerations and tensions of the current state"),
+    "checkpoint_peak_t": _v("time of the located peak of v_max (NaN: none yet)"),
+    **{k: CHECKPOINT_VARS[k] for k in ("checkpoint_peak_state", "checkpoint_ctl", "checkpoint_pk", "checkpoint_meas",
+                                       "checkpoint_meas0", "checkpoint_rinv0", "checkpoint_snapshot_state",
+                                       "checkpoint_snapshot_t", "checkpoint_requested",
+                                       "checkpoint_after_fractions")},
 }
 #: String variable (no units) holding the kinds of the snapshots so far.
 CHECKPOINT_KIND_VAR = "checkpoint_snapshot_kind"

@@ -16,6 +16,15 @@ Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
   sampled catenary, slightly shorter than 1/N, are lengthened to 1/N. Compare with
   Euler-Richardson runs at ``chords="exact"``.
 
+Long runs behave as the Euler-Richardson ones (the same driver,
+:func:`snapping.simulate.stepper._drive`): periodic atomic checkpoints into the run
+file (``checkpoint_every``; names :data:`snapping.schema.CHECKPOINT_VARS_DOP853`: the
+two last steps with their stages, the first-same-as-last stage and the dense output,
+the step controller, the records, snapshots and peak trackers), SIGINT/SIGTERM stop at
+a step boundary with a saved file, :func:`snapping.simulate.resume` continues bit for
+bit, and ``max_energy_drift``, ``max_rejections``, ``dt_min`` raise the subclasses of
+:class:`snapping.simulate.SimulationError` (attributes ``failure``, ``failure_node``).
+
 ``tol`` is the relative and absolute tolerance of every angle and angular velocity
 per step (max norm); ``link_error`` is the link-length error of the chain itself,
 ``|N |d_k| - 1|`` with ``d_k = (cos theta_k, sin theta_k)/N`` (positions, as float64
@@ -23,10 +32,6 @@ sums of links, carry an extra round-off up to about N ulp).
 """
 
 from __future__ import annotations
-
-import math
-import sys
-import time
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -70,7 +75,7 @@ class _Engine:
     """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
-                 dt_min=1e-14):
+                 dt_min=1e-14, max_energy_drift=None, max_rejections=100):
         N = y0.size // 2
         self.N = N
         n = 2 * N
@@ -129,6 +134,9 @@ class _Engine:
         c[R.Q_DT_MAX_ACC] = 0.0
         c[R.Q_ERROLD] = 1e-4
         c[R.Q_BETA] = PI_BETA
+        c[R.Q_MAXENERGY] = np.inf if max_energy_drift is None else max_energy_drift
+        c[R.Q_MAXREJ] = max_rejections
+        c[R.Q_CONSREJ] = 0.0
         self.ctl = c
         pk = np.full((4, R.NPKR), np.nan)
         for qi, m in enumerate(_PEAK_MEAS):
@@ -280,7 +288,10 @@ class _Engine:
         self._set_targets()
         return None
 
-    def loop(self, bar) -> int:
+    def loop(self, bar, poll=None) -> int:
+        """Run the compiled loop until a stop or failure code; returns it. ``poll()`` is
+        called at every clean step boundary (see :meth:`snapping.simulate.stepper._Engine.loop`);
+        a non-None result stops the loop and is returned."""
         self.start()
         w = self.w
         while True:
@@ -290,17 +301,180 @@ class _Engine:
             final = self.handle(code, bar)
             if final is not None:
                 return final
+            if poll is not None:
+                stop = poll()
+                if stop is not None:
+                    return stop
+
+    # -- the interface of the shared driver (snapping.simulate.stepper._drive)
+    @property
+    def n_steps(self) -> int:
+        return int(self.ctl[R.Q_NSTEPS])
+
+    def snapshots_now(self) -> list:
+        """The snapshots so far plus the located peak of v_max and the current state ('final')."""
+        snaps = list(self.snapshots)
+        if self.peak_state is not None:
+            snaps.append((self.peak_state[0], "peak", self.peak_state[1].copy()))
+        snaps.append((self.t, "final", self.Z.copy()))
+        return snaps
+
+    def final_state(self) -> ChainState:
+        Z = self.Z
+        final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), self.t)
+        final.x[-1] = final.y[-1] = final.vx[-1] = final.vy[-1] = 0.0
+        final.extra["angles"] = self.Y1[int(self.ctl[R.Q_SLOT])].copy()
+        return final
+
+    def results(self, status: str, reason: str, wall: float, failure: str = "", node: int = -1) -> dict:
+        """The result attributes (schema.RESULT_ATTRS) of the run so far."""
+        from .. import __version__
+
+        c, pk = self.ctl, self.pk
+        results = {"status": status, "stop_reason": reason, "failure": failure, "failure_node": int(node)}
+        for qi, name in enumerate(K.PEAK_QUANTITIES):
+            if name != "kappa":
+                results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
+            results[f"{name}_peak"] = float(pk[qi, R.PK_BEST])
+        results.update({
+            "kappa_max_0": float(self.meas0[K.M_KMAX]),
+            "energy_drift": float(c[R.Q_DRIFT_E]),
+            "link_drift": float(c[R.Q_DRIFT_LINK]),
+            "link_drift_initial": float(c[R.Q_DRIFT_LINK]),
+            "length_drift": float(c[R.Q_DRIFT_LEN]),
+            "link_error_initial": self.link_error_initial,
+            "t_final": self.t,
+            "energy_initial": float(self.meas0[K.M_ENERGY]),
+            "dt_min_accepted": float(c[R.Q_DT_MIN_ACC]) if np.isfinite(c[R.Q_DT_MIN_ACC]) else float("nan"),
+            "dt_max_accepted": float(c[R.Q_DT_MAX_ACC]) if c[R.Q_DT_MAX_ACC] > 0 else float("nan"),
+            "n_steps": int(c[R.Q_NSTEPS]),
+            "n_rejected": int(c[R.Q_NREJ]),
+            "n_rhs": int(c[R.Q_NRHS]),
+            "wall_time": wall,
+            "snapping_version": __version__,
+        })
+        return results
+
+    def worst_node(self, code: int) -> int:
+        """Index (along ``node``, 0 = free end) of the node behind a failure: the first
+        non-finite node (state, then the failed attempt's angles), the start of the worst
+        link, the largest acceleration (energy), or the link whose angle or angular
+        velocity changed most in the last attempted step (step size, rejections)."""
+        N = self.N
+        Z = self.Z
+        sl = int(self.ctl[R.Q_SLOT])
+        att = self.Y1[1 - sl]
+        if code == K.RET_FAIL_NAN:
+            bad = ~np.all(np.isfinite(Z[:, :N]), axis=0)
+            if not bad.any():
+                bad = ~(np.isfinite(att[:N]) & np.isfinite(att[N:]))
+            return int(np.argmax(bad)) if bad.any() else -1
+        if code == K.RET_FAIL_DRIFT:
+            return int(np.argmax(np.abs(N * np.hypot(np.diff(Z[K.RX]), np.diff(Z[K.RY])) - 1.0)))
+        if code == K.RET_FAIL_ENERGY:
+            return int(np.argmax(np.hypot(Z[K.RAX, :N], Z[K.RAY, :N])))
+        cur = self.Y1[sl]
+        m = np.maximum(np.abs(att[:N] - cur[:N]), np.abs(att[N:] - cur[N:]))
+        return int(np.argmax(np.where(np.isfinite(m), m, np.inf)))
+
+    def failure_message(self, code: int, node: int = -1) -> str:
+        return _failure_message(code, self, node)
+
+    # -- checkpoints
+    def checkpoint_vars(self) -> dict:
+        """The checkpoint variables (schema.CHECKPOINT_VARS_DOP853), to add to the run Dataset so far."""
+        from .. import schema
+
+        def pad(vals):
+            return np.asarray(list(vals) + [np.nan], dtype=float)
+
+        nd, ld = schema.NODE_DIM, schema.LINK_DIM
+        row, slot, ang = "checkpoint_row", "checkpoint_slot", "checkpoint_angle"
+        snaps = self.snapshots
+        peak_t, peak_Z = (np.nan, np.full_like(self.Z, np.nan)) if self.peak_state is None else self.peak_state
+        out = {
+            "checkpoint_Y0": ((slot, ang), self.Y0.copy()),
+            "checkpoint_Y1": ((slot, ang), self.Y1.copy()),
+            "checkpoint_stages": ((slot, "checkpoint_stage", ang), self.KK.copy()),
+            "checkpoint_dense": ((slot, "checkpoint_dense", ang), self.F.copy()),
+            "checkpoint_step_t": ((slot,), self.TS.copy()),
+            "checkpoint_step_h": ((slot,), self.HS.copy()),
+            "checkpoint_dense_ok": ((slot,), self.DOK.copy()),
+            "checkpoint_Z": ((row, nd), self.Z.copy()),
+            "checkpoint_peak_t": ((), np.float64(peak_t)),
+            "checkpoint_peak_state": ((row, nd), np.array(peak_Z, dtype=float)),
+            "checkpoint_ctl": (("checkpoint_ctl",), self.ctl.copy()),
+            "checkpoint_pk": (("checkpoint_peak", "checkpoint_peak_col"), self.pk.copy()),
+            "checkpoint_meas": (("checkpoint_meas",), self.meas.copy()),
+            "checkpoint_meas0": (("checkpoint_meas",), self.meas0.copy()),
+            "checkpoint_rinv0": ((ld,), self.rinv0.copy()),
+            "checkpoint_snapshot_state": (("checkpoint_snapshot", row, nd), np.stack([z for _, _, z in snaps])),
+            "checkpoint_snapshot_t": (("checkpoint_snapshot",), np.array([t for t, _, _ in snaps], dtype=float)),
+            "checkpoint_requested": (("checkpoint_pending",), pad(self.requested)),
+            "checkpoint_after_fractions": (("checkpoint_pending_after",), pad(self.after_fracs)),
+        }
+        out = {k: (dims, v, dict(schema.CHECKPOINT_VARS_DOP853[k])) for k, (dims, v) in out.items()}
+        out[schema.CHECKPOINT_KIND_VAR] = (("checkpoint_snapshot",), np.array([k for _, k, _ in snaps], dtype=str),
+                                           {"long_name": "kinds of the snapshots so far"})
+        return out
+
+    def restore(self, ds) -> None:
+        """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
+        from .. import schema
+        from .dataset import records_from_dataset
+
+        def get(name, shape):
+            a = np.array(ds[name].values, dtype=float)
+            if shape is not None and a.shape != shape:
+                raise V.SnappingInputError(f"checkpoint variable {name!r} has shape {a.shape}, expected {shape}")
+            return a
+
+        N = self.N
+        for name, arr in (("checkpoint_Y0", self.Y0), ("checkpoint_Y1", self.Y1), ("checkpoint_stages", self.KK),
+                          ("checkpoint_dense", self.F), ("checkpoint_step_t", self.TS),
+                          ("checkpoint_step_h", self.HS), ("checkpoint_dense_ok", self.DOK),
+                          ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
+                          ("checkpoint_meas0", self.meas0)):
+            arr[...] = get(name, arr.shape)
+        ctl = get("checkpoint_ctl", None)
+        if ctl.shape != (R.NQ,):
+            raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {R.NQ}")
+        self.ctl[...] = ctl
+        self.rinv0 = get("checkpoint_rinv0", (N,))
+        self.link_error_initial = float(ds.attrs["checkpoint_link_error_initial"])
+        peak_t = float(get("checkpoint_peak_t", ()))
+        self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
+        st = get("checkpoint_snapshot_state", None)
+        ts = get("checkpoint_snapshot_t", None)
+        kinds = [str(k) for k in np.asarray(ds[schema.CHECKPOINT_KIND_VAR].values)]
+        if st.ndim != 3 or st.shape[1:] != (K.NROWS, N + 1) or not (len(ts) == len(kinds) == st.shape[0]):
+            raise V.SnappingInputError("checkpoint snapshots are inconsistent")
+        self.snapshots = [(float(t), k, z.copy()) for t, k, z in zip(ts, kinds, st)]
+        self.requested = [float(v) for v in get("checkpoint_requested", None) if np.isfinite(v)]
+        self.after_fracs = [float(v) for v in get("checkpoint_after_fractions", None) if np.isfinite(v)]
+        recs = records_from_dataset(ds)
+        self.chunks = [recs] if len(recs) else []
+        self.ctl[R.Q_NREC] = 0
 
 
-def _failure_message(code: int, eng: _Engine) -> str:
+def _failure_message(code: int, eng: _Engine, node: int = -1) -> str:
     t = eng.t
+    c = eng.ctl
+    where = f" (step {int(c[R.Q_NSTEPS])}, worst node {node}: s={(eng.N - node) / eng.N:.6g})" if node >= 0 else ""
     if code == K.RET_FAIL_NAN:
-        return f"non-finite values (NaN/inf) in the state at t={t:.9g}"
+        return f"non-finite values (NaN/inf) in the state at t={t:.9g}{where}"
     if code == K.RET_FAIL_DT:
-        return f"time-step underflow at t={t:.9g}: dt={eng.ctl[R.Q_H]:.3g} < {eng.ctl[R.Q_DTMIN]:.3g}"
+        return f"time-step underflow at t={t:.9g}: dt={c[R.Q_H]:.3g} < dt_min={c[R.Q_DTMIN]:.3g}{where}"
     if code == K.RET_FAIL_DRIFT:
         return (f"link-length drift past the bound at t={t:.9g}: relative link error "
-                f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error = {eng.ctl[R.Q_MAXLINK]:.3g}")
+                f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error = {c[R.Q_MAXLINK]:.3g}{where}")
+    if code == K.RET_FAIL_ENERGY:
+        de = abs(eng.meas[K.M_ENERGY] - c[R.Q_E0])
+        return (f"energy drift past the bound at t={t:.9g}: |E - E0| = {de:.3g} > "
+                f"max_energy_drift={c[R.Q_MAXENERGY]:.3g}{where}")
+    if code == K.RET_FAIL_REJECT:
+        return (f"{int(c[R.Q_CONSREJ])} consecutive rejected steps at t={t:.9g} > max_rejections="
+                f"{int(c[R.Q_MAXREJ])} (last dt={c[R.Q_H]:.3g}){where}")
     return f"unknown failure code {code}"
 
 
@@ -323,10 +497,39 @@ def _warm_up() -> None:
     _compiled = True
 
 
+def _setup(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
+           max_link_error, chords, initial, dt_min=1e-14, max_energy_drift=None, max_rejections=100):
+    """The input attributes and the engine of an angle-form run (validated arguments)."""
+    method = resolve_method(method)
+    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+    y0 = AG.state_to_angles(state0)
+    inputs = {
+        "chi": chi, "N": N, "method": method, "tol": tol, "dt0": 0.0, "t_end": 0.0 if t_end is None else t_end,
+        "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
+        "chords": chords, "initial": "catenary" if initial is None else "snapshot", "t_end_max": t_end_max,
+        "max_link_error": max_link_error, "max_energy_drift": 0.0 if max_energy_drift is None else max_energy_drift,
+        "dt_min": dt_min, "max_rejections": max_rejections,
+    }
+    _warm_up()
+    eng = _Engine(y0, state0.t, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
+                  stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
+                  max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min,
+                  max_energy_drift=max_energy_drift, max_rejections=max_rejections)
+    inputs["dt0"] = eng.dt0
+    return inputs, eng
+
+
 def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-                  max_link_error, chords, initial, output, progress, dt_min=1e-14):
+                  max_link_error, chords, initial, output, progress, dt_min=1e-14, max_energy_drift=None,
+                  max_rejections=100, checkpoint_every=None):
     """The body of :func:`snapping.simulate.run` for the angle-form methods (inputs
     already validated by it). Returns a :class:`snapping.simulate.Run`.
+
+    Driven like the Euler-Richardson runs (:func:`snapping.simulate.stepper._drive`):
+    periodic atomic checkpoints of the full state into ``output`` every
+    ``checkpoint_every`` seconds, SIGINT/SIGTERM stop at a step boundary with a saved,
+    resumable file (:func:`snapping.simulate.resume` continues it bit for bit), and the
+    numerical failures raise the subclasses of :class:`SimulationError`.
 
     Examples
     --------
@@ -335,94 +538,44 @@ def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, 
     >>> ds.attrs["method"], round(ds.attrs["t_snap_v"], 3), bool(ds.attrs["link_drift"] < 1e-14)
     ('dop853', 1.144, True)
     """
-    from .. import __version__
-    from .stepper import Run, SimulationError
+    from .stepper import _drive
 
-    method = resolve_method(method)
-    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
-    y0 = AG.state_to_angles(state0)
-    inputs = {
-        "chi": chi, "N": N, "method": method, "tol": tol, "dt0": 0.0, "t_end": 0.0 if t_end is None else t_end,
-        "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
-        "chords": chords, "initial": "catenary" if initial is None else "snapshot", "t_end_max": t_end_max,
-        "max_link_error": max_link_error,
-    }
-    _warm_up()
-    wall0 = time.perf_counter()
-    eng = _Engine(y0, state0.t, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
-                  stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
-                  max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min)
-    inputs["dt0"] = eng.dt0
-    bar = None
-    if progress or progress is None:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=t_end, file=sys.stderr, disable=None if progress is None else False, unit="t",
-                   desc=f"chain N={N} ({method})", dynamic_ncols=True,
-                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
-                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
-    status, reason, code = "completed", "", None
-    try:
-        code = eng.loop(bar)
-    except KeyboardInterrupt:
-        status, reason = "interrupted", f"interrupted by the user at t={eng.t:.9g}"
-    finally:
-        wall = time.perf_counter() - wall0
-        if bar is not None:
-            bar.close()
-    return _finish(eng, inputs, code, status, reason, wall, output, stop_fraction, t_end)
+    inputs, eng = _setup(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
+                         t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
+                         max_link_error=max_link_error, chords=chords, initial=initial, dt_min=dt_min,
+                         max_energy_drift=max_energy_drift, max_rejections=max_rejections)
+    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
 
 
 def _finish(eng: _Engine, inputs: dict, code, status: str, reason: str, wall: float, output, stop_fraction, t_end,
             raise_on_failure: bool = True):
-    """The run Dataset of a finished engine (saved to ``output`` if given); a Run."""
-    from .. import __version__
-    from .stepper import Run, SimulationError
+    """The run Dataset of a finished engine (saved to ``output`` if given); a Run.
+    (Used by the ensembles; single runs go through :func:`snapping.simulate.stepper._drive`.)"""
+    from .stepper import _FAILURES, Run, SimulationError
 
-    N = eng.N
+    c = eng.ctl
+    inputs = dict(inputs)
+    inputs.setdefault("max_energy_drift", float(c[R.Q_MAXENERGY]) if np.isfinite(c[R.Q_MAXENERGY]) else 0.0)
+    inputs.setdefault("dt_min", float(c[R.Q_DTMIN]))
+    inputs.setdefault("max_rejections", int(c[R.Q_MAXREJ]))
+    failure, node = "", -1
     if code is not None:
         if code == K.RET_STOP:
             reason = f"snap detected: v_max fell below {stop_fraction:g} of its peak"
         elif code == K.RET_END:
             reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
         else:
-            status, reason = "failed", _failure_message(code, eng)
-    if eng.peak_state is not None:
-        eng.snapshots.append((eng.peak_state[0], "peak", eng.peak_state[1]))
-    eng.snapshots.append((eng.t, "final", eng.Z.copy()))
-    records = eng.records()
-    c, pk = eng.ctl, eng.pk
-    results = {"status": status, "stop_reason": reason}
-    for qi, name in enumerate(K.PEAK_QUANTITIES):
-        if name != "kappa":
-            results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
-        results[f"{name}_peak"] = float(pk[qi, R.PK_BEST])
-    results.update({
-        "kappa_max_0": float(eng.meas0[K.M_KMAX]),
-        "energy_drift": float(c[R.Q_DRIFT_E]),
-        "link_drift": float(c[R.Q_DRIFT_LINK]),
-        "link_drift_initial": float(c[R.Q_DRIFT_LINK]),
-        "length_drift": float(c[R.Q_DRIFT_LEN]),
-        "link_error_initial": eng.link_error_initial,
-        "t_final": eng.t,
-        "energy_initial": float(eng.meas0[K.M_ENERGY]),
-        "dt_min_accepted": float(c[R.Q_DT_MIN_ACC]) if np.isfinite(c[R.Q_DT_MIN_ACC]) else float("nan"),
-        "dt_max_accepted": float(c[R.Q_DT_MAX_ACC]) if c[R.Q_DT_MAX_ACC] > 0 else float("nan"),
-        "n_steps": int(c[R.Q_NSTEPS]),
-        "n_rejected": int(c[R.Q_NREJ]),
-        "n_rhs": int(c[R.Q_NRHS]),
-        "wall_time": wall,
-        "snapping_version": __version__,
-    })
-    ds = build_dataset(records, eng.snapshots, N, inputs, results)
-    Z = eng.Z
-    final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), eng.t)
-    final.x[-1] = final.y[-1] = final.vx[-1] = final.vy[-1] = 0.0
-    final.extra["angles"] = eng.Y1[int(c[R.Q_SLOT])].copy()
+            status = "failed"
+            node = eng.worst_node(code)
+            reason = eng.failure_message(code, node)
+            failure = _FAILURES.get(code, SimulationError).kind
+    ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs,
+                       eng.results(status, reason, wall, failure, node))
     path = save(ds, output) if output is not None else None
     if status == "failed" and raise_on_failure:
         where = f"; what was computed is saved in {path}" if path else ""
-        raise SimulationError(f"simulation failed: {reason}{where}", dataset=ds, path=path)
+        cls = _FAILURES.get(code, SimulationError)
+        raise cls(f"simulation failed: {reason}{where}", dataset=ds, path=path, t=eng.t, step=eng.n_steps, node=node)
     if status == "interrupted":
         raise KeyboardInterrupt(reason + (f"; saved in {path}" if path else ""))
-    return Run(ds, final, path)
+    return Run(ds, eng.final_state(), path)

@@ -70,8 +70,8 @@ ERR_EXPONENT = -1.0 / 8.0
 (Q_T, Q_H, Q_SLOT, Q_NSTEPS, Q_NREJ, Q_NRHS, Q_NREC, Q_TOL, Q_THIN, Q_MAXLINK, Q_DTMIN,
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
- Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL) = range(34)
-NQ = 34
+ Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ) = range(37)
+NQ = 37
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
@@ -202,15 +202,21 @@ def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         ctl[Q_H] = MIN_FACTOR * h
         ctl[Q_NREJ] += 1.0
         ctl[Q_REJECTED] = 1.0
+        ctl[Q_CONSREJ] += 1.0
         if ctl[Q_H] < dtmin:
             return K.RET_FAIL_NAN
+        if ctl[Q_CONSREJ] > ctl[Q_MAXREJ]:
+            return K.RET_FAIL_REJECT
         return GO_REJECTED
     if err > 1.0:
         ctl[Q_H] = h * max(MIN_FACTOR, SAFETY * err ** ERR_EXPONENT)
         ctl[Q_NREJ] += 1.0
         ctl[Q_REJECTED] = 1.0
+        ctl[Q_CONSREJ] += 1.0
         if ctl[Q_H] < dtmin:
             return K.RET_FAIL_DT
+        if ctl[Q_CONSREJ] > ctl[Q_MAXREJ]:
+            return K.RET_FAIL_REJECT
         return GO_REJECTED
     # ---- accept
     # (PI control, Gustafsson / Hairer's DOP853: beta = ctl[Q_BETA]; 0 is the I controller)
@@ -223,6 +229,7 @@ def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     if ctl[Q_REJECTED] != 0.0:
         fac = min(1.0, fac)
     ctl[Q_REJECTED] = 0.0
+    ctl[Q_CONSREJ] = 0.0
     t = ctl[Q_T]
     TS[ns] = t
     HS[ns] = h
@@ -284,6 +291,8 @@ def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         code = K.RET_FAIL_NAN
     elif meas[K.M_LINKERR] > ctl[Q_MAXLINK]:
         code = K.RET_FAIL_DRIFT
+    elif de > ctl[Q_MAXENERGY]:
+        code = K.RET_FAIL_ENERGY
     elif dt < dtmin:
         code = K.RET_FAIL_DT
     elif stopfrac > 0.0 and vmax < stopfrac * vbest:

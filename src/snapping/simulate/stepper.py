@@ -366,6 +366,24 @@ class _Engine:
     def current(self) -> np.ndarray:
         return self.S[int(self.ctl[K.C_CUR])]
 
+    # -- the interface of the driver (:func:`_drive`; shared with highorder._Engine)
+    @property
+    def n_steps(self) -> int:
+        return int(self.ctl[K.C_NSTEPS])
+
+    def results(self, status: str, reason: str, wall: float, failure: str = "", node: int = -1) -> dict:
+        return _results(self, status, reason, wall, failure, node)
+
+    def worst_node(self, code: int) -> int:
+        return _worst_node(code, self)
+
+    def failure_message(self, code: int, node: int = -1) -> str:
+        return _failure_message(code, self, node)
+
+    def final_state(self) -> ChainState:
+        Z = self.current()
+        return ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), self.t)
+
     def drain(self) -> None:
         n = int(self.ctl[K.C_NREC])
         if n:
@@ -701,7 +719,8 @@ def run(
         return run_highorder(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
                              t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
                              max_link_error=max_link_error, chords=chords, initial=initial, output=output,
-                             progress=progress, dt_min=dt_min)
+                             progress=progress, dt_min=dt_min, max_energy_drift=max_energy_drift,
+                             max_rejections=max_rejections, checkpoint_every=checkpoint_every)
     if dt0 is None:
         dt0 = math.sqrt(tol)
     _check_memory(N, chi=chi, tol=tol, method=method, dt0=dt0, t_end=t_end, t_end_max=t_end_max,
@@ -887,15 +906,23 @@ def _resume_command(path) -> str:
 
 
 def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
-    """Run ``eng`` to its end, with progress bar, signal handling and checkpoints; build and save the result."""
+    """Run ``eng`` to its end, with progress bar, signal handling and checkpoints; build and save the result.
+
+    ``eng`` is an Euler-Richardson :class:`_Engine` or an angle-form
+    :class:`snapping.simulate.highorder._Engine`: both provide ``t``, ``n_steps``,
+    ``loop(bar, poll)``, ``records()``, ``snapshots_now()``, ``checkpoint_vars()``,
+    ``results(...)``, ``worst_node(code)``, ``failure_message(code, node)``,
+    ``final_state()`` and ``link_error_initial``."""
     t_end = inputs["t_end"] or None
     N = eng.N
     bar = None
     if progress or progress is None:
         from tqdm.auto import tqdm
 
+        desc = f"chain N={N}" if inputs["method"] in ("euler-richardson", "euler-richardson-fixed") else \
+            f"chain N={N} ({inputs['method']})"
         bar = tqdm(total=t_end, initial=eng.t, file=sys.stderr, disable=None if progress is None else False,
-                   unit="t", desc=f"chain N={N}", dynamic_ncols=True,
+                   unit="t", desc=desc, dynamic_ncols=True,
                    bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
                                else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
     got = {"signum": None, "last": time.monotonic()}
@@ -913,8 +940,8 @@ def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wa
             return RET_SIGNAL
         if output is not None and checkpoint_every is not None and time.monotonic() - got["last"] >= checkpoint_every:
             wall = wall_before + time.perf_counter() - wall0
-            res = _results(eng, "checkpoint", f"running; checkpoint at t={eng.t:.9g}, step {int(eng.ctl[K.C_NSTEPS])}; "
-                           f"if the run was killed, continue with: {_resume_command(output)}", wall)
+            res = eng.results("checkpoint", f"running; checkpoint at t={eng.t:.9g}, step {eng.n_steps}; "
+                              f"if the run was killed, continue with: {_resume_command(output)}", wall)
             save(_checkpoint_dataset(eng, inputs, res), output)
             got["last"] = time.monotonic()
         return None
@@ -944,10 +971,10 @@ def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wa
                 name = signal.Signals(got["signum"]).name
             except ValueError:
                 name = f"signal {got['signum']}"
-            reason = f"interrupted by {name} at t={eng.t:.9g}, step {int(eng.ctl[K.C_NSTEPS])}"
+            reason = f"interrupted by {name} at t={eng.t:.9g}, step {eng.n_steps}"
             if output is not None:
                 reason += f"; continue with: {_resume_command(output)}"
-            ds = _checkpoint_dataset(eng, inputs, _results(eng, status, reason, wall))
+            ds = _checkpoint_dataset(eng, inputs, eng.results(status, reason, wall))
             path = save(ds, output) if output is not None else None
             raise RunInterrupted(f"{reason}" + (f" (saved in {path})" if path else " (not saved: no output file)"),
                                  int(got["signum"]), dataset=ds, path=path)
@@ -957,15 +984,12 @@ def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wa
             reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
         else:
             status = "failed"
-            node = _worst_node(code, eng)
-            reason = _failure_message(code, eng, node)
+            node = eng.worst_node(code)
+            reason = eng.failure_message(code, node)
             failure = _FAILURES.get(code, SimulationError).kind
         ds = build_dataset(eng.records(), eng.snapshots_now(), N, inputs,
-                           _results(eng, status, reason, wall, failure, node))
-        final = None
-        if status == "completed":
-            Z = eng.current()
-            final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), eng.t)
+                           eng.results(status, reason, wall, failure, node))
+        final = eng.final_state() if status == "completed" else None
         path = save(ds, output) if output is not None else None
     finally:
         for sig, h in handlers.items():
@@ -974,7 +998,7 @@ def _drive(eng: _Engine, inputs: dict, *, output, progress, checkpoint_every, wa
         where = f"; what was computed is saved in {path}" if path else ""
         cls = _FAILURES.get(code, SimulationError)
         raise cls(f"simulation failed: {reason}{where}", dataset=ds, path=path, t=eng.t,
-                  step=int(eng.ctl[K.C_NSTEPS]), node=node)
+                  step=eng.n_steps, node=node)
     return Run(ds, final, path)
 
 
@@ -1015,8 +1039,9 @@ def _open_checkpoint(path) -> xr.Dataset:
                                        f"resume, only runs with status in {schema.RESUMABLE_STATUS} continue")
         raise V.SnappingInputError(f"path={p!r} is not a snapping run checkpoint (status={status!r}; "
                                    f"expected one of {schema.RESUMABLE_STATUS})")
-    missing = [k for k in (*schema.CHECKPOINT_VARS, schema.CHECKPOINT_KIND_VAR, *schema.STEP_VARS)
-               if k not in ds.variables]
+    ck_vars = schema.CHECKPOINT_VARS_DOP853 if str(ds.attrs.get("method", "")) in ("dop853", "fast") else \
+        schema.CHECKPOINT_VARS
+    missing = [k for k in (*ck_vars, schema.CHECKPOINT_KIND_VAR, *schema.STEP_VARS) if k not in ds.variables]
     missing += [k for k in (*schema.CHECKPOINT_ATTRS, "chi", "N", "method", "tol") if k not in ds.attrs]
     if missing:
         raise V.SnappingInputError(f"path={p!r} is not a complete checkpoint: missing {missing[:5]}")
@@ -1042,6 +1067,10 @@ def is_resumable(path, **expected) -> bool:
         if v is None or k in ("output", "progress", "checkpoint_every"):
             continue
         have = kw.get(k)
+        if k == "method" and v == "fast":  # files name the method it stands for
+            from .highorder import resolve_method
+
+            v = resolve_method(v)
         if k == "snapshot_times":
             if tuple(float(x) for x in np.atleast_1d(np.asarray(v, dtype=float))) != tuple(have or ()):
                 return False
@@ -1112,8 +1141,19 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
                                    f"({type(exc).__name__}: {exc})") from None
     _check_memory(N, chi=chi, tol=tol, method=method, dt0=dt0, t_end=t_end, t_end_max=t_end_max,
                   snapshot_times=snapshot_times, record_thin=record_thin)
-    inputs, eng = _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-                         max_link_error, chords, kw.get("initial"), max_energy_drift, dt_min, max_rejections)
+    if method in ("dop853", "fast"):
+        from .highorder import _setup as _setup_highorder
+
+        inputs, eng = _setup_highorder(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end,
+                                       stop_fraction=stop_fraction, t_end_max=t_end_max,
+                                       snapshot_times=snapshot_times, record_thin=record_thin,
+                                       max_link_error=max_link_error, chords=chords, initial=kw.get("initial"),
+                                       dt_min=dt_min, max_energy_drift=max_energy_drift,
+                                       max_rejections=max_rejections)
+    else:
+        inputs, eng = _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times,
+                             record_thin, max_link_error, chords, kw.get("initial"), max_energy_drift, dt_min,
+                             max_rejections)
     try:
         eng.restore(ds)
     except (KeyError, ValueError, TypeError) as exc:
