@@ -147,6 +147,19 @@ def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
     return np.stack(cols, axis=1) if cols[0].size else np.zeros((0, K.NREC))
 
 
+def open_netcdf(p: str) -> xr.Dataset:
+    """The netCDF file at path ``p`` loaded into memory (the file is closed), or
+    SnappingInputError saying why it cannot be read."""
+    if not os.path.isfile(p):
+        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
+    try:
+        with xr.open_dataset(p, engine="netcdf4") as f:
+            return f.load()
+    except Exception as exc:  # netCDF4/HDF5 raise OSError, ValueError, KeyError, ...
+        msg = (str(exc).strip().splitlines() or [""])[0][:160]
+        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF run file ({type(exc).__name__}: {msg})") from None
+
+
 def load_run(path) -> xr.Dataset:
     """Open a run file (loaded into memory, the file is closed).
 
@@ -158,14 +171,7 @@ def load_run(path) -> xr.Dataset:
     4
     """
     p = V.file_path("path", path)
-    if not os.path.isfile(p):
-        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
-    try:
-        with xr.open_dataset(p, engine="netcdf4") as f:
-            ds = f.load()
-    except Exception as exc:  # netCDF4/HDF5 raise OSError, ValueError, KeyError, ...
-        msg = (str(exc).strip().splitlines() or [""])[0][:160]
-        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF run file ({type(exc).__name__}: {msg})") from None
+    ds = open_netcdf(p)
     if "t" not in ds.variables or "N" not in ds.attrs:
         raise V.SnappingInputError(f"path={p!r} is not a snapping run file (no time 't' or attribute 'N'; "
                                    f"variables: {sorted(map(str, ds.variables))[:6]})")

@@ -38,6 +38,7 @@ from scipy.optimize import minimize_scalar
 
 from .. import _validate as V
 from . import angles as AG
+from ._engine_common import CheckpointMixin, checkpoint_getter
 from . import kernels as K
 from . import rk as R
 from .chain import ChainState, initial_state
@@ -71,7 +72,7 @@ def resolve_method(method: str) -> str:
     return FAST if method == "fast" else method
 
 
-class _Engine:
+class _Engine(CheckpointMixin):
     """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
@@ -380,19 +381,15 @@ class _Engine:
     def failure_message(self, code: int, node: int = -1) -> str:
         return _failure_message(code, self, node)
 
-    # -- checkpoints
+    # -- checkpoints (the shared part: _engine_common.CheckpointMixin)
     def checkpoint_vars(self) -> dict:
         """The checkpoint variables (schema.CHECKPOINT_VARS_DOP853), to add to the run Dataset so far."""
         from .. import schema
 
-        def pad(vals):
-            return np.asarray(list(vals) + [np.nan], dtype=float)
-
-        nd, ld = schema.NODE_DIM, schema.LINK_DIM
+        nd = schema.NODE_DIM
         row, slot, ang = "checkpoint_row", "checkpoint_slot", "checkpoint_angle"
-        snaps = self.snapshots
         peak_t, peak_Z = (np.nan, np.full_like(self.Z, np.nan)) if self.peak_state is None else self.peak_state
-        out = {
+        return self._checkpoint_vars({
             "checkpoint_Y0": ((slot, ang), self.Y0.copy()),
             "checkpoint_Y1": ((slot, ang), self.Y1.copy()),
             "checkpoint_stages": ((slot, "checkpoint_stage", ang), self.KK.copy()),
@@ -403,59 +400,22 @@ class _Engine:
             "checkpoint_Z": ((row, nd), self.Z.copy()),
             "checkpoint_peak_t": ((), np.float64(peak_t)),
             "checkpoint_peak_state": ((row, nd), np.array(peak_Z, dtype=float)),
-            "checkpoint_ctl": (("checkpoint_ctl",), self.ctl.copy()),
-            "checkpoint_pk": (("checkpoint_peak", "checkpoint_peak_col"), self.pk.copy()),
-            "checkpoint_meas": (("checkpoint_meas",), self.meas.copy()),
-            "checkpoint_meas0": (("checkpoint_meas",), self.meas0.copy()),
-            "checkpoint_rinv0": ((ld,), self.rinv0.copy()),
-            "checkpoint_snapshot_state": (("checkpoint_snapshot", row, nd), np.stack([z for _, _, z in snaps])),
-            "checkpoint_snapshot_t": (("checkpoint_snapshot",), np.array([t for t, _, _ in snaps], dtype=float)),
-            "checkpoint_requested": (("checkpoint_pending",), pad(self.requested)),
-            "checkpoint_after_fractions": (("checkpoint_pending_after",), pad(self.after_fracs)),
-        }
-        out = {k: (dims, v, dict(schema.CHECKPOINT_VARS_DOP853[k])) for k, (dims, v) in out.items()}
-        out[schema.CHECKPOINT_KIND_VAR] = (("checkpoint_snapshot",), np.array([k for _, k, _ in snaps], dtype=str),
-                                           {"long_name": "kinds of the snapshots so far"})
-        return out
+        }, schema.CHECKPOINT_VARS_DOP853)
 
     def restore(self, ds) -> None:
         """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
-        from .. import schema
-        from .dataset import records_from_dataset
-
-        def get(name, shape):
-            a = np.array(ds[name].values, dtype=float)
-            if shape is not None and a.shape != shape:
-                raise V.SnappingInputError(f"checkpoint variable {name!r} has shape {a.shape}, expected {shape}")
-            return a
-
-        N = self.N
+        get = checkpoint_getter(ds)
         for name, arr in (("checkpoint_Y0", self.Y0), ("checkpoint_Y1", self.Y1), ("checkpoint_stages", self.KK),
                           ("checkpoint_dense", self.F), ("checkpoint_step_t", self.TS),
                           ("checkpoint_step_h", self.HS), ("checkpoint_dense_ok", self.DOK),
                           ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
                           ("checkpoint_meas0", self.meas0)):
             arr[...] = get(name, arr.shape)
-        ctl = get("checkpoint_ctl", None)
-        if ctl.shape != (R.NQ,):
-            raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {R.NQ}")
-        self.ctl[...] = ctl
-        self.rinv0 = get("checkpoint_rinv0", (N,))
-        self.link_error_initial = float(ds.attrs["checkpoint_link_error_initial"])
+        self._restore_ctl(get, R.NQ)
+        self._restore_scales(ds, get)
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
-        st = get("checkpoint_snapshot_state", None)
-        ts = get("checkpoint_snapshot_t", None)
-        kinds = [str(k) for k in np.asarray(ds[schema.CHECKPOINT_KIND_VAR].values)]
-        if st.ndim != 3 or st.shape[1:] != (K.NROWS, N + 1) or not (len(ts) == len(kinds) == st.shape[0]):
-            raise V.SnappingInputError("checkpoint snapshots are inconsistent")
-        self.snapshots = [(float(t), k, z.copy()) for t, k, z in zip(ts, kinds, st)]
-        self.requested = [float(v) for v in get("checkpoint_requested", None) if np.isfinite(v)]
-        self.after_fracs = [float(v) for v in get("checkpoint_after_fractions", None) if np.isfinite(v)]
-        recs = records_from_dataset(ds)
-        self.chunks = [recs] if len(recs) else []
-        self.ctl[R.Q_NREC] = 0
-
+        self._restore_history(ds, get, R.Q_NREC)
 
 def _failure_message(code: int, eng: _Engine, node: int = -1) -> str:
     t = eng.t

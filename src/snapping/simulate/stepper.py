@@ -21,8 +21,9 @@ import xarray as xr
 
 from .. import _validate as V
 from . import kernels as K
+from ._engine_common import CheckpointMixin, checkpoint_getter
 from .chain import ChainState, initial_state
-from .dataset import build_dataset, check_writable, inputs_from_attrs, records_from_dataset, save
+from .dataset import build_dataset, check_writable, inputs_from_attrs, open_netcdf, save
 
 __all__ = ["run", "rerun", "resume", "is_resumable", "memory_need", "Run", "SimulationError", "NonFiniteError",
            "StepSizeError", "DriftError", "EnergyDriftError", "RejectionError", "RunInterrupted", "METHODS",
@@ -289,7 +290,7 @@ def _warm_up() -> None:
     _compiled = True
 
 
-class _Engine:
+class _Engine(CheckpointMixin):
     """Buffers and control state of one run (the compiled loop's arguments)."""
 
     def __init__(self, state: ChainState, *, tol, dt0, fixed, t_end, stop_fraction, thin, max_link_error,
@@ -404,68 +405,28 @@ class _Engine:
         snaps.append((self.t, "final", self.current().copy()))
         return snaps
 
-    # -- checkpoints
+    # -- checkpoints (the shared part: _engine_common.CheckpointMixin)
     def checkpoint_vars(self) -> dict:
         """The checkpoint variables (schema.CHECKPOINT_VARS), to add to the run Dataset so far."""
         from .. import schema
 
-        def pad(vals):
-            return np.asarray(list(vals) + [np.nan], dtype=float)
-
-        nd, ld = schema.NODE_DIM, schema.LINK_DIM
-        row = "checkpoint_row"
-        snaps = self.snapshots
-        out = {
+        row, nd = "checkpoint_row", schema.NODE_DIM
+        return self._checkpoint_vars({
             "checkpoint_S": (("checkpoint_buffer", row, nd), self.S.copy()),
             "checkpoint_peak_state": ((row, nd), self.PS.copy()),
-            "checkpoint_ctl": (("checkpoint_ctl",), self.ctl.copy()),
-            "checkpoint_pk": (("checkpoint_peak", "checkpoint_peak_col"), self.pk.copy()),
-            "checkpoint_meas": (("checkpoint_meas",), self.meas.copy()),
-            "checkpoint_meas0": (("checkpoint_meas",), self.meas0.copy()),
-            "checkpoint_rinv0": ((ld,), self.rinv0.copy()),
-            "checkpoint_snapshot_state": (("checkpoint_snapshot", row, nd), np.stack([z for _, _, z in snaps])),
-            "checkpoint_snapshot_t": (("checkpoint_snapshot",), np.array([t for t, _, _ in snaps], dtype=float)),
-            "checkpoint_requested": (("checkpoint_pending",), pad(self.requested)),
-            "checkpoint_after_fractions": (("checkpoint_pending_after",), pad(self.after_fracs)),
-        }
-        out = {k: (dims, v, dict(schema.CHECKPOINT_VARS[k])) for k, (dims, v) in out.items()}
-        out[schema.CHECKPOINT_KIND_VAR] = (("checkpoint_snapshot",), np.array([k for _, k, _ in snaps], dtype=str),
-                                           {"long_name": "kinds of the snapshots so far"})
-        return out
+        }, schema.CHECKPOINT_VARS)
 
     def restore(self, ds) -> None:
         """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
-        from .. import schema
-
-        def get(name, shape):
-            a = np.array(ds[name].values, dtype=float)
-            if shape is not None and a.shape != shape:
-                raise V.SnappingInputError(f"checkpoint variable {name!r} has shape {a.shape}, expected {shape}")
-            return a
-
-        N = self.N
+        get = checkpoint_getter(ds)
         self.S[...] = get("checkpoint_S", self.S.shape)
         self.PS[...] = get("checkpoint_peak_state", self.PS.shape)
-        ctl = get("checkpoint_ctl", None)
-        if ctl.shape != (K.NCTL,):
-            raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {K.NCTL}")
-        self.ctl[...] = ctl
+        self._restore_ctl(get, K.NCTL)
         self.pk[...] = get("checkpoint_pk", self.pk.shape)
         self.meas[...] = get("checkpoint_meas", self.meas.shape)
         self.meas0[...] = get("checkpoint_meas0", self.meas0.shape)
-        self.rinv0 = get("checkpoint_rinv0", (N,))
-        self.link_error_initial = float(ds.attrs["checkpoint_link_error_initial"])
-        st = get("checkpoint_snapshot_state", None)
-        ts = get("checkpoint_snapshot_t", None)
-        kinds = [str(k) for k in np.asarray(ds[schema.CHECKPOINT_KIND_VAR].values)]
-        if st.ndim != 3 or st.shape[1:] != (K.NROWS, N + 1) or not (len(ts) == len(kinds) == st.shape[0]):
-            raise V.SnappingInputError("checkpoint snapshots are inconsistent")
-        self.snapshots = [(float(t), k, z.copy()) for t, k, z in zip(ts, kinds, st)]
-        self.requested = [float(v) for v in get("checkpoint_requested", None) if np.isfinite(v)]
-        self.after_fracs = [float(v) for v in get("checkpoint_after_fractions", None) if np.isfinite(v)]
-        recs = records_from_dataset(ds)
-        self.chunks = [recs] if len(recs) else []
-        self.ctl[K.C_NREC] = 0
+        self._restore_scales(ds, get)
+        self._restore_history(ds, get, K.C_NREC)
 
     def _set_targets(self) -> None:
         c = self.ctl
@@ -1024,14 +985,7 @@ def _open_checkpoint(path) -> xr.Dataset:
     p = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
     if not p:
         raise V.SnappingInputError(f"path={path!r} is not a file path")
-    if not os.path.isfile(p):
-        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
-    try:
-        with xr.open_dataset(p, engine="netcdf4") as f:
-            ds = f.load()
-    except Exception as exc:  # netCDF4/HDF5 raise OSError, ValueError, KeyError, ...
-        msg = (str(exc).strip().splitlines() or [""])[0][:160]
-        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF run file ({type(exc).__name__}: {msg})") from None
+    ds = open_netcdf(p)
     status = str(ds.attrs.get("status", ""))
     if status not in schema.RESUMABLE_STATUS:
         if status in ("completed", "failed"):
