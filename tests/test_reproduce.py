@@ -1,5 +1,6 @@
 """One command reproduces the paper: a tiny plan runs end to end and its report says true things."""
 
+import math
 import re
 
 import pytest
@@ -11,9 +12,14 @@ TINY = Plan(name="tiny", shapes_chi=(0.5, 0.25), shapes_N=40, speed_chi=(0.25,),
             scaling_chi=(0.25, 0.4), scaling_N=40, tol_chi=0.25, tol_N=40, tols=(1e-7, 1e-8))
 
 
-def test_tiny_reproduction_writes_report_and_figures(tmp_path):
-    report = reproduce(tmp_path, TINY, workers=2, progress=False, log=lambda *a: None)
-    text = report.read_text()
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    out = tmp_path_factory.mktemp("tiny")
+    return out, reproduce(out, TINY, workers=2, progress=False, log=lambda *a: None).read_text()
+
+
+def test_tiny_reproduction_writes_report_and_figures(tiny):
+    tmp_path, text = tiny
     # t* row: the exact value, agreeing with the paper's 1.19814
     assert f"| {ideal.t_star_str(15)} | ≈ 1.19814 | agrees |" in text
     assert "typo in the paper (sign)" in text
@@ -35,3 +41,69 @@ def test_plans_and_bad_mode(tmp_path):
     assert expected_seconds(PLANS["full"]) > 3 * expected_seconds(PLANS["quick"])
     with pytest.raises(SnappingInputError, match="mode='fast'"):
         reproduce(tmp_path, "fast")
+
+
+def _cells(text: str, claim_start: str) -> list[str]:
+    row = next(l for l in text.splitlines() if l.startswith(f"| {claim_start}"))
+    return [c.strip() for c in row.strip("|").split(" | ")]
+
+
+def test_report_verdicts_follow_from_the_numbers_in_their_rows(tiny):
+    """The verdict of each computed claim is recomputed here from the numbers printed in its row."""
+    from snapping import reproduce as R
+
+    text = tiny[1]
+    num = r"([-+0-9.e]+)"
+    # delta rows: the ratios printed, against the paper's bands
+    for scale in R.DELTA_BANDS:
+        claim, measured, _, verdict = _cells(text, f"predicted/computed peaks with {scale} ")
+        ratios = [dict(v=float(v), a=float(a), sigma=float(s))
+                  for v, a, s in re.findall(rf"v ×{num}, a ×{num}, σ ×{num}", measured)]
+        assert len(ratios) == len(TINY.scaling_chi)
+        assert verdict == R.delta_verdict(scale, ratios)
+    # the three snapping times
+    _, measured, _, verdict = _cells(text, "t*_chi from max speed")
+    spreads = [float(x) for x in re.findall(rf"spread {num}", measured)]
+    assert len(spreads) == len(TINY.scaling_chi)
+    assert verdict.startswith("agrees" if max(spreads) < R.FIFTH_DIGIT else "differs")
+    # t*_chi row: monotone towards the ideal t*
+    _, measured, _, verdict = _cells(text, "t*_chi approaches")
+    pairs = [(float(c), float(t)) for c, t in re.findall(rf"chi={num}: {num}", measured)]
+    assert verdict == R.monotone_verdict([c for c, _ in pairs], [t for _, t in pairs], ideal.t_star())
+    # curvature amplification against the tension's
+    _, measured, _, verdict = _cells(text, "amplification of the maximum curvature")
+    amps = re.findall(rf"kappa ×{num} \(tension ×{num}\)", measured)
+    k, s = [float(a) for a, _ in amps], [float(b) for _, b in amps]
+    weak = all(math.log(x) <= R.WEAK_AMPLIFICATION * math.log(y) for x, y in zip(k, s))
+    assert verdict.startswith("agrees" if weak else "differs")
+    # tolerance row: the coarsest-vs-finest changes against the paper's digits; N = 40 is flagged
+    _, measured, _, verdict = _cells(text, "maxima insensitive to tol")
+    first = measured.split(";")[0]
+    rel = {q: float(x) for q, x in re.findall(rf"(v_peak|a_peak|sigma_peak) {num}", first)}
+    assert verdict.startswith("agrees" if all(rel[q] < b for q, b in R.TOL_BOUNDS.items()) else "differs")
+    assert "N = 5000" in verdict
+    # the boundary layer is only judged at the paper's N
+    assert _cells(text, "links in the boundary layer")[3].startswith("lower N")
+
+
+def test_verdict_rules_on_the_papers_own_numbers():
+    from snapping import reproduce as R
+
+    # Fig. 4 as the paper describes it (chi = 0.1, N = 5000): delta_kappa_m v, a excellent, sigma x2
+    assert R.delta_verdict("delta_kappa_m", [dict(v=0.98, a=0.94, sigma=1.95)]).startswith("agrees")
+    assert R.delta_verdict("delta_kappa_m", [dict(v=0.98, a=0.94, sigma=1.0)]).startswith("differs")
+    assert R.delta_verdict("delta_kappa0", [dict(v=0.33, a=0.01, sigma=0.21)]).startswith("agrees")
+    assert R.delta_verdict("delta_kappa0", [dict(v=0.33, a=0.5, sigma=0.21)]).startswith("differs")
+    # ninth digit for v, sixth for a and sigma
+    ok = dict(v_peak=3e-9, a_peak=4e-6, sigma_peak=2e-6)
+    assert R.tolerance_verdict(ok, 5000).startswith("agrees") and "N = 5000" not in R.tolerance_verdict(ok, 5000)
+    bad = R.tolerance_verdict(dict(ok, v_peak=1.5e-6), 5000)
+    assert bad.startswith("differs (v_peak 1.5e-06)")
+    assert R.boundary_layer_verdict(12.0, 5000).startswith("agrees")
+    assert R.boundary_layer_verdict(20.0, 5000).startswith("differs")
+    assert R.monotone_verdict([0.1, 0.25, 0.4], [1.1936, 1.1748, 1.1482], 1.19814).startswith("agrees")
+    assert R.monotone_verdict([0.1, 0.25, 0.4], [1.1748, 1.1936, 1.1482], 1.19814) == "differs"
+    # chi = 0.25, N = 5000: kappa x5.7 against tension x51 (the -1/6 law against -2/3 gives 1/4 of the e-folds)
+    assert R.amplification_verdict([5.7], [51.0]).startswith("agrees")
+    assert R.amplification_verdict([51.0 ** 0.25], [51.0]).startswith("agrees")
+    assert R.amplification_verdict([51.0], [51.0]).startswith("differs")  # the inferred -2/3 law

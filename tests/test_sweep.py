@@ -28,6 +28,7 @@ def test_sweep_runs_combines_and_skips_finished(tmp_path):
     n = int(direct.sizes["step"])
     np.testing.assert_array_equal(comb["v_max"].sel(chi=0.7, N=12).values[:n], direct["v_max"].values)
     assert comb["v_max"].attrs["units"] == "1"
+    assert comb["wall_time"].attrs["units"] == "s" and comb["v_peak"].attrs["units"] == "1"
     # a rerun does nothing to finished runs; a removed run is redone
     mtimes = {p: os.stat(p).st_mtime_ns for p in paths}
     os.remove(paths[0])

@@ -44,7 +44,7 @@ class Plan:
     scaling_chi: tuple = (0.1, 0.15, 0.2, 0.25, 0.3, 0.4)
     scaling_N: int = 5000
     tol_chi: float = 0.25
-    tol_N: int = 2000
+    tol_N: int = 5000
     tols: tuple = (1e-7, 1e-8, 1e-9)
     tol: float = 1e-8
 
@@ -141,6 +141,84 @@ def _boundary_layer_links(ds) -> int:
     i = int(np.argmin(np.abs(ts - float(ds.attrs["t_snap_v"]))))
     sig = ds["tension"].isel(snapshot=i).values  # link 1 is at the free end
     return int(np.argmax(sig >= 0.9 * np.nanmax(sig))) + 1
+
+
+# ------------------------------------------------------------------ verdicts
+# Each paper claim becomes a test on numbers; the bands below are the paper's words made
+# explicit, and the verdict cell names the band so that a reader can check it.
+
+#: The paper's claims on the predicted/computed peak ratios (Fig. 4(b)-(d)), as bands per quantity.
+DELTA_BANDS: dict[str, dict[str, tuple[float, float]]] = {
+    # "just barely provide order-of-magnitude estimates for velocity and tension, but
+    #  underestimate the acceleration by nearly two orders of magnitude"
+    "delta_kappa0": {"v": (0.1, 10.0), "sigma": (0.1, 10.0), "a": (0.0, 0.1)},
+    # "velocity and acceleration are in excellent agreement; tension over by about a factor of two"
+    "delta_kappa_m": {"v": (0.75, 1.33), "a": (0.75, 1.33), "sigma": (1.5, 2.5)},
+    # "less accurate, but still within the order of magnitude"
+    "delta_c": {"v": (0.1, 10.0), "a": (0.1, 10.0), "sigma": (0.1, 10.0)},
+}
+
+#: "about 10-15 links are present in the boundary layer" (chi = 0.1, N = 5000), read as 9-16.
+BOUNDARY_LAYER_BAND = (9.0, 16.0)
+
+#: "the maxima change at the ninth significant digit for velocity and the sixth for
+#: acceleration and tension" (tol 1e-7 -> 1e-9, N = 5000): relative changes below these.
+TOL_BOUNDS = {"v_peak": 1e-8, "a_peak": 1e-5, "sigma_peak": 1e-5}
+
+#: "t*_chi from the three maxima differ only at the fifth significant digit": t*_chi ~ 1.1,
+#: so their spread (largest minus smallest) is below one unit of that digit.
+FIFTH_DIGIT = 1e-4
+
+#: "the amplification of maximum curvature is weak": the curvature gains at most this
+#: fraction of the e-folds the maximum tension gains in the same run,
+#: ln(kappa amplification) / ln(tension amplification). The paper's observed -1/6
+#: against the tension's -2/3 gives 1/4; the inferred kappa ~ tau^(-2/3) would give 1.
+WEAK_AMPLIFICATION = 0.5
+
+
+def _band(x: float, lo: float, hi: float) -> bool:
+    return lo <= x <= hi
+
+
+def delta_verdict(scale: str, ratios: list[dict[str, float]]) -> str:
+    """Verdict on the predicted/computed peak ratios of one scale over several runs."""
+    bands = DELTA_BANDS[scale]
+    ok = sum(all(_band(r[q], *bands[q]) for q in bands) for r in ratios)
+    spec = ", ".join(f"{q} in [{lo:g}, {hi:g}]" for q, (lo, hi) in bands.items())
+    return f"{'agrees' if ok == len(ratios) else 'differs'}: {ok} of {len(ratios)} runs have {spec}"
+
+
+def amplification_verdict(kappa_amp: list[float], sigma_amp: list[float]) -> str:
+    """Curvature amplification weak: ln(kappa_amp) / ln(sigma_amp) <= WEAK_AMPLIFICATION, run by run."""
+    ok = sum(math.log(k) <= WEAK_AMPLIFICATION * math.log(s) for k, s in zip(kappa_amp, sigma_amp))
+    return (f"{'agrees' if ok == len(kappa_amp) else 'differs'}: in {ok} of {len(kappa_amp)} runs the curvature "
+            f"gains at most {WEAK_AMPLIFICATION:g} of the tension's e-folds (exponents -1/6 vs -2/3 give 1/4)")
+
+
+def boundary_layer_verdict(links: float, N: int) -> str:
+    lo, hi = BOUNDARY_LAYER_BAND
+    if N != 5000:
+        return "lower N than the paper's 5000: compare with --full"
+    return f"{'agrees' if _band(links, lo, hi) else 'differs'} (band {lo:g}-{hi:g} for 'about 10-15')"
+
+
+def tolerance_verdict(rel: dict[str, float], N: int) -> str:
+    """Relative changes of the peaks from the coarsest to the finest tol against TOL_BOUNDS."""
+    bad = [q for q, b in TOL_BOUNDS.items() if not rel[q] < b]
+    bounds = ", ".join(f"{q} < {b:g}" for q, b in TOL_BOUNDS.items())
+    v = "agrees" if not bad else "differs (" + ", ".join(f"{q} {rel[q]:.1e}" for q in bad) + ")"
+    v += f" against {bounds}"
+    if N != 5000:
+        v += f"; at N = {N}, the paper's statement is for N = 5000"
+    return v
+
+
+def monotone_verdict(chis: list[float], t_stars: list[float], t_ideal: float) -> str:
+    """t*_chi below t*, increasing as chi decreases, the smallest chi closest to t*."""
+    order = np.argsort(chis)
+    ts = np.asarray(t_stars, dtype=float)[order]
+    ok = bool(np.all(ts < t_ideal) and np.all(np.diff(ts) < 0))
+    return "agrees (below t* and increasing monotonically towards it as chi decreases)" if ok else "differs"
 
 
 def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progress: bool = True, log=print) -> Path:
@@ -264,36 +342,42 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     exponent_row("sigma_max", "-2/3", "-2/3")
     exponent_row("a_max (intermediate)", "about -5/6 at intermediate times", "-5/6")
     exponent_row("kappa_max", "about -1/6 late (not the inferred -2/3)", "-1/6")
-    spreads = [(res.chi, res.snap.spread / res.snap.t_star) for res in results]
+    spreads = [(res.chi, res.snap.spread) for res in results]
+    n_ok = sum(sp < FIFTH_DIGIT for _, sp in spreads)
     rows.append(("t*_chi from max speed, acceleration and tension agree",
-                 "; ".join(f"chi={c:g}: relative spread {s:.1e}" for c, s in spreads),
+                 "; ".join(f"chi={c:g}: spread {sp:.1e}" for c, sp in spreads),
                  "differ only at the 5th significant digit",
-                 f"agrees in {sum(s < 5e-5 for _, s in spreads)} of {len(spreads)}"))
-    t_small = min(results, key=lambda r: r.chi)
+                 f"{'agrees' if n_ok == len(spreads) else 'differs'}: spread below {FIFTH_DIGIT:g} in {n_ok} of {len(spreads)}"))
+    by_chi = sorted(results, key=lambda r: r.chi)
     rows.append(("t*_chi approaches the ideal t* as chi -> 0",
-                 "; ".join(f"chi={r.chi:g}: {r.snap.t_star:.5f}" for r in sorted(results, key=lambda r: r.chi)),
+                 "; ".join(f"chi={r.chi:g}: {r.snap.t_star:.5f}" for r in by_chi),
                  f"ideal t* = {t_star:.5f}",
-                 "agrees" if abs(t_small.snap.t_star - t_star) < abs(results[-1].snap.t_star - t_star) else "differs"))
-    amps = [(r.chi, r.kappa_amplification) for r in results]
+                 monotone_verdict([r.chi for r in by_chi], [r.snap.t_star for r in by_chi], t_star)))
+    sig_amp = [float(ds.attrs["sigma_peak"]) / float(ds["sigma_max"].values[0]) for ds in sc_runs]
     rows.append(("amplification of the maximum curvature is weak",
-                 "; ".join(f"chi={c:g}: ×{a:.2f}" for c, a in amps), "weak (an approximate doubling early)", "see Fig. 3(d)"))
+                 "; ".join(f"chi={r.chi:g}: kappa ×{r.kappa_amplification:.2f} (tension ×{s:.0f})"
+                           for r, s in zip(results, sig_amp)),
+                 "weak (an approximate doubling early)",
+                 amplification_verdict([r.kappa_amplification for r in results], sig_amp)))
     for scale, paper in (("delta_kappa0", "v, sigma barely within an order of magnitude; a under by ~2 orders"),
                          ("delta_kappa_m", "v and a in excellent agreement; sigma over by about ×2"),
                          ("delta_c", "less accurate, but within an order of magnitude")):
-        cells = []
+        cells, ratios = [], []
         for res in results:
             if res.delta is None:
                 continue
             rr = res.delta.ratios()[scale]
+            ratios.append(rr)
             cells.append(f"chi={res.chi:g}: v ×{rr['v']:.2f}, a ×{rr['a']:.2f}, σ ×{rr['sigma']:.2f}")
-        rows.append((f"predicted/computed peaks with {scale} (eq. estimates)", "; ".join(cells), paper, "see Fig. 4"))
+        rows.append((f"predicted/computed peaks with {scale} (eq. estimates)", "; ".join(cells), paper,
+                     delta_verdict(scale, ratios) if ratios else "no curvature data"))
 
     chi_bl = min(plan.scaling_chi)
     res_bl = min(results, key=lambda r: r.chi)
     dkm = res_bl.delta.deltas["delta_kappa_m"] if res_bl.delta is not None else math.nan
     n90 = _boundary_layer_links(_load(out, chi_bl, plan.scaling_N, plan.tol))
     links = dkm * plan.scaling_N
-    verdict = ("agrees" if 8 <= links <= 20 else "differs") if plan.scaling_N == 5000 else "lower N: compare with --full"
+    verdict = boundary_layer_verdict(links, plan.scaling_N)
     rows.append((f"links in the boundary layer at chi = {chi_bl:g}, N = {plan.scaling_N}",
                  f"{links:.1f} links in delta_kappa_m (the whirling length; {n90} links from the free end to 90% "
                  "of the peak tension at the snap)", "10-15 at chi = 0.1, N = 5000", verdict))
@@ -310,14 +394,15 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                  "agrees" if worst["energy_drift"] < 8e-7 else "differs"))
     tol_runs = {t: _load(out, plan.tol_chi, plan.tol_N, t) for t in plan.tols}
     ref = tol_runs[min(plan.tols)]
-    cells, worst = [], 0.0
+    cells = []
     for t in sorted(plan.tols, reverse=True)[:-1]:
-        rel = {q: abs(float(tol_runs[t].attrs[q]) / float(ref.attrs[q]) - 1.0) for q in ("v_peak", "a_peak", "sigma_peak")}
-        worst = max(worst, *rel.values()) if t == max(plan.tols) else worst
+        rel = {q: abs(float(tol_runs[t].attrs[q]) / float(ref.attrs[q]) - 1.0) for q in TOL_BOUNDS}
+        if t == max(plan.tols):
+            rel_coarse = rel
         cells.append(f"tol {t:g} vs {min(plan.tols):g}: " + ", ".join(f"{q} {r:.1e}" for q, r in rel.items()))
     rows.append((f"maxima insensitive to tol {max(plan.tols):g} -> {min(plan.tols):g} (chi = {plan.tol_chi:g}, N = {plan.tol_N})",
                  "; ".join(cells), "N = 5000: v changes at the 9th digit, a and sigma at the 6th",
-                 "agrees" if worst < 1e-5 else "differs (relative change above 1e-5 from the coarsest tol)"))
+                 tolerance_verdict(rel_coarse, plan.tol_N)))
 
     # ---------------------------------------------------------------- REPORT.md
     timings["total"] = time.perf_counter() - t0

@@ -44,7 +44,9 @@ def _v(long_name: str, units: str = "1") -> dict[str, str]:
 #: Coordinates.
 COORDS: dict[str, dict[str, str]] = {
     "t": _v("time"),
-    "t_snapshot": _v("time of the profile snapshot"),
+    "t_snapshot": _v("time of the profile snapshot (euler-richardson: the first accepted step at or after a "
+                     "requested time, so later by less than one step; dop853: the requested time exactly, "
+                     "from the dense output)"),
     "s_node": _v("arclength of the node from the pinned end"),
     "s_link": _v("arclength of the link midpoint from the pinned end"),
     "snapshot_kind": _v("why the snapshot was taken: initial, requested, speed_level, peak, after_peak or final"),
@@ -139,6 +141,16 @@ RESULT_ATTRS: dict[str, str] = {
     "wall_time": "wall-clock time of the run in seconds",
     "snapping_version": "version of the snapping package that wrote the file",
 }
+
+#: Units of the numeric result attributes where they are not nondimensional ("1"), for
+#: tools that turn them into variables (:func:`snapping.sweep.combine`).
+RESULT_UNITS: dict[str, str] = {"wall_time": "s"}
+
+
+def result_units(name: str) -> str:
+    """Units of the result attribute ``name``: ``"s"`` for wall-clock times, else ``"1"``."""
+    return RESULT_UNITS.get(name, "1")
+
 
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS}
 

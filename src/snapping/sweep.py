@@ -283,7 +283,7 @@ def combine(paths) -> "xr.Dataset":
                 raise V.SnappingInputError(f"{str(path)!r} is not a run file: attribute {key!r} is missing")
         chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
         summary = {
-            k: ((), float(ds.attrs[k]), {"long_name": schema.RESULT_ATTRS[k], "units": "1"})
+            k: ((), float(ds.attrs[k]), {"long_name": schema.RESULT_ATTRS[k], "units": schema.result_units(k)})
             for k in _SUMMARY_ATTRS
             if k in ds.attrs and np.isscalar(ds.attrs[k]) and not isinstance(ds.attrs[k], str)
         }

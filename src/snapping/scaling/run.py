@@ -584,9 +584,31 @@ def ideal_window_exponent(quantity: str, tau_lo: float, tau_hi: float) -> float:
     return float(np.polyfit(np.log(tau[ok]), np.log(y[ok]), 1)[0])
 
 
+#: Spacing of the paper's exponent ladder (-1/3, -2/3, -4/3): the separation from the
+#: nearest other candidate for rows that name no alternative exponent.
+EXPONENT_SPACING = 1.0 / 3.0
+
+
+def inconclusive_err(spec: RowSpec) -> float:
+    """Largest exponent uncertainty that still tells the row's reference from its nearest
+    other candidate (the alternative exponent, else EXPONENT_SPACING) at 4 uncertainties,
+    so that an "agrees" (within 2) excludes the other candidate. kappa_max: |-1/6 + 2/3| / 4
+    = 0.125; v_max: 1/12."""
+    sep = abs(spec.ref - spec.alt) if spec.alt is not None else EXPONENT_SPACING
+    return sep / 4.0
+
+
 def _verdict(fit: PowerLawFit, spec: RowSpec) -> tuple[float, str]:
+    """``agrees`` (within 2 uncertainties of the reference), ``differs`` or
+    ``inconclusive`` (uncertainty above :func:`inconclusive_err`), with remarks: closer
+    to the alternative exponent, a window that is not flat, a window chosen inside a
+    slope range (which leans the fit towards that range)."""
     z = (fit.beta - spec.ref) / fit.beta_err if fit.beta_err > 0 else math.inf
-    v = "agrees" if abs(z) <= 2.0 else "differs"
+    emax = inconclusive_err(spec)
+    if not fit.beta_err <= emax:
+        v = f"inconclusive (uncertainty {fit.beta_err:.2g} > {emax:.3g})"
+    else:
+        v = "agrees" if abs(z) <= 2.0 else "differs"
     extra = []
     if spec.alt is not None and fit.beta_err > 0:
         za = (fit.beta - spec.alt) / fit.beta_err
@@ -594,6 +616,9 @@ def _verdict(fit: PowerLawFit, spec: RowSpec) -> tuple[float, str]:
             extra.append(f"closer to {spec.alt:+.3f} ({spec.alt_label})")
     if not fit.flat:
         extra.append("window not flat")
+    sr = spec.fit_kw.get("slope_range")
+    if sr is not None:
+        extra.append(f"window constrained to local slopes in [{sr[0]:g}, {sr[1]:g}]")
     return float(z), v + (f" ({'; '.join(extra)})" if extra else "")
 
 
@@ -614,7 +639,8 @@ def fit_run(
     time from the three peaks and its uncertainty propagated, and again with
     t* fitted jointly; each gets a verdict against the paper's exponent
     (eq. asymptoticscalings, -5/6, -1/6): "agrees" when within two of its
-    uncertainties.
+    uncertainties, "inconclusive" when that uncertainty is too large to exclude
+    the nearest other candidate exponent (:func:`inconclusive_err`).
 
     Parameters
     ----------
