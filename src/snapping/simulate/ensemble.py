@@ -465,18 +465,22 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
         ctls[act[lane], R.Q_NCALL] = 0.0
         tolL[lane] = ctls[act[lane], R.Q_TOL]
     first = True
+    slot = np.zeros(L, dtype=np.int64)  # per lane: the member's current slot, then the slot of its attempt
+    acc = np.zeros(L, dtype=np.bool_)
     while True:
         for lane in range(L):
             m = act[lane]
-            sl = int(ctls[m, R.Q_SLOT])
+            slot[lane] = int(ctls[m, R.Q_SLOT])
             h, last = R.step_size(ctls[m])
             hL[lane] = h
             lastL[lane] = 1.0 if last else 0.0
-            Y1m = Y1s[m, sl]
-            K12 = KKs[m, sl, R.NS]
-            for i in range(n):
-                yE0[i, lane] = Y1m[i]
-                KE[0, i, lane] = K12[i]
+        # copies between the members' rows and the lane buffers run with the lane index
+        # innermost, so that each cache line of a lane buffer is touched once per copy
+        for i in range(n):
+            for lane in range(L):
+                m = act[lane]
+                yE0[i, lane] = Y1s[m, slot[lane], i]
+                KE[0, i, lane] = KKs[m, slot[lane], R.NS, i]
         if first:  # the padding lanes: a copy of lane 0 (finite; its results are not used)
             first = False
             for lane in range(L, W):
@@ -496,28 +500,38 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
         _rhs_tiles(N, yE1, KE[R.NS], cE, sE, SE, cpE, dpE, sigE)
         # ---- error of each lane (as rk.rk_step)
         _err_tiles(n, hL, yE0, yE1, KE, tolL, errL)
+        # ---- accepted steps go into the member's other slot
+        n_acc = 0
+        for lane in range(L):
+            err = errL[lane]
+            slot[lane] = 1 - slot[lane]
+            acc[lane] = err - err == 0.0 and err <= 1.0
+            n_acc += acc[lane]
+        if n_acc:
+            for i in range(n):
+                for lane in range(L):
+                    if acc[lane]:
+                        m = act[lane]
+                        Y0s[m, slot[lane], i] = yE0[i, lane]
+                        Y1s[m, slot[lane], i] = yE1[i, lane]
+            for j in range(R.NS + 1):
+                for i in range(n):
+                    for lane in range(L):
+                        if acc[lane]:
+                            KKs[act[lane], slot[lane], j, i] = KE[j, i, lane]
+            for j in range(N):
+                for lane in range(L):
+                    if acc[lane]:
+                        m = act[lane]
+                        cM[m, j] = cE[j, lane]
+                        sM[m, j] = sE[j, lane]
+                        sigM[m, j] = sigE[j, lane]
         # ---- each member's own bookkeeping
         stop = False
         for lane in range(L):
             m = act[lane]
-            err = errL[lane]
-            ns = 1 - int(ctls[m, R.Q_SLOT])
-            if err - err == 0.0 and err <= 1.0:  # accepted: the step goes into the member's slot
-                Y0m = Y0s[m, ns]
-                Y1m = Y1s[m, ns]
-                for i in range(n):
-                    Y0m[i] = yE0[i, lane]
-                    Y1m[i] = yE1[i, lane]
-                for j in range(R.NS + 1):
-                    Kj = KKs[m, ns, j]
-                    for i in range(n):
-                        Kj[i] = KE[j, i, lane]
-                for j in range(N):
-                    cM[m, j] = cE[j, lane]
-                    sM[m, j] = sE[j, lane]
-                    sigM[m, j] = sigE[j, lane]
-            code = R.after_attempt(N, err, hL[lane], lastL[lane] != 0.0, ns, Y1s[m], TSs[m], HSs[m], DOKs[m],
-                                   cM[m], sM[m], sigM[m], Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m])
+            code = R.after_attempt(N, errL[lane], hL[lane], lastL[lane] != 0.0, slot[lane], Y1s[m], TSs[m], HSs[m],
+                                   DOKs[m], cM[m], sM[m], sigM[m], Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m])
             if code >= 0:
                 codes[m] = code
                 stop = True
