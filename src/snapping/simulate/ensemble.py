@@ -592,8 +592,11 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
 
     Same physics, numerics, stop rules and Dataset as ``run(chi, N, method="dop853",
     ...)`` for each chi (the angle form of :mod:`snapping.simulate.angles`); the members
-    share only the arithmetic, so the cost per member is less than that of separate
-    runs (the tridiagonal recurrence of one chain is latency-bound; several interleave).
+    share only the arithmetic. The interleaved tension recurrence is cheaper per member
+    than one chain's (latency-bound), but the rest of a step is not, and members that
+    need fewer steps idle in their lanes: measured, an ensemble costs 1.0-1.4x as much
+    as separate single runs (``benchmarks/bench_step_costs.py``), so prefer single runs
+    for speed; use an ensemble to keep several chi in one process and one call.
 
     Parameters
     ----------
