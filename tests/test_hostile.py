@@ -316,6 +316,9 @@ def _cli_cases():
     add("sweep", "--chi", "0.3", "--N", "10", "--workers", "0", "-o", "{root}/sw")
     add("sweep", "--chi", "0.3", "--N", "10", "--tol", "-1", "-o", "{root}/sw")
     add("sweep", "--chi", "0.3", "--N", "10", "--method", "rk4", "-o", "{root}/sw")
+    add("sweep", "--chi", "0.3,0.4", "--N", "10", "--ensemble", "2", "-o", "{root}/sw")  # needs an angle method
+    for v in ("0", "-3", "two"):
+        add("sweep", "--chi", "0.3", "--N", "10", "--method", "fast", "--ensemble", v, "-o", "{root}/sw")
     for k in ("garbage", "proc", "under_file"):
         add("sweep", "--chi", "0.3", "--N", "10", "-o", f"{{{k}}}")
     for k in ("missing", "empty", "garbage", "truncated", "foreign", "almost", "table", "dir"):

@@ -109,3 +109,38 @@ def test_cli_sweep(tmp_path, capsys):
     assert (tmp_path / "sweep.nc").is_file()
     assert main(["sweep", "--chi", "0.5,0.5", "--N", "6", "-o", str(tmp_path)]) == 2
     assert "duplicate" in capsys.readouterr().err
+
+
+def test_sweep_in_ensembles_gives_the_single_runs_files(tmp_path):
+    """--ensemble K: several chi of one N in one kernel; each member file as its single run's."""
+    opts = {"method": "fast", "chords": "exact", "tol": 1e-8}
+    grid = S.Grid(chi=[0.3, 0.4, 0.5], N=[20, 30], options=opts)
+    paths = S.run_sweep(grid, tmp_path / "ens", workers=2, progress=False, ensemble=2)
+    assert all(S.is_complete_run(p) for p in paths)
+    for chi in grid.chi:
+        for N in grid.N:
+            ens = simulate.load_run(grid.path(tmp_path / "ens", chi, N)).attrs
+            single = simulate.run(chi, N, **opts).dataset.attrs
+            for q in ("v_peak", "a_peak", "sigma_peak", "t_snap_v"):
+                assert ens[q] == pytest.approx(single[q], rel=1e-8), (chi, N, q)
+            assert ens["link_drift"] < 1e-14
+    # a rerun redoes only the missing member, alone
+    os.remove(paths[1])
+    mtimes = {p: os.stat(p).st_mtime_ns for p in paths if p != paths[1]}
+    S.run_sweep(grid, tmp_path / "ens", workers=1, progress=False, ensemble=2)
+    assert S.is_complete_run(paths[1]) and all(os.stat(p).st_mtime_ns == m for p, m in mtimes.items())
+    # groups hold one N each, at most K members
+    todo = [({"chi": c, "N": n}, "") for c in (0.3, 0.4, 0.5) for n in (20, 30)]
+    assert [len(t) for t in S._groups(todo, 2)] == [2, 1, 2, 1]
+    assert all(len({p["N"] for p, _ in t}) == 1 for t in S._groups(todo, 2))
+
+
+def test_ensemble_sweep_bad_options(tmp_path):
+    grid = S.Grid(chi=[0.3, 0.4], N=[10], options={"tol": 1e-6})
+    with pytest.raises(SnappingInputError, match="ensemble=2 needs an angle-form method"):
+        S.run_sweep(grid, tmp_path, ensemble=2, progress=False)
+    grid = S.Grid(chi=[0.3, 0.4], N=[10], options={"method": "fast", "checkpoint_every": 10.0})
+    with pytest.raises(SnappingInputError, match=r"options \['checkpoint_every'\] are not supported"):
+        S.run_sweep(grid, tmp_path, ensemble=2, progress=False)
+    with pytest.raises(SnappingInputError, match="ensemble"):
+        S.run_sweep(grid, tmp_path, ensemble=0, progress=False)

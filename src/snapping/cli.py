@@ -393,6 +393,7 @@ def _add_sweep(sub) -> None:
         epilog=(
             "examples:\n"
             "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_out\n"
+            "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --method fast --ensemble 4 -o sweep_out\n"
             "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_out"
         ),
     )
@@ -402,6 +403,8 @@ def _add_sweep(sub) -> None:
     p.add_argument("--method", default=None, help="time-stepping method (default: euler-richardson)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    p.add_argument("--ensemble", type=int, default=None, metavar="K",
+                   help="run up to K chi of one N together in one ensemble kernel (needs --method fast or dop853)")
     p.add_argument("-o", "--output", required=True, help="output directory")
     p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
     p.set_defaults(func=_cmd_sweep)
@@ -416,7 +419,7 @@ def _cmd_sweep(args) -> int:
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     try:
         paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
-                                progress=sys.stderr.isatty())
+                                progress=sys.stderr.isatty(), ensemble=args.ensemble)
     except KeyboardInterrupt:
         print(f"snapping sweep: interrupted; finished and checkpointed runs are kept in {args.output}: "
               "run the same command again to resume only the missing runs", file=sys.stderr)
