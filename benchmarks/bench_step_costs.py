@@ -8,7 +8,7 @@ one attempt per iteration, so a member that needs fewer attempts idles in its la
 until the others finish or its lane group of 4 empties). Together they bound what an
 ensemble can save over single runs on this machine:
 
-    ensemble / singles >= (12 rhs_lane + sums_lane) / step_single / utilisation
+    ensemble / singles >= (12 rhs_lane + sums_lane) / (12 rhs_single + sums_single) / utilisation
 
 Usage::
 

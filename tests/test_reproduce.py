@@ -61,11 +61,13 @@ def test_report_verdicts_follow_from_the_numbers_in_their_rows(tiny):
                   for v, a, s in re.findall(rf"v ×{num}, a ×{num}, σ ×{num}", measured)]
         assert len(ratios) == len(TINY.scaling_chi)
         assert verdict == R.delta_verdict(scale, ratios)
-    # the three snapping times
+    # the three snapping times: the digit their spread touches
     _, measured, _, verdict = _cells(text, "t*_chi from max speed")
-    spreads = [float(x) for x in re.findall(rf"spread {num}", measured)]
-    assert len(spreads) == len(TINY.scaling_chi)
-    assert verdict.startswith("agrees" if max(spreads) < R.FIFTH_DIGIT else "differs")
+    found = re.findall(rf"t\*_chi {num}, spread {num} \(digit (\d+)\)", measured)
+    assert len(found) == len(TINY.scaling_chi)
+    for t, sp, d in found:
+        assert int(d) == R.changed_digit(float(t), float(sp))
+    assert verdict.startswith("agrees" if all(int(d) >= R.T_STAR_DIGIT for *_, d in found) else "differs")
     # t*_chi row: monotone towards the ideal t*
     _, measured, _, verdict = _cells(text, "t*_chi approaches")
     pairs = [(float(c), float(t)) for c, t in re.findall(rf"chi={num}: {num}", measured)]
@@ -76,11 +78,13 @@ def test_report_verdicts_follow_from_the_numbers_in_their_rows(tiny):
     k, s = [float(a) for a, _ in amps], [float(b) for _, b in amps]
     weak = all(math.log(x) <= R.WEAK_AMPLIFICATION * math.log(y) for x, y in zip(k, s))
     assert verdict.startswith("agrees" if weak else "differs")
-    # tolerance row: the coarsest-vs-finest changes against the paper's digits; N = 40 is flagged
+    # tolerance row: the digit each coarsest-vs-finest change touches, against the paper's
     _, measured, _, verdict = _cells(text, "maxima insensitive to tol")
     first = measured.split(";")[0]
-    rel = {q: float(x) for q, x in re.findall(rf"(v_peak|a_peak|sigma_peak) {num}", first)}
-    assert verdict.startswith("agrees" if all(rel[q] < b for q, b in R.TOL_BOUNDS.items()) else "differs")
+    digits = {q: int(d) for q, _, d in re.findall(rf"(v_peak|a_peak|sigma_peak) {num} \(digit (\d+)\)", first)}
+    assert set(digits) == set(R.TOL_DIGITS)
+    assert verdict == R.tolerance_verdict(digits, TINY.tol_N)
+    assert verdict.startswith("agrees" if all(digits[q] >= d for q, d in R.TOL_DIGITS.items()) else "differs")
     assert "N = 5000" in verdict
     # the boundary layer is only judged at the paper's N
     assert _cells(text, "links in the boundary layer")[3].startswith("lower N")
@@ -94,13 +98,21 @@ def test_verdict_rules_on_the_papers_own_numbers():
     assert R.delta_verdict("delta_kappa_m", [dict(v=0.98, a=0.94, sigma=1.0)]).startswith("differs")
     assert R.delta_verdict("delta_kappa0", [dict(v=0.33, a=0.01, sigma=0.21)]).startswith("agrees")
     assert R.delta_verdict("delta_kappa0", [dict(v=0.33, a=0.5, sigma=0.21)]).startswith("differs")
-    # ninth digit for v, sixth for a and sigma
-    ok = dict(v_peak=3e-9, a_peak=4e-6, sigma_peak=2e-6)
+    assert R.delta_verdict("delta_kappa0", [dict(v=0.33, a=0.001, sigma=0.21)]).startswith("differs")  # 3 orders
+    # the paper's digits: "differ only at the fifth significant digit" admits t* 1.14811 vs 1.14831
+    assert R.changed_digit(1.14811, 1.14831 - 1.14811) == 5
+    assert R.spread_verdict([1.14811], [2.0e-4]).startswith("agrees")
+    assert R.spread_verdict([1.14811], [2.0e-3]).startswith("differs")  # the fourth digit
+    # "the ninth significant digit for velocity and the sixth for acceleration and tension" (N = 5000)
+    assert R.changed_digit(11.081378, 7e-7) == 9 and R.changed_digit(8638.4, 0.095) == 6
+    assert R.changed_digit(24.581, 1.4e-4) == 6 and R.changed_digit(24.581, 0.14) == 3
+    ok = {"v_peak": 9, "a_peak": 6, "sigma_peak": 7}
     assert R.tolerance_verdict(ok, 5000).startswith("agrees") and "N = 5000" not in R.tolerance_verdict(ok, 5000)
-    bad = R.tolerance_verdict(dict(ok, v_peak=1.5e-6), 5000)
-    assert bad.startswith("differs (v_peak 1.5e-06)")
+    assert R.tolerance_verdict(dict(ok, v_peak=8), 5000).startswith("differs (v_peak at digit 8)")
+    assert R.changed_digit(3.0, 0.0) > 9
     assert R.boundary_layer_verdict(12.0, 5000).startswith("agrees")
     assert R.boundary_layer_verdict(20.0, 5000).startswith("differs")
+    assert R.boundary_layer_verdict(math.nan, 5000).startswith("no data")
     assert R.monotone_verdict([0.1, 0.25, 0.4], [1.1936, 1.1748, 1.1482], 1.19814).startswith("agrees")
     assert R.monotone_verdict([0.1, 0.25, 0.4], [1.1748, 1.1936, 1.1482], 1.19814) == "differs"
     # chi = 0.25, N = 5000: kappa x5.7 against tension x51 (the -1/6 law against -2/3 gives 1/4 of the e-folds)

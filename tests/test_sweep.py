@@ -111,8 +111,8 @@ def test_cli_sweep(tmp_path, capsys):
     assert "duplicate" in capsys.readouterr().err
 
 
-def test_sweep_in_ensembles_gives_the_single_runs_files(tmp_path):
-    """--ensemble K: several chi of one N in one kernel; each member file as its single run's."""
+def test_sweep_in_ensembles_matches_single_runs(tmp_path):
+    """--ensemble K: several chi of one N in one kernel; each member's peaks as its single run's."""
     opts = {"method": "fast", "chords": "exact", "tol": 1e-8}
     grid = S.Grid(chi=[0.3, 0.4, 0.5], N=[20, 30], options=opts)
     paths = S.run_sweep(grid, tmp_path / "ens", workers=2, progress=False, ensemble=2)
@@ -144,3 +144,11 @@ def test_ensemble_sweep_bad_options(tmp_path):
         S.run_sweep(grid, tmp_path, ensemble=2, progress=False)
     with pytest.raises(SnappingInputError, match="ensemble"):
         S.run_sweep(grid, tmp_path, ensemble=0, progress=False)
+
+
+def test_ensemble_sweep_with_a_failing_member_keeps_the_other(tmp_path):
+    # chi = 0.1 needs steps below dt_min = 3e-4 at N = 40, chi = 0.5 does not
+    grid = S.Grid(chi=[0.1, 0.5], N=[40], options={"method": "fast", "dt_min": 3e-4})
+    with pytest.raises(RuntimeError, match=r"1 of 2 runs failed \(chi=0.1,0.5 N=40: ensemble members failed: chi=0.1"):
+        S.run_sweep(grid, tmp_path, workers=1, ensemble=2, progress=False)
+    assert S.is_complete_run(grid.path(tmp_path, 0.5, 40)) and not S.is_complete_run(grid.path(tmp_path, 0.1, 40))

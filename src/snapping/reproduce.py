@@ -150,9 +150,10 @@ def _boundary_layer_links(ds) -> int:
 #: The paper's claims on the predicted/computed peak ratios (Fig. 4(b)-(d)), as bands per quantity.
 DELTA_BANDS: dict[str, dict[str, tuple[float, float]]] = {
     # "just barely provide order-of-magnitude estimates for velocity and tension, but
-    #  underestimate the acceleration by nearly two orders of magnitude"
-    "delta_kappa0": {"v": (0.1, 10.0), "sigma": (0.1, 10.0), "a": (0.0, 0.1)},
+    #  underestimate the acceleration by nearly two orders of magnitude": a under by x10 to x200
+    "delta_kappa0": {"v": (0.1, 10.0), "sigma": (0.1, 10.0), "a": (0.005, 0.1)},
     # "velocity and acceleration are in excellent agreement; tension over by about a factor of two"
+    # (a tolerant reading of "excellent": within a third)
     "delta_kappa_m": {"v": (0.75, 1.33), "a": (0.75, 1.33), "sigma": (1.5, 2.5)},
     # "less accurate, but still within the order of magnitude"
     "delta_c": {"v": (0.1, 10.0), "a": (0.1, 10.0), "sigma": (0.1, 10.0)},
@@ -162,12 +163,23 @@ DELTA_BANDS: dict[str, dict[str, tuple[float, float]]] = {
 BOUNDARY_LAYER_BAND = (9.0, 16.0)
 
 #: "the maxima change at the ninth significant digit for velocity and the sixth for
-#: acceleration and tension" (tol 1e-7 -> 1e-9, N = 5000): relative changes below these.
-TOL_BOUNDS = {"v_peak": 1e-8, "a_peak": 1e-5, "sigma_peak": 1e-5}
+#: acceleration and tension" (tol 1e-7 -> 1e-9, N = 5000): the first digit a change may touch.
+TOL_DIGITS = {"v_peak": 9, "a_peak": 6, "sigma_peak": 6}
 
-#: "t*_chi from the three maxima differ only at the fifth significant digit": t*_chi ~ 1.1,
-#: so their spread (largest minus smallest) is below one unit of that digit.
-FIFTH_DIGIT = 1e-4
+#: "the values of t*_chi obtained from the velocity, acceleration, and tension maxima
+#: differ only at the fifth significant digit".
+T_STAR_DIGIT = 5
+
+
+def changed_digit(x: float, dx: float) -> int:
+    """The significant digit of ``x`` that a change ``dx`` first touches (1 = the
+    leading digit): ``changed_digit(1.14811, 2e-4) == 5``, ``changed_digit(8638.4, 0.095) == 6``.
+    A zero change touches no digit (returns 99)."""
+    dx = abs(dx)
+    if dx == 0.0:
+        return 99
+    return int(math.floor(math.log10(abs(x))) - math.floor(math.log10(dx))) + 1
+
 
 #: "the amplification of maximum curvature is weak": the curvature gains at most this
 #: fraction of the e-folds the maximum tension gains in the same run,
@@ -197,24 +209,35 @@ def amplification_verdict(kappa_amp: list[float], sigma_amp: list[float]) -> str
 
 def boundary_layer_verdict(links: float, N: int) -> str:
     lo, hi = BOUNDARY_LAYER_BAND
+    if not math.isfinite(links):
+        return "no data (delta_kappa_m not measured)"
     if N != 5000:
         return "lower N than the paper's 5000: compare with --full"
     return f"{'agrees' if _band(links, lo, hi) else 'differs'} (band {lo:g}-{hi:g} for 'about 10-15')"
 
 
-def tolerance_verdict(rel: dict[str, float], N: int) -> str:
-    """Relative changes of the peaks from the coarsest to the finest tol against TOL_BOUNDS."""
-    bad = [q for q, b in TOL_BOUNDS.items() if not rel[q] < b]
-    bounds = ", ".join(f"{q} < {b:g}" for q, b in TOL_BOUNDS.items())
-    v = "agrees" if not bad else "differs (" + ", ".join(f"{q} {rel[q]:.1e}" for q in bad) + ")"
-    v += f" against {bounds}"
+def tolerance_verdict(digits: dict[str, int], N: int) -> str:
+    """The first digit each peak's change from the coarsest to the finest tol touches,
+    against TOL_DIGITS."""
+    bad = [q for q, d in TOL_DIGITS.items() if digits[q] < d]
+    want = ", ".join(f"{q} from digit {d}" for q, d in TOL_DIGITS.items())
+    v = "agrees" if not bad else "differs (" + ", ".join(f"{q} at digit {digits[q]}" for q in bad) + ")"
+    v += f" against {want}"
     if N != 5000:
         v += f"; at N = {N}, the paper's statement is for N = 5000"
     return v
 
 
+def spread_verdict(t_stars: list[float], spreads: list[float]) -> str:
+    """t*_chi from the three maxima differ only from the fifth significant digit on."""
+    ok = sum(changed_digit(t, sp) >= T_STAR_DIGIT for t, sp in zip(t_stars, spreads))
+    return (f"{'agrees' if ok == len(spreads) else 'differs'}: in {ok} of {len(spreads)} runs the spread touches "
+            f"digit {T_STAR_DIGIT} or later")
+
+
 def monotone_verdict(chis: list[float], t_stars: list[float], t_ideal: float) -> str:
-    """t*_chi below t*, increasing as chi decreases, the smallest chi closest to t*."""
+    """t*_chi below t*, increasing as chi decreases (this project's reading of the limit
+    chi -> 0 of the paper: the folded string is the chi = 0 case)."""
     order = np.argsort(chis)
     ts = np.asarray(t_stars, dtype=float)[order]
     ok = bool(np.all(ts < t_ideal) and np.all(np.diff(ts) < 0))
@@ -316,7 +339,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     timings["fig3_fig4"] = time.perf_counter() - t1
 
     def exponent_row(name, paper, ref):
-        cells, agree, agree_w, n_w = [], 0, 0, 0
+        cells, agree, inconclusive, agree_w, n_w = [], 0, 0, 0, 0
         for res in results:
             try:
                 r = res.row(name)
@@ -332,7 +355,10 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                 agree_w += "agrees with the exact" in r.verdict
             cells.append(cell)
             agree += r.verdict.startswith("agrees")
+            inconclusive += r.verdict.startswith("inconclusive")
         verdict = f"agrees with {ref} in {agree} of {len(results)}"
+        if inconclusive:
+            verdict += f" (inconclusive in {inconclusive})"
         if n_w:
             verdict += f"; with the exact folded string on the fit window in {agree_w} of {n_w}"
         rows.append((f"exponent of {name} near t*_chi (N = {plan.scaling_N})", "; ".join(cells), paper, verdict))
@@ -342,18 +368,20 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     exponent_row("sigma_max", "-2/3", "-2/3")
     exponent_row("a_max (intermediate)", "about -5/6 at intermediate times", "-5/6")
     exponent_row("kappa_max", "about -1/6 late (not the inferred -2/3)", "-1/6")
-    spreads = [(res.chi, res.snap.spread) for res in results]
-    n_ok = sum(sp < FIFTH_DIGIT for _, sp in spreads)
     rows.append(("t*_chi from max speed, acceleration and tension agree",
-                 "; ".join(f"chi={c:g}: spread {sp:.1e}" for c, sp in spreads),
+                 "; ".join(f"chi={r.chi:g}: t*_chi {r.snap.t_star:.6f}, spread {r.snap.spread:.1e} "
+                           f"(digit {changed_digit(r.snap.t_star, r.snap.spread)})" for r in results),
                  "differ only at the 5th significant digit",
-                 f"{'agrees' if n_ok == len(spreads) else 'differs'}: spread below {FIFTH_DIGIT:g} in {n_ok} of {len(spreads)}"))
+                 spread_verdict([r.snap.t_star for r in results], [r.snap.spread for r in results])))
     by_chi = sorted(results, key=lambda r: r.chi)
     rows.append(("t*_chi approaches the ideal t* as chi -> 0",
                  "; ".join(f"chi={r.chi:g}: {r.snap.t_star:.5f}" for r in by_chi),
                  f"ideal t* = {t_star:.5f}",
                  monotone_verdict([r.chi for r in by_chi], [r.snap.t_star for r in by_chi], t_star)))
-    sig_amp = [float(ds.attrs["sigma_peak"]) / float(ds["sigma_max"].values[0]) for ds in sc_runs]
+    sig_amp = []  # over t < t*_chi, as the curvature's (scaling.fit_run)
+    for ds, r in zip(sc_runs, results):
+        sg = np.asarray(ds["sigma_max"].values, dtype=float)
+        sig_amp.append(float(np.nanmax(sg[ds["t"].values < r.snap.t_star]) / sg[0]))
     rows.append(("amplification of the maximum curvature is weak",
                  "; ".join(f"chi={r.chi:g}: kappa ×{r.kappa_amplification:.2f} (tension ×{s:.0f})"
                            for r, s in zip(results, sig_amp)),
@@ -394,15 +422,17 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                  "agrees" if worst["energy_drift"] < 8e-7 else "differs"))
     tol_runs = {t: _load(out, plan.tol_chi, plan.tol_N, t) for t in plan.tols}
     ref = tol_runs[min(plan.tols)]
-    cells = []
+    cells, digits_coarse = [], None
     for t in sorted(plan.tols, reverse=True)[:-1]:
-        rel = {q: abs(float(tol_runs[t].attrs[q]) / float(ref.attrs[q]) - 1.0) for q in TOL_BOUNDS}
-        if t == max(plan.tols):
-            rel_coarse = rel
-        cells.append(f"tol {t:g} vs {min(plan.tols):g}: " + ", ".join(f"{q} {r:.1e}" for q, r in rel.items()))
+        x = {q: (float(ref.attrs[q]), float(tol_runs[t].attrs[q]) - float(ref.attrs[q])) for q in TOL_DIGITS}
+        digits = {q: changed_digit(v, dv) for q, (v, dv) in x.items()}
+        if digits_coarse is None:
+            digits_coarse = digits
+        cells.append(f"tol {t:g} vs {min(plan.tols):g}: " + ", ".join(
+            f"{q} {abs(dv / v):.1e} (digit {digits[q]})" for q, (v, dv) in x.items()))
     rows.append((f"maxima insensitive to tol {max(plan.tols):g} -> {min(plan.tols):g} (chi = {plan.tol_chi:g}, N = {plan.tol_N})",
                  "; ".join(cells), "N = 5000: v changes at the 9th digit, a and sigma at the 6th",
-                 tolerance_verdict(rel_coarse, plan.tol_N)))
+                 tolerance_verdict(digits_coarse, plan.tol_N) if digits_coarse else "needs two tolerances"))
 
     # ---------------------------------------------------------------- REPORT.md
     timings["total"] = time.perf_counter() - t0

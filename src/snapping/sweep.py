@@ -197,7 +197,7 @@ def _label(task: list) -> str:
 def _run_task(task: list) -> list[str]:
     """Worker: one run (:func:`_run_one`), or several runs of one N as one ensemble
     (:func:`snapping.simulate.run_ensemble`; each member saved atomically to its file).
-    A failed member raises after the others are saved."""
+    A failed member raises (naming it) after every member is saved."""
     if len(task) == 1:
         return [_run_one(*task[0])]
     import warnings
@@ -261,7 +261,8 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     ensemble : int, optional
         Run up to this many chi of one N together in one ensemble kernel
         (:func:`snapping.simulate.run_ensemble`; the grid's ``method`` must be
-        ``"fast"``/``"dop853"``). Each member's file is the same as its single run's.
+        ``"fast"``/``"dop853"``). Each member's file holds the run of its single run's
+        physics and options (peaks equal to ~1e-9; step counts may differ slightly).
         Ensembles are not checkpointed: an interrupted one restarts. They save
         processes, not time (measured 1.0-1.4x the cost of single runs).
 
@@ -280,6 +281,14 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     tasks = _groups(todo, size)
     bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
     failures = []
+
+    def collect(task, result) -> None:  # keep going: the other runs are independent
+        try:
+            result()
+        except Exception as exc:
+            failures.append((task, exc))
+        bar.update(len(task))
+
     try:
         if scheduler is not None:
             from dask.distributed import as_completed as dask_completed
@@ -288,11 +297,7 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
             try:
                 futures = {client.submit(_run_task, task, pure=False): task for task in tasks}
                 for fut in dask_completed(futures):
-                    try:
-                        fut.result()
-                    except Exception as exc:  # keep going: the other runs are independent
-                        failures.append((futures[fut], exc))
-                    bar.update(len(futures[fut]))
+                    collect(futures[fut], fut.result)
             finally:
                 if owned:
                     client.close()
@@ -300,27 +305,19 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
             n = min(workers or os.cpu_count() or 1, len(tasks))
             if n == 1:
                 for task in tasks:
-                    try:
-                        _run_task(task)
-                    except Exception as exc:
-                        failures.append((task, exc))
-                    bar.update(len(task))
+                    collect(task, lambda task=task: _run_task(task))
             else:
                 import multiprocessing as mp
 
                 with ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context("spawn")) as pool:
                     futures = {pool.submit(_run_task, task): task for task in tasks}
                     for fut in as_completed(futures):
-                        try:
-                            fut.result()
-                        except Exception as exc:
-                            failures.append((futures[fut], exc))
-                        bar.update(len(futures[fut]))
+                        collect(futures[fut], fut.result)
     finally:
         bar.close()
     if failures:
         lines = "; ".join(f"{_label(task)}: {exc}" for task, exc in failures)
-        n_failed = sum(len(task) for task, _ in failures)
+        n_failed = sum(not is_complete_run(path) for task, _ in failures for _, path in task)
         raise RuntimeError(f"{n_failed} of {len(todo)} runs failed ({lines}); rerun to retry only those")
     return grid.paths(out)
 

@@ -703,7 +703,8 @@ def fit_run(
         if spec.ideal is not None:
             bw = ideal_window_exponent(spec.ideal, f.tau_lo, f.tau_hi)
             zw = (f.beta - bw) / f.beta_err if f.beta_err > 0 else math.inf
-            verdict += f"; {'agrees' if abs(zw) <= 2.0 else 'differs'} with the exact folded string in this window"
+            vw = "inconclusive" if not f.beta_err <= inconclusive_err(spec) else ("agrees" if abs(zw) <= 2.0 else "differs")
+            verdict += f"; {vw} with the exact folded string in this window"
         rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw))
     dc = None
     notes = []
