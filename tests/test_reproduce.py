@@ -26,7 +26,9 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     for name in ("fig1_shapes", "fig1e_pin_force", "fig2_profiles", "fig2d_peak_speed_vs_N", "fig3_maxima", "fig4_delta"):
         assert (tmp_path / "figures" / f"{name}.png").stat().st_size > 5000, name
         assert f"figures/{name}.png" in text
-    assert (tmp_path / "figures" / "fig1_shapes.pdf").is_file()
+    for name in ("fig1_shapes", "fig1e_pin_force", "fig2_profiles", "fig2d_peak_speed_vs_N", "fig3_maxima",
+                 "fig3_local_slopes", "fig4_delta"):
+        assert (tmp_path / "figures" / f"{name}.pdf").is_file(), name
     # every claim row has four cells and a verdict
     rows = [l for l in text.splitlines() if l.startswith("| ") and not l.startswith("| claim") and "seconds" not in l]
     assert len(rows) >= 15

@@ -334,6 +334,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     scaling.plot_maxima(sc_runs, results, figdir / "fig3_maxima.png")
     scaling.plot_maxima(sc_runs, results, figdir / "fig3_maxima.pdf")
     scaling.plot_local_slopes(sc_runs, results, figdir / "fig3_local_slopes.png")
+    scaling.plot_local_slopes(sc_runs, results, figdir / "fig3_local_slopes.pdf")
     scaling.plot_delta(sc_runs, results, figdir / "fig4_delta.png")
     scaling.plot_delta(sc_runs, results, figdir / "fig4_delta.pdf")
     timings["fig3_fig4"] = time.perf_counter() - t1
