@@ -11,10 +11,23 @@ Usage::
     python benchmarks/probe_implicit_steps.py 1e-8 50,100,200,400,800
     python benchmarks/probe_implicit_steps.py 1e-6 100,200,400,800
 """
-import sys, time, numpy as np
+
+import os
+import sys
+import time
+
+import numpy as np
 from scipy.integrate import solve_ivp
-from snapping.simulate import angles as AG, run
+
+from snapping.simulate import angles as AG
+from snapping.simulate import run
 from snapping.simulate.chain import initial_state
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_simulate import machine_rows  # noqa: E402
+
+for k, v in machine_rows():
+    print(f"  {k:14s} {v}")
 
 T = 0.9
 tol = float(sys.argv[1]) if len(sys.argv) > 1 else 1e-8

@@ -8,8 +8,22 @@ Usage::
 
     python benchmarks/probe_step_error.py
 """
-import math, numpy as np
-from snapping.simulate import run, rk as R, angles as AG
+
+import os
+import sys
+
+import numpy as np
+
+from snapping.simulate import angles as AG
+from snapping.simulate import rk as R
+from snapping.simulate import run
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_simulate import machine_rows  # noqa: E402
+
+for k, v in machine_rows():
+    print(f"  {k:14s} {v}")
+
 N = 1000
 ds = run(0.25, N, tol=1e-8, chords='exact', method='fast', snapshot_times=(0.5,)).dataset
 i = int(np.argmin(abs(ds['t_snapshot'].values - 0.5)))
