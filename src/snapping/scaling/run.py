@@ -598,17 +598,23 @@ def inconclusive_err(spec: RowSpec) -> float:
     return sep / 4.0
 
 
+def _judge(fit: PowerLawFit, ref: float, spec: RowSpec) -> tuple[float, str]:
+    """z-score of the fitted exponent against ``ref`` and the word for it: ``agrees``
+    (|z| <= 2), ``differs``, or ``inconclusive`` (uncertainty above :func:`inconclusive_err`)."""
+    z = (fit.beta - ref) / fit.beta_err if fit.beta_err > 0 else math.inf
+    if not fit.beta_err <= inconclusive_err(spec):
+        return z, "inconclusive"
+    return z, "agrees" if abs(z) <= 2.0 else "differs"
+
+
 def _verdict(fit: PowerLawFit, spec: RowSpec) -> tuple[float, str]:
     """``agrees`` (within 2 uncertainties of the reference), ``differs`` or
     ``inconclusive`` (uncertainty above :func:`inconclusive_err`), with remarks: closer
     to the alternative exponent, a window that is not flat, a window chosen inside a
     slope range (which leans the fit towards that range)."""
-    z = (fit.beta - spec.ref) / fit.beta_err if fit.beta_err > 0 else math.inf
-    emax = inconclusive_err(spec)
-    if not fit.beta_err <= emax:
-        v = f"inconclusive (uncertainty {fit.beta_err:.2g} > {emax:.3g})"
-    else:
-        v = "agrees" if abs(z) <= 2.0 else "differs"
+    z, v = _judge(fit, spec.ref, spec)
+    if v == "inconclusive":
+        v += f" (uncertainty {fit.beta_err:.2g} > {inconclusive_err(spec):.3g})"
     extra = []
     if spec.alt is not None and fit.beta_err > 0:
         za = (fit.beta - spec.alt) / fit.beta_err
@@ -702,9 +708,7 @@ def fit_run(
         bw = math.nan
         if spec.ideal is not None:
             bw = ideal_window_exponent(spec.ideal, f.tau_lo, f.tau_hi)
-            zw = (f.beta - bw) / f.beta_err if f.beta_err > 0 else math.inf
-            vw = "inconclusive" if not f.beta_err <= inconclusive_err(spec) else ("agrees" if abs(zw) <= 2.0 else "differs")
-            verdict += f"; {vw} with the exact folded string in this window"
+            verdict += f"; {_judge(f, bw, spec)[1]} with the exact folded string in this window"
         rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw))
     dc = None
     notes = []
