@@ -503,9 +503,8 @@ def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, mea
         # ---- accepted steps go into the member's other slot
         n_acc = 0
         for lane in range(L):
-            err = errL[lane]
             slot[lane] = 1 - slot[lane]
-            acc[lane] = err - err == 0.0 and err <= 1.0
+            acc[lane] = R.accepted(errL[lane])
             n_acc += acc[lane]
         if n_acc:
             for i in range(n):
@@ -595,7 +594,8 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     share only the arithmetic. The interleaved tension recurrence is cheaper per member
     than one chain's (latency-bound), but the rest of a step is not, and members that
     need fewer steps idle in their lanes: measured, an ensemble costs 1.0-1.4x as much
-    as separate single runs (``benchmarks/bench_step_costs.py``), so prefer single runs
+    as separate single runs (``benchmarks/bench_methods.py``; the parts of a step in
+    ``benchmarks/bench_step_costs.py``), so prefer single runs
     for speed; use an ensemble to keep several chi in one process and one call.
 
     Parameters

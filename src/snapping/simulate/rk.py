@@ -188,6 +188,12 @@ def step_size(ctl):
     return h, False
 
 
+@njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+def accepted(err) -> bool:
+    """The acceptance rule of :func:`after_attempt`: a finite scaled error <= 1."""
+    return err - err == 0.0 and err <= 1.0
+
+
 @njit(cache=True, fastmath=False, boundscheck=False)
 def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas):
     """Everything after the stages of an attempted step of size h into slot ``ns``
