@@ -26,7 +26,7 @@ import numpy as np
 from snapping.simulate import run, run_ensemble
 
 sys.path.insert(0, os.path.dirname(__file__))
-from bench_simulate import machine_rows  # noqa: E402
+from bench_simulate import print_machine  # noqa: E402
 
 
 def one(chi: float, N: int, method: str, tol: float) -> dict:
@@ -53,11 +53,7 @@ def main(argv=None) -> int:
     if args.ensemble:
         M, NE = (int(v) for v in args.ensemble.split(":"))
 
-    print("machine")
-    for k, v in machine_rows():
-        print(f"  {k:<14} {v}")
-    print(f"  load average   {os.getloadavg()[0]:.2f} (at start; timings are single-threaded)")
-    print()
+    print_machine()
     print(f"both methods from the catenary with exact chords, tol {args.tol:g}, to shortly after the snap")
     hdr = (f"  {'chi':>5} {'N':>5} {'method':<17} {'v_peak':>12} {'a_peak':>12} {'sigma_peak':>11} {'t_snap_v':>10} "
            f"{'link err':>9} {'rhs evals':>10} {'wall s':>8}")

@@ -51,6 +51,17 @@ def machine_rows():
     ]
 
 
+def print_machine(load: bool = True) -> None:
+    """The machine table every benchmark starts with (and the load average, which makes
+    shared-machine timings readable)."""
+    print("machine")
+    for k, v in machine_rows():
+        print(f"  {k:<14} {v}")
+    if load:
+        print(f"  load average   {os.getloadavg()[0]:.2f} (at start; timings are single-threaded)")
+    print()
+
+
 def _state(chi: float, N: int):
     """A moving state (catenary positions, smooth velocities) in the kernel layout."""
     st = initial_state(chi, N)
@@ -118,10 +129,7 @@ def main(argv=None) -> int:
     if args.no_runs:
         runs = []
 
-    print("machine")
-    for k, v in machine_rows():
-        print(f"  {k:<14} {v}")
-    print()
+    print_machine(load=False)
     print("kernels: nanoseconds per node per evaluation (best of 5), one core")
     hdr = f"  {'N':>6} {'chi':>5} {'evals':>9} {'rhs':>8} {'thomas':>8} {'record':>8} {'rhs+rec':>8} {'rhs us':>9}"
     print(hdr)

@@ -32,7 +32,7 @@ from snapping.simulate import run
 from snapping.simulate.chain import initial_state
 
 sys.path.insert(0, os.path.dirname(__file__))
-from bench_simulate import machine_rows  # noqa: E402
+from bench_simulate import print_machine  # noqa: E402
 
 
 def per_call(fn, target_s: float = 0.3) -> float:
@@ -59,10 +59,7 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     N, n = a.N, 2 * a.N
     chis = [float(c) for c in a.chis.split(",")]
-    print("machine")
-    for k, v in machine_rows():
-        print(f"  {k:14s} {v}")
-    print(f"  load average   {os.getloadavg()[0]:.2f} (at start; timings are single-threaded)\n")
+    print_machine()
 
     y = AG.state_to_angles(initial_state(0.25, N, chords="exact"))
     y = y + 1e-3 * np.random.default_rng(0).standard_normal(y.size)  # a generic moving state

@@ -19,10 +19,9 @@ from snapping.simulate import rk as R
 from snapping.simulate import run
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_simulate import machine_rows  # noqa: E402
+from bench_simulate import print_machine  # noqa: E402
 
-for k, v in machine_rows():
-    print(f"  {k:14s} {v}")
+print_machine()
 
 N = 1000
 ds = run(0.25, N, tol=1e-8, chords='exact', method='fast', snapshot_times=(0.5,)).dataset
