@@ -9,8 +9,6 @@ existed before is changed (its bytes are compared before and after).
 
 from __future__ import annotations
 
-import math
-import os
 from pathlib import Path
 
 import numpy as np

@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from . import _validate as V
-from . import estimates, figures, ideal, sweep
+from . import figures, ideal, sweep
 from .estimates import PAPER_CHAIN
 
 __all__ = ["Plan", "PLANS", "reproduce", "expected_seconds"]

@@ -23,17 +23,20 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import tempfile
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import _validate as V
 from . import schema
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 __all__ = ["Grid", "run_sweep", "combine", "atomic_to_netcdf", "is_complete_run"]
 

@@ -14,12 +14,16 @@ import itertools
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .. import _validate as V
 from .. import estimates, schema
 from .fit import PeakTime, PowerLawFit, fit_power_law, local_slope, peak_time
+
+if TYPE_CHECKING:  # annotations only
+    import xarray as xr
 
 __all__ = [
     "report_specs",

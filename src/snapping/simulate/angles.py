@@ -78,27 +78,28 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 SINCOS_FAST_MAX = 1.0e5
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def sincos(N, th, c, s):
     """c[j], s[j] = cos(th[j]), sin(th[j]) for j < N, to within ~1 ulp.
 
     A branch-free polynomial (fdlibm's kernels after a three-part reduction by pi/2)
     that the compiler vectorises: about 2 ns per angle against about 16 ns for two
-    libm calls. Angles beyond ``SINCOS_FAST_MAX`` in magnitude go to libm.
+    libm calls. Each angle beyond ``SINCOS_FAST_MAX`` in magnitude goes to libm.
     """
-    big = 0.0
+    nbig = 0  # (a count, not a running maximum: the count vectorises with the polynomial)
     for j in range(N):
-        big = max(big, abs(th[j]))
-    if big > SINCOS_FAST_MAX:
+        x = th[j]
+        nbig += abs(x) > SINCOS_FAST_MAX
+        c[j], s[j] = sincos1(x)
+    if nbig:  # (each such angle alone, so that the result of one angle never depends on the others)
         for j in range(N):
-            c[j] = math.cos(th[j])
-            s[j] = math.sin(th[j])
-        return
-    for j in range(N):
-        c[j], s[j] = sincos1(th[j])
+            x = th[j]
+            if abs(x) > SINCOS_FAST_MAX:
+                c[j] = math.cos(x)
+                s[j] = math.sin(x)
 
 
-@njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
 def sincos1(x):
     """(cos x, sin x) by the branch-free polynomial of :func:`sincos` (|x| <= SINCOS_FAST_MAX)."""
     k = np.floor(x * _TWO_OVER_PI + 0.5)
@@ -126,7 +127,7 @@ class Work:
         self.sig = np.zeros(N)
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def angle_rhs(N, y, f, c, s, S, cp, dp, sig):
     """Derivative ``f = [theta', theta'']`` of the angle state ``y`` (length 2N).
 
@@ -201,7 +202,7 @@ def angle_rhs(N, y, f, c, s, S, cp, dp, sig):
     f[N] = n2 * s_nn * S[0]
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def angles_to_Z(N, y, c, s, sig, Z):
     """Fill the (7, N + 1) position-form state ``Z`` (x, y, vx, vy, ax, ay, sigma) from
     the angle state ``y`` with its ``c = cos theta``, ``s = sin theta`` and tension
@@ -242,7 +243,7 @@ def angles_to_Z(N, y, c, s, sig, Z):
         Z[K.RAY, j] = fN * sy + 1.0
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def link_error_angles(N, c, s):
     """max_k |N |d_k| - 1| of the links d_k = (cos theta_k, sin theta_k)/N (round-off only)."""
     e = 0.0
@@ -253,7 +254,7 @@ def link_error_angles(N, c, s):
     return e
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def measure_angles(N, y, c, s, sig, Z, rinv0, meas):
     """The per-step diagnostics of :func:`kernels.measure` for an angle state: ``Z`` is
     filled by :func:`angles_to_Z`, measured, and the link-length entries (error against

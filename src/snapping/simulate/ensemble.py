@@ -2,15 +2,26 @@
 
 Every member is a full DOP853 angle-form run (:mod:`snapping.simulate.highorder`) with
 its own adaptive step, its own record, peaks, snapshots and stop; only the arithmetic is
-shared. The members' states are stored interleaved, ``y[i, lane]``, so that every
-loop of a step -- the polynomial sines and cosines, the stage sums, and above all the
-tridiagonal elimination, whose recurrence is a chain of dependent multiply-adds that
-a single chain cannot overlap -- runs over the lanes in SIMD registers, several
-independent recurrences at once. Each iteration advances every active member by one
-attempted step (of its own size); a member that stops (snap, t_end, failure) leaves
-the lane set. After each attempt the member's own bookkeeping
-(:func:`snapping.simulate.rk.after_attempt`) runs exactly as in a single run, so an
-ensemble member's Dataset equals that of the single run to round-off.
+shared. The members' states are stored interleaved, ``y[i, lane]``: the elementwise
+passes of a step (stage sums, sines and cosines, coupling coefficients, accelerations,
+error norm) run over the flattened (component, lane) index, and the two recurrences of
+the tension solve -- chains of dependent operations that one chain cannot overlap --
+update all lanes at once at each node, so that the compiler vectorises them across
+the lanes. Each iteration advances every active member by one attempted step (of its
+own size); a member that stops (snap, t_end, failure) leaves the lanes, and the last
+one finishes on the single-run kernel. The lanes keep their members' last two steps
+themselves (for the dense output); after each attempt the member's own bookkeeping
+(:func:`snapping.simulate.rk.after_attempt`) runs on its lane exactly as in a single
+run. Every operation is the single run's, in the same order, so an ensemble member's
+Dataset equals that of its single run bit for bit (all but ``wall_time``).
+
+Cost: the lanes make the tension recurrence about 2.5x cheaper per member, but the rest
+of a step (sines and cosines, stage sums, error norm, diagnostics) is already
+vectorised along the chain in a single run, and the lanes multiply the working set by
+their number (out of the core's L2 cache from N ~ 1000 at 8 lanes). Measured on a
+2-core Xeon (``benchmarks/bench_methods.py``, ``benchmarks/bench_step_costs.py``), an
+ensemble costs 1.1-1.2x as much as its members run one after another: use it to keep
+several chi in one process and one call, not for speed.
 
 Example
 -------
@@ -32,399 +43,148 @@ from numba import njit
 from .. import _validate as V
 from . import angles as AG
 from . import highorder as HO
-from . import kernels as K
 from . import rk as R
 from .chain import initial_state
 
-__all__ = ["run_ensemble", "rhs_lanes"]
+__all__ = ["run_ensemble", "rhs_lanes", "LaneWork"]
 
 BLOCK = AG.BLOCK
+#: elements per chunk of the flat stage sums (a chunk of the sum stays in L1)
+CHUNK = 1024
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
-def rhs_lanes(N, L, y, f, c, s, S, cp, dp, sig, pm, pmm, qv, cpv, snx, snn):
-    """:func:`angles.angle_rhs` for L interleaved chains: ``y, f`` (2N, >= L), work
-    ``c, s, S, cp, dp, sig`` (N, >= L), lane vectors ``pm ... snn`` (>= L)."""
-    fN = float(N)
-    n2 = fN * fN
-    inv_n2 = 1.0 / n2
-    big = 0.0
-    for j in range(N):
-        for lane in range(L):
-            big = max(big, abs(y[j, lane]))
-    if big > AG.SINCOS_FAST_MAX:
-        for j in range(N):
-            for lane in range(L):
-                c[j, lane] = math.cos(y[j, lane])
-                s[j, lane] = math.sin(y[j, lane])
-    else:
-        for j in range(N):
-            for lane in range(L):
-                c[j, lane], s[j, lane] = AG.sincos1(y[j, lane])
-    for j in range(N):
-        for lane in range(L):
-            f[j, lane] = y[N + j, lane]
-    if N == 1:
-        for lane in range(L):
-            w = y[1, lane]
-            sig[0, lane] = w * w - s[0, lane]
-            f[1, lane] = -c[0, lane]
-        return
-    for lane in range(L):
-        cpv[lane] = 0.0
-        pm[lane] = 1.0
-        pmm[lane] = 0.0
-        qv[lane] = 0.0
-    j0 = 0
-    while j0 < N - 1:
-        j1 = min(j0 + BLOCK, N - 1)
-        for j in range(j0, j1):
-            for lane in range(L):
-                cj = c[j, lane]
-                sj = s[j, lane]
-                cn = c[j + 1, lane]
-                sn = s[j + 1, lane]
-                C = cn * cj + sn * sj
-                S[j, lane] = sn * cj - cn * sj
-                w = y[N + j, lane]
-                r = -(w * w) * inv_n2
-                cprev = cpv[lane]
-                pml = pm[lane]
-                p = -2.0 * pml - (cprev * cprev) * pmm[lane]
-                q = r * pml - cprev * qv[lane]
-                inv = 1.0 / p
-                cp[j, lane] = C * pml * inv
-                dp[j, lane] = q * inv
-                pmm[lane] = pml
-                pm[lane] = p
-                qv[lane] = q
-                cpv[lane] = C
-        for lane in range(L):
-            e = math.frexp(pm[lane])[1]
-            sc = math.ldexp(1.0, -e)
-            pm[lane] *= sc
-            pmm[lane] *= sc
-            qv[lane] *= sc
-        j0 = j1
-    jl = N - 1
-    for lane in range(L):
-        w = y[N + jl, lane]
-        r = -(w * w) * inv_n2 + s[jl, lane] / fN
-        cprev = cpv[lane]
-        p = -pm[lane] - (cprev * cprev) * pmm[lane]
-        q = r * pm[lane] - cprev * qv[lane]
-        snx[lane] = q / p
-        sig[jl, lane] = snx[lane]
-        snn[lane] = 0.0
-    for j in range(N - 2, -1, -1):
-        if j + 1 == N - 1:
-            for lane in range(L):
-                sj = dp[j, lane] - cp[j, lane] * snx[lane]
-                sig[j, lane] = sj
-                f[N + j + 1, lane] = -n2 * sj * S[j, lane] - fN * c[j + 1, lane]
-                snn[lane] = snx[lane]
-                snx[lane] = sj
-        else:
-            for lane in range(L):
-                sj = dp[j, lane] - cp[j, lane] * snx[lane]
-                sig[j, lane] = sj
-                f[N + j + 1, lane] = n2 * (snn[lane] * S[j + 1, lane] - sj * S[j, lane])
-                snn[lane] = snx[lane]
-                snx[lane] = sj
-    for lane in range(L):
-        f[N, lane] = n2 * snn[lane] * S[0, lane]
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def rhs_lanes(N, y, f, c, s, S, C, P, Q, cp, dp, sig):
+    """:func:`angles.angle_rhs` for the ``W = y.shape[1]`` interleaved chains of ``y, f``
+    (2N, W), with the same arithmetic (and so the same results, bit for bit).
 
-
-@njit(cache=True, fastmath=False, boundscheck=False)
-def _rhs_tiles(N, y, f, c, s, S, cp, dp, sig):
-    """:func:`angles.angle_rhs` (the same arithmetic) for the ``W = y.shape[1]`` (a
-    multiple of 4) interleaved chains of ``y, f`` (2N, W); work ``c ... sig`` (N, W).
-    The recurrences run on tiles of 4 lanes held in scalars (one SIMD register each)."""
+    Work: ``c, s, S, cp, dp, sig`` (N, W); ``C, P, Q`` (N + 2, W), where row j + 2
+    holds the coupling coefficient C_j, the leading minor p_j and the eliminated right
+    side q_j of row j (rows 0 and 1: the start of the recurrence). Every pass that is
+    elementwise runs over the flattened (node, lane) index; only the two recurrences
+    (forward elimination, back substitution) step through the nodes, each step
+    updating all W lanes at once, so that the compiler vectorises them across lanes.
+    """
     W = y.shape[1]
     fN = float(N)
     n2 = fN * fN
     inv_n2 = 1.0 / n2
+    nW = N * W
     yf = y.reshape(-1)
     ff = f.reshape(-1)
     cf = c.reshape(-1)
     sf = s.reshape(-1)
-    nW = N * W
-    big = 0.0
+    AG.sincos(nW, yf, cf, sf)
+    yw = yf[nW:]
     for i in range(nW):
-        big = max(big, abs(yf[i]))
-    if big > AG.SINCOS_FAST_MAX:
-        for i in range(nW):
-            cf[i] = math.cos(yf[i])
-            sf[i] = math.sin(yf[i])
-    else:
-        for i in range(nW):
-            cf[i], sf[i] = AG.sincos1(yf[i])
-    for i in range(nW):
-        ff[i] = yf[nW + i]
+        ff[i] = yw[i]
     if N == 1:
         for lane in range(W):
             w = y[1, lane]
             sig[0, lane] = w * w - s[0, lane]
             f[1, lane] = -c[0, lane]
         return
-    for g in range(W // 4):
-        l = 4 * g
-        cprev0 = 0.0
-        pm0 = 1.0
-        pmm0 = 0.0
-        q0 = 0.0
-        cprev1 = 0.0
-        pm1 = 1.0
-        pmm1 = 0.0
-        q1 = 0.0
-        cprev2 = 0.0
-        pm2 = 1.0
-        pmm2 = 0.0
-        q2 = 0.0
-        cprev3 = 0.0
-        pm3 = 1.0
-        pmm3 = 0.0
-        q3 = 0.0
-        j0 = 0
-        while j0 < N - 1:
-            j1 = min(j0 + BLOCK, N - 1)
-            for j in range(j0, j1):
-                cj = c[j, l]
-                sj = s[j, l]
-                cn = c[j + 1, l]
-                sn = s[j + 1, l]
-                C = cn * cj + sn * sj
-                S[j, l] = sn * cj - cn * sj
-                w = y[N + j, l]
-                r = -(w * w) * inv_n2
-                p = -2.0 * pm0 - (cprev0 * cprev0) * pmm0
-                q0 = r * pm0 - cprev0 * q0
+    # coefficients C_j = cos(theta_{j+1} - theta_j), S_j = sin(...), right sides -theta_j'^2 / N^2
+    # (slices keep every index of the flat loops provably non-negative: they vectorise)
+    Sf = S.reshape(-1)
+    Cf2 = C.reshape(-1)[2 * W:]
+    Qf2 = Q.reshape(-1)[2 * W:]
+    cf1 = cf[W:]
+    sf1 = sf[W:]
+    for i in range((N - 1) * W):
+        cj = cf[i]
+        sj = sf[i]
+        cn = cf1[i]
+        sn = sf1[i]
+        Cf2[i] = cn * cj + sn * sj
+        Sf[i] = sn * cj - cn * sj
+    for i in range(nW):
+        w = yw[i]
+        Qf2[i] = -(w * w) * inv_n2
+    for lane in range(W):
+        Q[N + 1, lane] = Q[N + 1, lane] + s[N - 1, lane] / fN  # the pin row
+        C[1, lane] = 0.0
+        P[0, lane] = 0.0
+        P[1, lane] = 1.0
+        Q[1, lane] = 0.0
+    # forward elimination, rows j = 0 .. N-2 (rescaled by a power of two every BLOCK rows)
+    j0 = 0
+    while j0 < N - 1:
+        j1 = min(j0 + BLOCK, N - 1)
+        for j in range(j0, j1):
+            for lane in range(W):
+                cprev = C[j + 1, lane]
+                pm = P[j + 1, lane]
+                p = -2.0 * pm - (cprev * cprev) * P[j, lane]
+                q = Q[j + 2, lane] * pm - cprev * Q[j + 1, lane]
+                P[j + 2, lane] = p
+                Q[j + 2, lane] = q
                 inv = 1.0 / p
-                cp[j, l] = C * pm0 * inv
-                dp[j, l] = q0 * inv
-                pmm0 = pm0
-                pm0 = p
-                cprev0 = C
-                cj = c[j, l + 1]
-                sj = s[j, l + 1]
-                cn = c[j + 1, l + 1]
-                sn = s[j + 1, l + 1]
-                C = cn * cj + sn * sj
-                S[j, l + 1] = sn * cj - cn * sj
-                w = y[N + j, l + 1]
-                r = -(w * w) * inv_n2
-                p = -2.0 * pm1 - (cprev1 * cprev1) * pmm1
-                q1 = r * pm1 - cprev1 * q1
-                inv = 1.0 / p
-                cp[j, l + 1] = C * pm1 * inv
-                dp[j, l + 1] = q1 * inv
-                pmm1 = pm1
-                pm1 = p
-                cprev1 = C
-                cj = c[j, l + 2]
-                sj = s[j, l + 2]
-                cn = c[j + 1, l + 2]
-                sn = s[j + 1, l + 2]
-                C = cn * cj + sn * sj
-                S[j, l + 2] = sn * cj - cn * sj
-                w = y[N + j, l + 2]
-                r = -(w * w) * inv_n2
-                p = -2.0 * pm2 - (cprev2 * cprev2) * pmm2
-                q2 = r * pm2 - cprev2 * q2
-                inv = 1.0 / p
-                cp[j, l + 2] = C * pm2 * inv
-                dp[j, l + 2] = q2 * inv
-                pmm2 = pm2
-                pm2 = p
-                cprev2 = C
-                cj = c[j, l + 3]
-                sj = s[j, l + 3]
-                cn = c[j + 1, l + 3]
-                sn = s[j + 1, l + 3]
-                C = cn * cj + sn * sj
-                S[j, l + 3] = sn * cj - cn * sj
-                w = y[N + j, l + 3]
-                r = -(w * w) * inv_n2
-                p = -2.0 * pm3 - (cprev3 * cprev3) * pmm3
-                q3 = r * pm3 - cprev3 * q3
-                inv = 1.0 / p
-                cp[j, l + 3] = C * pm3 * inv
-                dp[j, l + 3] = q3 * inv
-                pmm3 = pm3
-                pm3 = p
-                cprev3 = C
-            sc = math.ldexp(1.0, -math.frexp(pm0)[1])
-            pm0 *= sc
-            pmm0 *= sc
-            q0 *= sc
-            sc = math.ldexp(1.0, -math.frexp(pm1)[1])
-            pm1 *= sc
-            pmm1 *= sc
-            q1 *= sc
-            sc = math.ldexp(1.0, -math.frexp(pm2)[1])
-            pm2 *= sc
-            pmm2 *= sc
-            q2 *= sc
-            sc = math.ldexp(1.0, -math.frexp(pm3)[1])
-            pm3 *= sc
-            pmm3 *= sc
-            q3 *= sc
-            j0 = j1
-        jl = N - 1
-        w = y[N + jl, l]
-        r = -(w * w) * inv_n2 + s[jl, l] / fN
-        p = -pm0 - (cprev0 * cprev0) * pmm0
-        q0 = r * pm0 - cprev0 * q0
-        snx0 = q0 / p
-        sig[jl, l] = snx0
-        snn0 = 0.0
-        w = y[N + jl, l + 1]
-        r = -(w * w) * inv_n2 + s[jl, l + 1] / fN
-        p = -pm1 - (cprev1 * cprev1) * pmm1
-        q1 = r * pm1 - cprev1 * q1
-        snx1 = q1 / p
-        sig[jl, l + 1] = snx1
-        snn1 = 0.0
-        w = y[N + jl, l + 2]
-        r = -(w * w) * inv_n2 + s[jl, l + 2] / fN
-        p = -pm2 - (cprev2 * cprev2) * pmm2
-        q2 = r * pm2 - cprev2 * q2
-        snx2 = q2 / p
-        sig[jl, l + 2] = snx2
-        snn2 = 0.0
-        w = y[N + jl, l + 3]
-        r = -(w * w) * inv_n2 + s[jl, l + 3] / fN
-        p = -pm3 - (cprev3 * cprev3) * pmm3
-        q3 = r * pm3 - cprev3 * q3
-        snx3 = q3 / p
-        sig[jl, l + 3] = snx3
-        snn3 = 0.0
-        j = N - 2
-        sj = dp[j, l] - cp[j, l] * snx0
-        sig[j, l] = sj
-        f[N + j + 1, l] = -n2 * sj * S[j, l] - fN * c[j + 1, l]
-        snn0 = snx0
-        snx0 = sj
-        sj = dp[j, l + 1] - cp[j, l + 1] * snx1
-        sig[j, l + 1] = sj
-        f[N + j + 1, l + 1] = -n2 * sj * S[j, l + 1] - fN * c[j + 1, l + 1]
-        snn1 = snx1
-        snx1 = sj
-        sj = dp[j, l + 2] - cp[j, l + 2] * snx2
-        sig[j, l + 2] = sj
-        f[N + j + 1, l + 2] = -n2 * sj * S[j, l + 2] - fN * c[j + 1, l + 2]
-        snn2 = snx2
-        snx2 = sj
-        sj = dp[j, l + 3] - cp[j, l + 3] * snx3
-        sig[j, l + 3] = sj
-        f[N + j + 1, l + 3] = -n2 * sj * S[j, l + 3] - fN * c[j + 1, l + 3]
-        snn3 = snx3
-        snx3 = sj
-        for j in range(N - 3, -1, -1):
-            sj = dp[j, l] - cp[j, l] * snx0
-            sig[j, l] = sj
-            f[N + j + 1, l] = n2 * (snn0 * S[j + 1, l] - sj * S[j, l])
-            snn0 = snx0
-            snx0 = sj
-            sj = dp[j, l + 1] - cp[j, l + 1] * snx1
-            sig[j, l + 1] = sj
-            f[N + j + 1, l + 1] = n2 * (snn1 * S[j + 1, l + 1] - sj * S[j, l + 1])
-            snn1 = snx1
-            snx1 = sj
-            sj = dp[j, l + 2] - cp[j, l + 2] * snx2
-            sig[j, l + 2] = sj
-            f[N + j + 1, l + 2] = n2 * (snn2 * S[j + 1, l + 2] - sj * S[j, l + 2])
-            snn2 = snx2
-            snx2 = sj
-            sj = dp[j, l + 3] - cp[j, l + 3] * snx3
-            sig[j, l + 3] = sj
-            f[N + j + 1, l + 3] = n2 * (snn3 * S[j + 1, l + 3] - sj * S[j, l + 3])
-            snn3 = snx3
-            snx3 = sj
-        f[N, l] = n2 * snn0 * S[0, l]
-        f[N, l + 1] = n2 * snn1 * S[0, l + 1]
-        f[N, l + 2] = n2 * snn2 * S[0, l + 2]
-        f[N, l + 3] = n2 * snn3 * S[0, l + 3]
+                cp[j, lane] = C[j + 2, lane] * pm * inv
+                dp[j, lane] = q * inv
+        for lane in range(W):
+            sc = math.ldexp(1.0, -math.frexp(P[j1 + 1, lane])[1])
+            P[j1 + 1, lane] *= sc
+            P[j1, lane] *= sc
+            Q[j1 + 1, lane] *= sc
+        j0 = j1
+    jl = N - 1  # the last row (link N, at the pin): b = -1
+    for lane in range(W):
+        cprev = C[jl + 1, lane]
+        pm = P[jl + 1, lane]
+        p = -pm - (cprev * cprev) * P[jl, lane]
+        q = Q[jl + 2, lane] * pm - cprev * Q[jl + 1, lane]
+        sig[jl, lane] = q / p
+    for j in range(N - 2, -1, -1):
+        for lane in range(W):
+            sig[j, lane] = dp[j, lane] - cp[j, lane] * sig[j + 1, lane]
+    # angular accelerations: links 2 .. N-1 elementwise, then the free end and the pin
+    gf = sig.reshape(-1)
+    fa = ff[nW + W:]
+    g2 = gf[2 * W:]
+    S1 = Sf[W:]
+    for i in range((N - 2) * W):
+        fa[i] = n2 * (g2[i] * S1[i] - gf[i] * Sf[i])
+    for lane in range(W):
+        f[N, lane] = n2 * sig[1, lane] * S[0, lane]
+        f[2 * N - 1, lane] = -n2 * sig[N - 2, lane] * S[N - 2, lane] - fN * c[N - 1, lane]
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
-def _err_tiles(n, hL, y0, y1, KE, tolL, errL):
-    """The scaled error of every lane (rk.rk_step's max norm and summation order)."""
+class LaneWork:
+    """Work arrays of :func:`rhs_lanes` for W chains of N links."""
+
+    def __init__(self, N: int, W: int):
+        self.c, self.s, self.S, self.cp, self.dp, self.sig = (np.zeros((N, W)) for _ in range(6))
+        self.C, self.P, self.Q = (np.zeros((N + 2, W)) for _ in range(3))
+
+    def args(self):
+        return self.c, self.s, self.S, self.C, self.P, self.Q, self.cp, self.dp, self.sig
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _err_lanes(n, hx, tolx, y0, y1, KE, ev, errL):
+    """The scaled error of every lane: rk.rk_step's norm with its operations in its order
+    (:func:`rk.scaled_error`), elementwise over the flattened (component, lane) index
+    (``hx``, ``tolx``: each element's lane step and tolerance; ``ev``: (n, W) scratch),
+    then the maximum of each lane."""
     W = y0.shape[1]
+    m = n * W
+    evf = ev.reshape(-1)
+    y0f = y0.reshape(-1)
+    y1f = y1.reshape(-1)
+    Kf = KE.reshape(KE.shape[0], m)
+    for i in range(m):
+        evf[i] = R.scaled_error(Kf, i, y0f[i], y1f[i], hx[i], tolx[i])
     for lane in range(W):
         errL[lane] = 0.0
     for i in range(n):
-        for g in range(W // 4):
-            l = 4 * g
-            e50 = 0.0
-            e30 = 0.0
-            e51 = 0.0
-            e31 = 0.0
-            e52 = 0.0
-            e32 = 0.0
-            e53 = 0.0
-            e33 = 0.0
-            for jj in range(R._E5NZ.size):
-                j = R._E5NZ[jj]
-                a = R.E5_RK[j]
-                e50 += a * KE[j, i, l]
-                e51 += a * KE[j, i, l + 1]
-                e52 += a * KE[j, i, l + 2]
-                e53 += a * KE[j, i, l + 3]
-            for jj in range(R._E3NZ.size):
-                j = R._E3NZ[jj]
-                a = R.E3_RK[j]
-                e30 += a * KE[j, i, l]
-                e31 += a * KE[j, i, l + 1]
-                e32 += a * KE[j, i, l + 2]
-                e33 += a * KE[j, i, l + 3]
-            sc = tolL[l] * (1.0 + max(abs(y0[i, l]), abs(y1[i, l])))
-            e5 = e50 / sc
-            e3 = e30 / sc
-            d = e5 * e5 + 0.01 * e3 * e3
-            if d > 0.0:
-                e = abs(hL[l]) * e5 * e5 / math.sqrt(d)
-                if e > errL[l]:
-                    errL[l] = e
-            elif not (d == 0.0):
-                errL[l] = np.inf
-            sc = tolL[l + 1] * (1.0 + max(abs(y0[i, l + 1]), abs(y1[i, l + 1])))
-            e5 = e51 / sc
-            e3 = e31 / sc
-            d = e5 * e5 + 0.01 * e3 * e3
-            if d > 0.0:
-                e = abs(hL[l + 1]) * e5 * e5 / math.sqrt(d)
-                if e > errL[l + 1]:
-                    errL[l + 1] = e
-            elif not (d == 0.0):
-                errL[l + 1] = np.inf
-            sc = tolL[l + 2] * (1.0 + max(abs(y0[i, l + 2]), abs(y1[i, l + 2])))
-            e5 = e52 / sc
-            e3 = e32 / sc
-            d = e5 * e5 + 0.01 * e3 * e3
-            if d > 0.0:
-                e = abs(hL[l + 2]) * e5 * e5 / math.sqrt(d)
-                if e > errL[l + 2]:
-                    errL[l + 2] = e
-            elif not (d == 0.0):
-                errL[l + 2] = np.inf
-            sc = tolL[l + 3] * (1.0 + max(abs(y0[i, l + 3]), abs(y1[i, l + 3])))
-            e5 = e53 / sc
-            e3 = e33 / sc
-            d = e5 * e5 + 0.01 * e3 * e3
-            if d > 0.0:
-                e = abs(hL[l + 3]) * e5 * e5 / math.sqrt(d)
-                if e > errL[l + 3]:
-                    errL[l + 3] = e
-            elif not (d == 0.0):
-                errL[l + 3] = np.inf
+        for lane in range(W):
+            v = ev[i, lane]
+            if v > errL[lane]:
+                errL[lane] = v
 
 
-#: elements per chunk of the flat stage sums (a chunk of the sum stays in L1)
-CHUNK = 1024
-
-
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _stage_flat(st, hx, y0, KE, out):
     """out = y0 + h_lane sum_j A[st, j] K_j for every lane, with the arithmetic of
     rk._stage_state; ``hx`` holds each element's lane step (h of its lane). Flat,
@@ -451,96 +211,151 @@ def _stage_flat(st, hx, y0, KE, out):
                 oc[i] += (hc[i] * a) * Kc[i]
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
-def advance_lanes(N, L, act, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, cM, sM, sigM, rinv0,
-                  yE0, KE, yEt, yE1, cE, sE, SE, cpE, dpE, sigE, hL, lastL, errL, tolL, hx, codes):
-    """Advance the members ``act[:L]`` (one lane each) together until one of them needs
-    Python; ``codes[m]`` then holds the return code of each member m that does (-1:
-    none). The per-member arrays (first index m) are those of a single run's engine;
-    the lane buffers have ``W = yE0.shape[1] >= L`` columns, a multiple of 4 (the
-    lanes past L repeat lane 0 and are ignored)."""
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _y1_flat(hx, y0, KE, out):
+    """out = y0 + h_lane sum_j B_j K_j (rk.rk_step's end state, :func:`rk.end_sum`)."""
+    m = out.size
+    o = out.reshape(-1)
+    y = y0.reshape(-1)
+    Kf = KE.reshape(KE.shape[0], m)
+    for i in range(m):
+        o[i] = y[i] + hx[i] * R.end_sum(Kf, i)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _lane_columns(A, B, mask):
+    """B[..., lane] = A[..., lane] for the lanes with ``mask[lane]`` (A, B of one shape)."""
+    W = mask.size
+    Af = A.reshape(-1)
+    Bf = B.reshape(-1)
+    for r in range(Af.size // W):
+        b = r * W
+        for lane in range(W):
+            if mask[lane]:
+                Bf[b + lane] = Af[b + lane]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _lanes_in(N, act, fresh, g, Y0s, Y1s, KKs, ctls, YA, YB, KL):
+    """Copy the two step slots of each member whose lane is ``fresh`` into its lane: its
+    last accepted step (slot ``ctl[Q_SLOT]``) to parity 1 - g, the other slot to g."""
     n = 2 * N
-    W = yE0.shape[1]
-    for lane in range(L):
+    for lane in range(act.size):
+        if not fresh[lane]:
+            continue
+        m = act[lane]
+        sl = int(ctls[m, R.Q_SLOT])
+        for par in range(2):
+            src = sl if par == 1 - g else 1 - sl
+            for i in range(n):
+                YA[par, i, lane] = Y0s[m, src, i]
+                YB[par, i, lane] = Y1s[m, src, i]
+            for j in range(R.NS + 1):
+                for i in range(n):
+                    KL[par, j, i, lane] = KKs[m, src, j, i]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _lanes_out(N, act, codes, g, Y0s, Y1s, KKs, ctls, YA, YB, KL):
+    """The inverse of :func:`_lanes_in` for the members with a return code."""
+    n = 2 * N
+    for lane in range(act.size):
+        m = act[lane]
+        if codes[m] < 0:
+            continue
+        sl = int(ctls[m, R.Q_SLOT])
+        for par in range(2):
+            dst = sl if par == 1 - g else 1 - sl
+            for i in range(n):
+                Y0s[m, dst, i] = YA[par, i, lane]
+                Y1s[m, dst, i] = YB[par, i, lane]
+            for j in range(R.NS + 1):
+                for i in range(n):
+                    KKs[m, dst, j, i] = KL[par, j, i, lane]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, rinv0, YA, YB, KL, yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes):
+    """Advance the members ``act`` (one lane each, ``W = act.size`` lanes) together
+    until one of them needs Python; ``codes[m]`` then holds the return code of each
+    member m that does (-1: none), and those members' rows their two step slots.
+
+    The per-member arrays (first index m) are those of a single run's engine. The
+    lanes keep their step slots themselves, between calls too, in two parities:
+    ``YA, YB`` (2, 2N, W) the start and end states, ``KL`` (2, 13, 2N, W) the stages.
+    Every attempt writes parity ``g = par[0]`` and starts from parity 1 - g, where each
+    lane's last accepted step is; after an iteration in which some lane accepted, g
+    flips, and the lanes that rejected copy their last step across (so that it is again
+    at 1 - g). Lanes marked ``fresh`` are first loaded from their members' rows. Each
+    member's diagnostics and bookkeeping (:func:`rk.after_attempt`) run exactly as in a
+    single run, on its lane's columns.
+    """
+    n = 2 * N
+    W = act.size
+    g = par[0]
+    for lane in range(W):
         ctls[act[lane], R.Q_NCALL] = 0.0
-        tolL[lane] = ctls[act[lane], R.Q_TOL]
-    first = True
-    slot = np.zeros(L, dtype=np.int64)  # per lane: the member's current slot, then the slot of its attempt
-    acc = np.zeros(L, dtype=np.bool_)
+    for i in range(n):
+        b = i * W
+        for lane in range(W):
+            tolx[b + lane] = ctls[act[lane], R.Q_TOL]
+    _lanes_in(N, act, fresh, g, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+    rej = np.zeros(W, dtype=np.bool_)
     while True:
-        for lane in range(L):
-            m = act[lane]
-            slot[lane] = int(ctls[m, R.Q_SLOT])
-            h, last = R.step_size(ctls[m])
+        for lane in range(W):
+            h, last = R.step_size(ctls[act[lane]])
             hL[lane] = h
             lastL[lane] = 1.0 if last else 0.0
-        # copies between the members' rows and the lane buffers run with the lane index
-        # innermost, so that each cache line of a lane buffer is touched once per copy
-        for i in range(n):
-            for lane in range(L):
-                m = act[lane]
-                yE0[i, lane] = Y1s[m, slot[lane], i]
-                KE[0, i, lane] = KKs[m, slot[lane], R.NS, i]
-        if first:  # the padding lanes: a copy of lane 0 (finite; its results are not used)
-            first = False
-            for lane in range(L, W):
-                hL[lane] = hL[0]
-                tolL[lane] = tolL[0]
-                for i in range(n):
-                    yE0[i, lane] = yE0[i, 0]
-                    KE[0, i, lane] = KE[0, i, 0]
-        for i in range(n):  # each element's lane step, for the flat stage sums
+        for i in range(n):  # each element's lane step, for the flat sums
             b = i * W
             for lane in range(W):
                 hx[b + lane] = hL[lane]
+        ya = YA[g]
+        yb = YB[g]
+        Kg = KL[g]
+        ypf = YB[1 - g].reshape(-1)  # start: the last accepted state, and its derivative (FSAL)
+        yaf = ya.reshape(-1)
+        k0 = Kg[0].reshape(-1)
+        kp = KL[1 - g, R.NS].reshape(-1)
+        for i in range(n * W):
+            yaf[i] = ypf[i]
+            k0[i] = kp[i]
         for st in range(1, R.NS):
-            _stage_flat(st, hx, yE0, KE, yEt)
-            _rhs_tiles(N, yEt, KE[st], cE, sE, SE, cpE, dpE, sigE)
-        _stage_flat(R.NSX, hx, yE0, KE, yE1)  # (row NSX of _NZ: the weights B)
-        _rhs_tiles(N, yE1, KE[R.NS], cE, sE, SE, cpE, dpE, sigE)
-        # ---- error of each lane (as rk.rk_step)
-        _err_tiles(n, hL, yE0, yE1, KE, tolL, errL)
-        # ---- accepted steps go into the member's other slot
+            _stage_flat(st, hx, ya, Kg, yEt)
+            rhs_lanes(N, yEt, Kg[st], c, s, S, C, P, Q, cp, dp, sig)
+        _y1_flat(hx, ya, Kg, yb)
+        rhs_lanes(N, yb, Kg[R.NS], c, s, S, C, P, Q, cp, dp, sig)
+        _err_lanes(n, hx, tolx, ya, yb, Kg, ev, errL)
+        # ---- each member's own bookkeeping, on its lane's new state, trigonometry and tension
         n_acc = 0
-        for lane in range(L):
-            slot[lane] = 1 - slot[lane]
-            acc[lane] = R.accepted(errL[lane])
-            n_acc += acc[lane]
-        if n_acc:
-            for i in range(n):
-                for lane in range(L):
-                    if acc[lane]:
-                        m = act[lane]
-                        Y0s[m, slot[lane], i] = yE0[i, lane]
-                        Y1s[m, slot[lane], i] = yE1[i, lane]
-            for j in range(R.NS + 1):
-                for i in range(n):
-                    for lane in range(L):
-                        if acc[lane]:
-                            KKs[act[lane], slot[lane], j, i] = KE[j, i, lane]
-            for j in range(N):
-                for lane in range(L):
-                    if acc[lane]:
-                        m = act[lane]
-                        cM[m, j] = cE[j, lane]
-                        sM[m, j] = sE[j, lane]
-                        sigM[m, j] = sigE[j, lane]
-        # ---- each member's own bookkeeping
         stop = False
-        for lane in range(L):
+        for lane in range(W):
             m = act[lane]
-            code = R.after_attempt(N, errL[lane], hL[lane], lastL[lane] != 0.0, slot[lane], Y1s[m], TSs[m], HSs[m],
-                                   DOKs[m], cM[m], sM[m], sigM[m], Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m])
+            ok = R.accepted(errL[lane])
+            rej[lane] = not ok
+            n_acc += ok
+            code = R.after_attempt(N, errL[lane], hL[lane], lastL[lane] != 0.0, 1 - int(ctls[m, R.Q_SLOT]),
+                                   yb[:, lane], TSs[m], HSs[m], DOKs[m], c[:, lane], s[:, lane], sig[:, lane],
+                                   Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m])
             if code >= 0:
                 codes[m] = code
                 stop = True
+        if n_acc:
+            g = 1 - g
+            if n_acc < W:  # the lanes that rejected: their last step to parity 1 - g
+                _lane_columns(YA[g], YA[1 - g], rej)
+                _lane_columns(YB[g], YB[1 - g], rej)
+                _lane_columns(KL[g], KL[1 - g], rej)
         if stop:
+            par[0] = g
+            _lanes_out(N, act, codes, g, Y0s, Y1s, KKs, ctls, YA, YB, KL)
             return
 
 
 class _Lanes:
     """Stacked per-member arrays (the members' engines hold views into them) and the
-    interleaved lane buffers (as many lanes as active members, rounded up to 4)."""
+    lane buffers of :func:`advance_lanes` (one lane per active member), kept between
+    calls while the set of active members stays the same."""
 
     def __init__(self, engines):
         M = len(engines)
@@ -553,33 +368,47 @@ class _Lanes:
             setattr(self, name, stack)
             for m, e in enumerate(engines):
                 setattr(e, name, stack[m])  # the engine now works on its row
-        self.c = np.zeros((M, N))
-        self.s = np.zeros((M, N))
-        self.sig = np.zeros((M, N))
         self.rinv0 = engines[0].rinv0
         self.codes = np.full(M, -1, dtype=np.int64)
-        self.W = 0
+        self.act = np.zeros(0, dtype=np.int64)
+        self.par = np.zeros(1, dtype=np.int64)
 
     def _buffers(self, W: int) -> None:
         n, N = 2 * self.N, self.N
-        self.W = W
-        self.yE0 = np.zeros((n, W))
-        self.KE = np.zeros((R.NS + 1, n, W))
+        self.YA = np.zeros((2, n, W))
+        self.YB = np.zeros((2, n, W))
+        self.KL = np.zeros((2, R.NS + 1, n, W))
         self.yEt = np.zeros((n, W))
-        self.yE1 = np.zeros((n, W))
-        self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE = (np.zeros((N, W)) for _ in range(6))
-        self.hL, self.lastL, self.errL, self.tolL = (np.zeros(W) for _ in range(4))
+        self.ev = np.zeros((n, W))
+        self.work = LaneWork(N, W)
+        self.hL, self.lastL, self.errL = (np.zeros(W) for _ in range(3))
         self.hx = np.zeros(n * W)
+        self.tolx = np.zeros(n * W)
 
     def advance(self, act: np.ndarray) -> None:
-        W = 4 * ((act.size + 3) // 4)
-        if W != self.W:
-            self._buffers(W)
+        """Advance the members ``act`` until some need Python (their codes in ``codes``)."""
         self.codes[:] = -1
-        advance_lanes(self.N, act.size, act, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ctl, self.rec,
-                      self.pk, self.meas, self.Z, self.c, self.s, self.sig, self.rinv0, self.yE0, self.KE, self.yEt,
-                      self.yE1, self.cE, self.sE, self.SE, self.cpE, self.dpE, self.sigE, self.hL, self.lastL,
-                      self.errL, self.tolL, self.hx, self.codes)
+        same = np.array_equal(act, self.act)
+        if not same and self.act.size:  # the lanes change: every member's slots back to its rows first
+            everyone = np.zeros(self.M, dtype=np.int64)
+            _lanes_out(self.N, self.act, everyone, int(self.par[0]), self.Y0, self.Y1, self.KK, self.ctl, self.YA,
+                       self.YB, self.KL)
+            self.act = np.zeros(0, dtype=np.int64)
+        if act.size == 1:  # one member left: the single-run loop is the faster kernel
+            m = int(act[0])
+            e = self.engines[m]
+            w = e.w
+            self.codes[m] = R.advance_rk(e.N, e.Y0, e.Y1, e.KK, e.TS, e.HS, e.DOK, e.ytmp, w.c, w.s, w.S, w.cp,
+                                         w.dp, w.sig, e.Z, e.rinv0, e.ctl, e.rec, e.pk, e.meas)
+            return
+        if not same:
+            self._buffers(act.size)
+        fresh = np.full(act.size, not same)
+        self.act = act.copy()
+        advance_lanes(self.N, act, fresh, self.par, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ctl,
+                      self.rec, self.pk, self.meas, self.Z, self.rinv0, self.YA, self.YB,
+                      self.KL, self.yEt, self.ev, *self.work.args(), self.hL, self.lastL, self.errL,
+                      self.hx, self.tolx, self.codes)
 
 
 def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end: float | None = None,
@@ -590,13 +419,10 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     kernel advancing all of them, each with its own adaptive DOP853 step.
 
     Same physics, numerics, stop rules and Dataset as ``run(chi, N, method="dop853",
-    ...)`` for each chi (the angle form of :mod:`snapping.simulate.angles`); the members
-    share only the arithmetic. The interleaved tension recurrence is cheaper per member
-    than one chain's (latency-bound), but the rest of a step is not, and members that
-    need fewer steps idle in their lanes: measured, an ensemble costs 1.0-1.4x as much
-    as separate single runs (``benchmarks/bench_methods.py``; the parts of a step in
-    ``benchmarks/bench_step_costs.py``), so prefer single runs
-    for speed; use an ensemble to keep several chi in one process and one call.
+    ...)`` for each chi (the angle form of :mod:`snapping.simulate.angles`), bit for
+    bit; the members share only the arithmetic. Measured, an ensemble costs 1.1-1.2x as
+    much as separate single runs (see the module docstring), so prefer single runs for
+    speed; use an ensemble to keep several chi in one process and one call.
 
     Parameters
     ----------

@@ -36,7 +36,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .. import _validate as V
 from . import angles as AG
 from ._engine_common import CheckpointMixin, checkpoint_getter
 from . import kernels as K

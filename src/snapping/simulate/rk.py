@@ -82,7 +82,7 @@ RET_REFINE = 7  # (the other return codes are those of kernels.advance)
 GO_REJECTED, GO_ON = -2, -1
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _stage_state(n, s, h, y0, Kst, out):
     """out = y0 + h sum_j A[s, j] K_j over the nonzero A[s, j]."""
     m = _NZ[s]
@@ -99,7 +99,7 @@ def _stage_state(n, s, h, y0, Kst, out):
             out[i] += a * Kj[i]
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def rk_step(N, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol):
     """One DOP853 step of size h from y0 (with Kst[0] = f(y0)) into y1; Kst[1..12] are
     filled (Kst[12] = f(y1), and c, s, sig then belong to y1). Returns the scaled
@@ -109,35 +109,48 @@ def rk_step(N, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol):
         _stage_state(n, st, h, y0, Kst, ytmp)
         AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
     for i in range(n):
-        acc = 0.0
-        for j in range(NS):
-            acc += B_RK[j] * Kst[j, i]
-        y1[i] = y0[i] + h * acc
+        y1[i] = y0[i] + h * end_sum(Kst, i)
     AG.angle_rhs(N, y1, Kst[NS], c, s, S, cp, dp, sig)
+    for i in range(n):  # (elementwise first: the loop vectorises; then the maximum)
+        ytmp[i] = scaled_error(Kst, i, y0[i], y1[i], h, tol)
     err = 0.0
     for i in range(n):
-        e5 = 0.0
-        for jj in range(_E5NZ.size):
-            j = _E5NZ[jj]
-            e5 += E5_RK[j] * Kst[j, i]
-        e3 = 0.0
-        for jj in range(_E3NZ.size):
-            j = _E3NZ[jj]
-            e3 += E3_RK[j] * Kst[j, i]
-        sc = tol * (1.0 + max(abs(y0[i]), abs(y1[i])))
-        e5 /= sc
-        e3 /= sc
-        d = e5 * e5 + 0.01 * e3 * e3
-        if d > 0.0:
-            e = abs(h) * e5 * e5 / math.sqrt(d)
-            if e > err:
-                err = e
-        elif not (d == 0.0):  # NaN
-            return np.inf
+        if ytmp[i] > err:
+            err = ytmp[i]
     return err
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def end_sum(Kst, i):
+    """sum_j B_j K_j[i], the stage combination of the end state (in stage order, from 0.0)."""
+    acc = 0.0
+    for j in range(NS):
+        acc += B_RK[j] * Kst[j, i]
+    return acc
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def scaled_error(Kst, i, y0i, y1i, h, tol):
+    """Component i's term of the scaled error of a step (Hairer's DOP853 norm; the error
+    is the maximum over i): 0 where both estimates vanish, inf where they are NaN.
+    Branch-free, so that a loop over i vectorises."""
+    e5 = 0.0
+    for jj in range(_E5NZ.size):
+        j = _E5NZ[jj]
+        e5 += E5_RK[j] * Kst[j, i]
+    e3 = 0.0
+    for jj in range(_E3NZ.size):
+        j = _E3NZ[jj]
+        e3 += E3_RK[j] * Kst[j, i]
+    sc = tol * (1.0 + max(abs(y0i), abs(y1i)))
+    e5 /= sc
+    e3 /= sc
+    d = e5 * e5 + 0.01 * e3 * e3
+    v = abs(h) * e5 * e5 / math.sqrt(d)
+    return v if d > 0.0 else (0.0 if d == 0.0 else np.inf)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def dense_build(N, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig):
     """The 7 dense-output coefficient vectors F of a step (3 more evaluations)."""
     n = 2 * N
@@ -158,7 +171,7 @@ def dense_build(N, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig):
             F[3 + r, i] = h * acc
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def dense_eval(N, x, y0, F, out):
     """The dense output at the fraction x in [0, 1] of the step (scipy's Horner form)."""
     n = 2 * N
@@ -173,12 +186,12 @@ def dense_eval(N, x, y0, F, out):
         out[i] = v + y0[i]
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _changed(q, last, thin):
     return abs(q - last) > thin * abs(last)
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def step_size(ctl):
     """(h, last): the next step size, clipped to land on ``ctl[Q_TEND]``."""
     h = ctl[Q_H]
@@ -188,16 +201,16 @@ def step_size(ctl):
     return h, False
 
 
-@njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
 def accepted(err) -> bool:
     """The acceptance rule of :func:`after_attempt`: a finite scaled error <= 1."""
     return err - err == 0.0 and err <= 1.0
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
-def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas):
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas):
     """Everything after the stages of an attempted step of size h into slot ``ns``
-    (whose ``Y1`` holds the new state and c, s, sig its trigonometry and tension):
+    (``y1`` the new state, c, s, sig its trigonometry and tension; any strides):
     rejection and step-size control, or acceptance with the diagnostics, the record,
     peak detection, invariants and the stop rules. Returns :data:`GO_REJECTED`,
     :data:`GO_ON` or a return code for Python. Shared by the single-run loop
@@ -253,7 +266,7 @@ def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         ctl[Q_DT_MAX_ACC] = h
     if err > ctl[Q_ERR_MAX_ACC]:
         ctl[Q_ERR_MAX_ACC] = err
-    AG.measure_angles(N, Y1[ns], c, s, sig, Z, rinv0, meas)
+    AG.measure_angles(N, y1, c, s, sig, Z, rinv0, meas)
     # ---- running peaks (every accepted step)
     for qi in range(4):
         if qi == 0:
@@ -335,7 +348,7 @@ def after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     return GO_ON
 
 
-@njit(cache=True, fastmath=False, boundscheck=False)
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas):
     """Advance the angle-form chain with DOP853 until something needs Python.
 
@@ -361,6 +374,6 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
             y0[i] = ycur[i]
             KK[ns, 0, i] = KK[sl, NS, i]
         err = rk_step(N, h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol)
-        code = after_attempt(N, err, h, last, ns, Y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas)
+        code = after_attempt(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas)
         if code >= 0:
             return code
