@@ -264,10 +264,10 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     ensemble : int, optional
         Run up to this many chi of one N together in one ensemble kernel
         (:func:`snapping.simulate.run_ensemble`; the grid's ``method`` must be
-        ``"fast"``/``"dop853"``). Each member's file holds the run of its single run's
-        physics and options (peaks equal to ~1e-9; step counts may differ slightly).
-        Ensembles are not checkpointed: an interrupted one restarts. They save
-        processes, not time (measured 1.0-1.4x the cost of single runs).
+        ``"fast"``/``"dop853"``). Each member's file holds its single run's Dataset,
+        bit for bit but ``wall_time``. Ensembles are not checkpointed: an interrupted
+        one restarts. They save processes, not time (measured 1.1-1.2x the cost of
+        single runs).
 
     Examples
     --------

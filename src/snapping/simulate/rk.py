@@ -108,10 +108,24 @@ def rk_step(N, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol):
     for st in range(1, NS):
         _stage_state(n, st, h, y0, Kst, ytmp)
         AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
+    end_state(n, h, y0, Kst, y1)
+    AG.angle_rhs(N, y1, Kst[NS], c, s, S, cp, dp, sig)
+    return step_error(n, h, tol, y0, y1, Kst, ytmp)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def end_state(n, h, y0, Kst, y1):
+    """y1 = y0 + h sum_j B_j K_j, the end state of a step."""
     for i in range(n):
         y1[i] = y0[i] + h * end_sum(Kst, i)
-    AG.angle_rhs(N, y1, Kst[NS], c, s, S, cp, dp, sig)
-    for i in range(n):  # (elementwise first: the loop vectorises; then the maximum)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def step_error(n, h, tol, y0, y1, Kst, ytmp):
+    """The scaled error of a step (accept if <= 1): the maximum over i of
+    :func:`scaled_error`, computed elementwise into ``ytmp`` first so that the loop
+    vectorises."""
+    for i in range(n):
         ytmp[i] = scaled_error(Kst, i, y0[i], y1[i], h, tol)
     err = 0.0
     for i in range(n):
