@@ -237,46 +237,38 @@ def _lane_columns(A, B, mask):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _lanes_in(N, act, fresh, g, Y0s, Y1s, KKs, ctls, YA, YB, KL):
-    """Copy the two step slots of each member whose lane is ``fresh`` into its lane: its
-    last accepted step (slot ``ctl[Q_SLOT]``) to parity 1 - g, the other slot to g."""
+def _lanes_copy(N, act, sel, g, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
+    """Copy the two step slots of each selected member (``sel[lane]``) between its rows
+    and its lane: into the lanes if ``into_lanes``, else back to the rows. In the lanes
+    the member's last accepted step (slot ``ctl[Q_SLOT]``) is at parity 1 - g, the
+    other slot at g."""
     n = 2 * N
     for lane in range(act.size):
-        if not fresh[lane]:
+        if not sel[lane]:
             continue
         m = act[lane]
         sl = int(ctls[m, R.Q_SLOT])
         for par in range(2):
-            src = sl if par == 1 - g else 1 - sl
-            for i in range(n):
-                YA[par, i, lane] = Y0s[m, src, i]
-                YB[par, i, lane] = Y1s[m, src, i]
-            for j in range(R.NS + 1):
+            k = sl if par == 1 - g else 1 - sl
+            if into_lanes:
                 for i in range(n):
-                    KL[par, j, i, lane] = KKs[m, src, j, i]
+                    YA[par, i, lane] = Y0s[m, k, i]
+                    YB[par, i, lane] = Y1s[m, k, i]
+                for j in range(R.NS + 1):
+                    for i in range(n):
+                        KL[par, j, i, lane] = KKs[m, k, j, i]
+            else:
+                for i in range(n):
+                    Y0s[m, k, i] = YA[par, i, lane]
+                    Y1s[m, k, i] = YB[par, i, lane]
+                for j in range(R.NS + 1):
+                    for i in range(n):
+                        KKs[m, k, j, i] = KL[par, j, i, lane]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _lanes_out(N, act, codes, g, Y0s, Y1s, KKs, ctls, YA, YB, KL):
-    """The inverse of :func:`_lanes_in` for the members with a return code."""
-    n = 2 * N
-    for lane in range(act.size):
-        m = act[lane]
-        if codes[m] < 0:
-            continue
-        sl = int(ctls[m, R.Q_SLOT])
-        for par in range(2):
-            dst = sl if par == 1 - g else 1 - sl
-            for i in range(n):
-                Y0s[m, dst, i] = YA[par, i, lane]
-                Y1s[m, dst, i] = YB[par, i, lane]
-            for j in range(R.NS + 1):
-                for i in range(n):
-                    KKs[m, dst, j, i] = KL[par, j, i, lane]
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, rinv0, YA, YB, KL, yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes):
+def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, rinv0, YA, YB, KL,
+                  yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes):
     """Advance the members ``act`` (one lane each, ``W = act.size`` lanes) together
     until one of them needs Python; ``codes[m]`` then holds the return code of each
     member m that does (-1: none), and those members' rows their two step slots.
@@ -300,7 +292,7 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
         b = i * W
         for lane in range(W):
             tolx[b + lane] = ctls[act[lane], R.Q_TOL]
-    _lanes_in(N, act, fresh, g, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+    _lanes_copy(N, act, fresh, g, True, Y0s, Y1s, KKs, ctls, YA, YB, KL)
     rej = np.zeros(W, dtype=np.bool_)
     while True:
         for lane in range(W):
@@ -349,7 +341,9 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
                 _lane_columns(KL[g], KL[1 - g], rej)
         if stop:
             par[0] = g
-            _lanes_out(N, act, codes, g, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+            for lane in range(W):
+                rej[lane] = codes[act[lane]] >= 0  # (now: the members that need Python)
+            _lanes_copy(N, act, rej, g, False, Y0s, Y1s, KKs, ctls, YA, YB, KL)
             return
 
 
@@ -391,9 +385,8 @@ class _Lanes:
         self.codes[:] = -1
         same = np.array_equal(act, self.act)
         if not same and self.act.size:  # the lanes change: every member's slots back to its rows first
-            everyone = np.zeros(self.M, dtype=np.int64)
-            _lanes_out(self.N, self.act, everyone, int(self.par[0]), self.Y0, self.Y1, self.KK, self.ctl, self.YA,
-                       self.YB, self.KL)
+            _lanes_copy(self.N, self.act, np.ones(self.act.size, dtype=np.bool_), int(self.par[0]), False, self.Y0,
+                        self.Y1, self.KK, self.ctl, self.YA, self.YB, self.KL)
             self.act = np.zeros(0, dtype=np.int64)
         if act.size == 1:  # one member left: the single-run loop is the faster kernel
             m = int(act[0])
