@@ -250,6 +250,25 @@ def test_ensemble_members_equal_single_runs_bit_for_bit():
         assert 0.5 in ds["t_snapshot"].values
 
 
+def test_ensemble_member_failing_on_a_rejected_step_equals_its_single_run():
+    """A member that fails on a rejected attempt (its step below dt_min) while another
+    member accepts in the same iteration: its Dataset, failure node and reason included,
+    equals the single run's (which keeps the failed attempt for the diagnosis)."""
+    from snapping.simulate import SimulationError, run_ensemble
+
+    with pytest.warns(UserWarning, match="chi=0.1 failed"):
+        dss = run_ensemble([0.1, 0.2], 40, dt_min=3e-4)
+    with pytest.raises(SimulationError) as info:
+        run(0.1, 40, method="fast", dt_min=3e-4)
+    for ds, single in ((dss[0], info.value.dataset), (dss[1], run(0.2, 40, method="fast", dt_min=3e-4).dataset)):
+        a, b = ds.attrs, single.attrs
+        assert {k for k in set(a) | set(b) if str(a.get(k)) != str(b.get(k))} == {"wall_time"}
+        for v in ds.data_vars:
+            np.testing.assert_array_equal(ds[v].values, single[v].values, err_msg=v)
+    assert dss[0].attrs["status"] == "failed" and dss[0].attrs["failure_node"] > 0
+    assert dss[1].attrs["status"] == "completed"
+
+
 @pytest.mark.parametrize("N", [1, 2, 3, 37])
 @pytest.mark.parametrize("W", [1, 2, 3, 8])
 def test_rhs_lanes_equals_angle_rhs_bit_for_bit(N, W):

@@ -15,11 +15,12 @@ themselves (for the dense output); after each attempt the member's own bookkeepi
 run. Every operation is the single run's, in the same order, so an ensemble member's
 Dataset equals that of its single run bit for bit (all but ``wall_time``).
 
-Cost: the lanes make the tension recurrence about 1.3x cheaper per member (4.1 against
-5.3 ns per node at 8 lanes), but the rest of a step (sines and cosines, stage sums,
-error norm, diagnostics) is already vectorised along the chain in a single run, and
-the lanes multiply the working set by their number (out of the core's L2 cache from
-N ~ 1000 at 8 lanes). Measured on a
+Cost: at 8 lanes the coupling coefficients, the tension recurrence and the
+accelerations cost 1.3x less per member (4.1 against 5.3 ns per node; at 2 lanes they
+cost more), but the rest of a step (sines and cosines, stage sums, error norm,
+diagnostics) is already vectorised along the chain in a single run, and the lanes
+multiply the working set by their number (out of the core's L2 cache from N ~ 1000 at
+8 lanes). Measured on a
 2-core Xeon (``benchmarks/bench_methods.py``, ``benchmarks/bench_step_costs.py``), an
 ensemble costs 1.1-1.2x as much as its members run one after another: use it to keep
 several chi in one process and one call, not for speed.
@@ -237,17 +238,18 @@ def _lane_columns(A, B, mask):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _lanes_copy(N, act, sel, g, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
+def _lanes_copy(N, act, sel, gl, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
     """Copy the two step slots of each selected member (``sel[lane]``) between its rows
-    and its lane: into the lanes if ``into_lanes``, else back to the rows. In the lanes
-    the member's last accepted step (slot ``ctl[Q_SLOT]``) is at parity 1 - g, the
-    other slot at g."""
+    and its lane: into the lanes if ``into_lanes``, else back to the rows. Slot
+    ``ctl[Q_SLOT]`` (the last accepted step) is at parity 1 - gl[lane], the other slot
+    at gl[lane]."""
     n = 2 * N
     for lane in range(act.size):
         if not sel[lane]:
             continue
         m = act[lane]
         sl = int(ctls[m, R.Q_SLOT])
+        g = gl[lane]
         for par in range(2):
             k = sl if par == 1 - g else 1 - sl
             if into_lanes:
@@ -271,7 +273,9 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
                   yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes):
     """Advance the members ``act`` (one lane each, ``W = act.size`` lanes) together
     until one of them needs Python; ``codes[m]`` then holds the return code of each
-    member m that does (-1: none), and those members' rows their two step slots.
+    member m that does (-1: none), and those members' rows their two step slots as a
+    single run has them (the last accepted step, and the step before it or the
+    rejected attempt).
 
     The per-member arrays (first index m) are those of a single run's engine. The
     lanes keep their step slots themselves, between calls too, in two parities:
@@ -292,8 +296,10 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
         b = i * W
         for lane in range(W):
             tolx[b + lane] = ctls[act[lane], R.Q_TOL]
-    _lanes_copy(N, act, fresh, g, True, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+    gl = np.full(W, g)
+    _lanes_copy(N, act, fresh, gl, True, Y0s, Y1s, KKs, ctls, YA, YB, KL)
     rej = np.zeros(W, dtype=np.bool_)
+    out = np.zeros(W, dtype=np.bool_)
     while True:
         for lane in range(W):
             h, last = R.step_size(ctls[act[lane]])
@@ -333,6 +339,11 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
             if code >= 0:
                 codes[m] = code
                 stop = True
+        if stop:  # the members that need Python get their slots back as a single run has them:
+            for lane in range(W):  # the last accepted step, and the step before it or a rejected attempt
+                out[lane] = codes[act[lane]] >= 0
+                gl[lane] = g if rej[lane] else 1 - g
+            _lanes_copy(N, act, out, gl, False, Y0s, Y1s, KKs, ctls, YA, YB, KL)
         if n_acc:
             g = 1 - g
             if n_acc < W:  # the lanes that rejected: their last step to parity 1 - g
@@ -341,9 +352,6 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
                 _lane_columns(KL[g], KL[1 - g], rej)
         if stop:
             par[0] = g
-            for lane in range(W):
-                rej[lane] = codes[act[lane]] >= 0  # (now: the members that need Python)
-            _lanes_copy(N, act, rej, g, False, Y0s, Y1s, KKs, ctls, YA, YB, KL)
             return
 
 
@@ -384,9 +392,10 @@ class _Lanes:
         """Advance the members ``act`` until some need Python (their codes in ``codes``)."""
         self.codes[:] = -1
         same = np.array_equal(act, self.act)
-        if not same and self.act.size:  # the lanes change: every member's slots back to its rows first
-            _lanes_copy(self.N, self.act, np.ones(self.act.size, dtype=np.bool_), int(self.par[0]), False, self.Y0,
-                        self.Y1, self.KK, self.ctl, self.YA, self.YB, self.KL)
+        if not same and self.act.size:  # the lanes change: the staying members' slots back to their rows
+            # first (those that left got theirs when they returned their codes)
+            _lanes_copy(self.N, self.act, np.isin(self.act, act), np.full(self.act.size, int(self.par[0])), False,
+                        self.Y0, self.Y1, self.KK, self.ctl, self.YA, self.YB, self.KL)
             self.act = np.zeros(0, dtype=np.int64)
         if act.size == 1:  # one member left: the single-run loop is the faster kernel
             m = int(act[0])
