@@ -20,10 +20,10 @@ accelerations cost 1.3x less per member (4.1 against 5.3 ns per node; at 2 lanes
 cost more), but the rest of a step (sines and cosines, stage sums, error norm,
 diagnostics) is already vectorised along the chain in a single run, and the lanes
 multiply the working set by their number (out of the core's L2 cache from N ~ 1000 at
-8 lanes). Measured on a
-2-core Xeon (``benchmarks/bench_methods.py``, ``benchmarks/bench_step_costs.py``), an
-ensemble costs 1.1-1.2x as much as its members run one after another: use it to keep
-several chi in one process and one call, not for speed.
+8 lanes). Measured on a 2-core Xeon (``benchmarks/bench_methods.py``,
+``benchmarks/bench_step_costs.py``), an ensemble costs 1.1-1.2x as much as its members
+run one after another: use it to keep several chi in one process and one call, not
+for speed.
 
 Example
 -------
