@@ -257,16 +257,18 @@ def test_ensemble_member_failing_on_a_rejected_step_equals_its_single_run():
     from snapping.simulate import SimulationError, run_ensemble
 
     with pytest.warns(UserWarning, match="chi=0.1 failed"):
-        dss = run_ensemble([0.1, 0.2], 40, dt_min=3e-4)
+        dss = run_ensemble([0.1, 0.2, 0.3], 40, dt_min=3e-4)
+    assert dss[0]["t"].values[-1] < min(ds["t"].values[-1] for ds in dss[1:])  # failed while all 3 in lanes
     with pytest.raises(SimulationError) as info:
         run(0.1, 40, method="fast", dt_min=3e-4)
-    for ds, single in ((dss[0], info.value.dataset), (dss[1], run(0.2, 40, method="fast", dt_min=3e-4).dataset)):
+    singles = [info.value.dataset] + [run(chi, 40, method="fast", dt_min=3e-4).dataset for chi in (0.2, 0.3)]
+    for ds, single in zip(dss, singles):
         a, b = ds.attrs, single.attrs
         assert {k for k in set(a) | set(b) if str(a.get(k)) != str(b.get(k))} == {"wall_time"}
         for v in ds.data_vars:
             np.testing.assert_array_equal(ds[v].values, single[v].values, err_msg=v)
     assert dss[0].attrs["status"] == "failed" and dss[0].attrs["failure_node"] > 0
-    assert dss[1].attrs["status"] == "completed"
+    assert [ds.attrs["status"] for ds in dss[1:]] == ["completed", "completed"]
 
 
 @pytest.mark.parametrize("N", [1, 2, 3, 37])

@@ -9,7 +9,7 @@ the tension solve -- chains of dependent operations that one chain cannot overla
 update all lanes at once at each node, so that the compiler vectorises them across
 the lanes. Each iteration advances every active member by one attempted step (of its
 own size); a member that stops (snap, t_end, failure) leaves the lanes, and the last
-one finishes on the single-run kernel. The lanes keep their members' last two steps
+last two finish on the single-run kernel. The lanes keep their members' last two steps
 themselves (for the dense output); after each attempt the member's own bookkeeping
 (:func:`snapping.simulate.rk.after_attempt`) runs on its lane exactly as in a single
 run. Every operation is the single run's, in the same order, so an ensemble member's
@@ -53,6 +53,9 @@ __all__ = ["run_ensemble", "rhs_lanes", "LaneWork"]
 BLOCK = AG.BLOCK
 #: elements per chunk of the flat stage sums (a chunk of the sum stays in L1)
 CHUNK = 1024
+#: with this many active members or fewer, each runs on the single-run kernel (2 lanes cost
+#: ~1.2x per member what one chain does: ``benchmarks/bench_step_costs.py``)
+SINGLE_BELOW = 2
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -397,12 +400,12 @@ class _Lanes:
             _lanes_copy(self.N, self.act, np.isin(self.act, act), np.full(self.act.size, int(self.par[0])), False,
                         self.Y0, self.Y1, self.KK, self.ctl, self.YA, self.YB, self.KL)
             self.act = np.zeros(0, dtype=np.int64)
-        if act.size == 1:  # one member left: the single-run loop is the faster kernel
-            m = int(act[0])
-            e = self.engines[m]
-            w = e.w
-            self.codes[m] = R.advance_rk(e.N, e.Y0, e.Y1, e.KK, e.TS, e.HS, e.DOK, e.ytmp, w.c, w.s, w.S, w.cp,
-                                         w.dp, w.sig, e.Z, e.rinv0, e.ctl, e.rec, e.pk, e.meas)
+        if act.size <= SINGLE_BELOW:  # few members left: the single-run loop is the faster kernel
+            for m in act:
+                e = self.engines[int(m)]
+                w = e.w
+                self.codes[m] = R.advance_rk(e.N, e.Y0, e.Y1, e.KK, e.TS, e.HS, e.DOK, e.ytmp, w.c, w.s, w.S, w.cp,
+                                             w.dp, w.sig, e.Z, e.rinv0, e.ctl, e.rec, e.pk, e.meas)
             return
         if not same:
             self._buffers(act.size)
@@ -539,9 +542,9 @@ def _warm_up() -> None:
         return
     engines = [HO._Engine(AG.state_to_angles(initial_state(c, 3, chords="exact")), 0.0, tol=1e-6, dt0=None,
                           t_end=0.01, stop_fraction=0.0, thin=0.0, max_link_error=0.5, snapshot_times=())
-               for c in (0.4, 0.6)]
+               for c in (0.4, 0.5, 0.6)]  # (more than SINGLE_BELOW: the lanes' kernel)
     lanes = _Lanes(engines)
     for e in engines:
         e.start()
-    lanes.advance(np.arange(2, dtype=np.int64))
+    lanes.advance(np.arange(3, dtype=np.int64))
     _compiled = True
