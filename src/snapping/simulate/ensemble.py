@@ -241,12 +241,11 @@ def _lane_columns(A, B, mask):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _lanes_copy(N, act, sel, gl, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
+def _lanes_copy(act, sel, gl, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
     """Copy the two step slots of each selected member (``sel[lane]``) between its rows
     and its lane: into the lanes if ``into_lanes``, else back to the rows. Slot
     ``ctl[Q_SLOT]`` (the last accepted step) is at parity 1 - gl[lane], the other slot
     at gl[lane]."""
-    n = 2 * N
     for lane in range(act.size):
         if not sel[lane]:
             continue
@@ -256,19 +255,13 @@ def _lanes_copy(N, act, sel, gl, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
         for par in range(2):
             k = sl if par == 1 - g else 1 - sl
             if into_lanes:
-                for i in range(n):
-                    YA[par, i, lane] = Y0s[m, k, i]
-                    YB[par, i, lane] = Y1s[m, k, i]
-                for j in range(R.NS + 1):
-                    for i in range(n):
-                        KL[par, j, i, lane] = KKs[m, k, j, i]
+                YA[par, :, lane] = Y0s[m, k]
+                YB[par, :, lane] = Y1s[m, k]
+                KL[par, :, :, lane] = KKs[m, k, :R.NS + 1]
             else:
-                for i in range(n):
-                    Y0s[m, k, i] = YA[par, i, lane]
-                    Y1s[m, k, i] = YB[par, i, lane]
-                for j in range(R.NS + 1):
-                    for i in range(n):
-                        KKs[m, k, j, i] = KL[par, j, i, lane]
+                Y0s[m, k] = YA[par, :, lane]
+                Y1s[m, k] = YB[par, :, lane]
+                KKs[m, k, :R.NS + 1] = KL[par, :, :, lane]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -300,7 +293,7 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
         for lane in range(W):
             tolx[b + lane] = ctls[act[lane], R.Q_TOL]
     gl = np.full(W, g)
-    _lanes_copy(N, act, fresh, gl, True, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+    _lanes_copy(act, fresh, gl, True, Y0s, Y1s, KKs, ctls, YA, YB, KL)
     rej = np.zeros(W, dtype=np.bool_)
     out = np.zeros(W, dtype=np.bool_)
     while True:
@@ -346,7 +339,7 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
             for lane in range(W):  # the last accepted step, and the step before it or a rejected attempt
                 out[lane] = codes[act[lane]] >= 0
                 gl[lane] = g if rej[lane] else 1 - g
-            _lanes_copy(N, act, out, gl, False, Y0s, Y1s, KKs, ctls, YA, YB, KL)
+            _lanes_copy(act, out, gl, False, Y0s, Y1s, KKs, ctls, YA, YB, KL)
         if n_acc:
             g = 1 - g
             if n_acc < W:  # the lanes that rejected: their last step to parity 1 - g
@@ -397,7 +390,7 @@ class _Lanes:
         same = np.array_equal(act, self.act)
         if not same and self.act.size:  # the lanes change: the staying members' slots back to their rows
             # first (those that left got theirs when they returned their codes)
-            _lanes_copy(self.N, self.act, np.isin(self.act, act), np.full(self.act.size, int(self.par[0])), False,
+            _lanes_copy(self.act, np.isin(self.act, act), np.full(self.act.size, int(self.par[0])), False,
                         self.Y0, self.Y1, self.KK, self.ctl, self.YA, self.YB, self.KL)
             self.act = np.zeros(0, dtype=np.int64)
         if act.size <= SINGLE_BELOW:  # few members left: the single-run loop is the faster kernel
