@@ -250,25 +250,28 @@ def test_ensemble_members_equal_single_runs_bit_for_bit():
         assert 0.5 in ds["t_snapshot"].values
 
 
-def test_ensemble_member_failing_on_a_rejected_step_equals_its_single_run():
+def test_ensemble_member_failing_on_a_rejected_step_equals_its_single_run(monkeypatch):
     """A member that fails on a rejected attempt (its step below dt_min) while another
     member accepts in the same iteration: its Dataset, failure node and reason included,
-    equals the single run's (which keeps the failed attempt for the diagnosis)."""
+    equals the single run's (which keeps the failed attempt for the diagnosis). Two
+    members kept in the lanes (not handed to the single-run kernel) to reach that case."""
     from snapping.simulate import SimulationError, run_ensemble
+    from snapping.simulate import ensemble as E
 
+    monkeypatch.setattr(E, "SINGLE_BELOW", 1)
     with pytest.warns(UserWarning, match="chi=0.1 failed"):
-        dss = run_ensemble([0.1, 0.2, 0.3], 40, dt_min=3e-4)
-    assert dss[0]["t"].values[-1] < min(ds["t"].values[-1] for ds in dss[1:])  # failed while all 3 in lanes
+        dss = run_ensemble([0.1, 0.2], 40, dt_min=3e-4)
+    assert dss[0]["t"].values[-1] < dss[1]["t"].values[-1]  # failed while both were in the lanes
     with pytest.raises(SimulationError) as info:
         run(0.1, 40, method="fast", dt_min=3e-4)
-    singles = [info.value.dataset] + [run(chi, 40, method="fast", dt_min=3e-4).dataset for chi in (0.2, 0.3)]
+    singles = [info.value.dataset, run(0.2, 40, method="fast", dt_min=3e-4).dataset]
     for ds, single in zip(dss, singles):
         a, b = ds.attrs, single.attrs
         assert {k for k in set(a) | set(b) if str(a.get(k)) != str(b.get(k))} == {"wall_time"}
         for v in ds.data_vars:
             np.testing.assert_array_equal(ds[v].values, single[v].values, err_msg=v)
     assert dss[0].attrs["status"] == "failed" and dss[0].attrs["failure_node"] > 0
-    assert [ds.attrs["status"] for ds in dss[1:]] == ["completed", "completed"]
+    assert dss[1].attrs["status"] == "completed"
 
 
 @pytest.mark.parametrize("N", [1, 2, 3, 37])
