@@ -75,7 +75,7 @@ def loops(chis, N, tol, calls=6, steps_per_call=60):
     def go_single(e):
         w = e.w
         R.advance_rk(e.N, e.Y0, e.Y1, e.KK, e.TS, e.HS, e.DOK, e.ytmp, w.c, w.s, w.S, w.cp, w.dp, w.sig, e.Z,
-                     e.rinv0, e.ctl, e.rec, e.pk, e.meas)
+                     e.rinv0, e.ctl, e.rec, e.pk, e.meas, e.mdl)
 
     def timed(step_all, engs):
         for e in engs:
@@ -121,12 +121,12 @@ def main(argv=None) -> int:
     def book(y1, c, s, sig, e=eng):  # an accepted attempt's diagnostics and bookkeeping
         e.ctl[R.Q_NREC] = 1.0
         R.after_attempt(N, 0.5, 1e-6, False, 1 - int(e.ctl[R.Q_SLOT]), y1, e.TS, e.HS, e.DOK, c, s, sig, e.Z,
-                        e.rinv0, e.ctl, e.rec, e.pk, e.meas)
+                        e.rinv0, e.ctl, e.rec, e.pk, e.meas, e.mdl)
 
     t_sc = per_call(lambda: AG.sincos(N, y, c, s)) * ns
     t_rhs = per_call(lambda: AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)) * ns
     t_sum = per_call(lambda: [R._stage_state(n, st, 1e-3, y, Kst, yt) for st in range(1, R.NS)]) * ns
-    t_step = per_call(lambda: R.rk_step(N, 1e-4, y, y1, Kst, yt, c, s, S, cp, dp, sig, a.tol)) * ns
+    t_step = per_call(lambda: R.rk_step(N, 0.0, 1e-4, y, y1, Kst, yt, c, s, S, cp, dp, sig, a.tol, eng.mdl)) * ns
     t_book = per_call(lambda: book(y, c, s, sig)) * ns
     t_err = per_call(lambda: (R.end_state(n, 1e-4, y, Kst, y1), R.step_error(n, 1e-4, a.tol, y, y1, Kst, yt))) * ns
     print(f"ns per node and chain, N = {N}   sincos     rhs  rhs-sincos  stage sums  end+error  diagnostics"

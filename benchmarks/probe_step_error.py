@@ -15,6 +15,7 @@ import sys
 import numpy as np
 
 from snapping.simulate import angles as AG
+from snapping.simulate import general as G
 from snapping.simulate import rk as R
 from snapping.simulate import run
 
@@ -38,7 +39,7 @@ Kst = np.zeros((R.NS + 1, n)); y1 = np.zeros(n); yt = np.zeros(n)
 AG.angle_rhs(N, y0, Kst[0], w.c, w.s, w.S, w.cp, w.dp, w.sig)
 tol = 1e-8
 for hh in (h, 2 * h, 4 * h):
-    err = R.rk_step(N, hh, y0, y1, Kst, yt, w.c, w.s, w.S, w.cp, w.dp, w.sig, tol)
+    err = R.rk_step(N, 0.0, hh, y0, y1, Kst, yt, w.c, w.s, w.S, w.cp, w.dp, w.sig, tol, G.uniform_model(N))
     e5 = sum(R.E5_RK[j] * Kst[j] for j in range(R.NS)); e3 = sum(R.E3_RK[j] * Kst[j] for j in range(R.NS))
     sc = tol * (1 + np.maximum(abs(y0), abs(y1)))
     e5s, e3s = e5 / sc, e3 / sc

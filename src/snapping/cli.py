@@ -148,6 +148,15 @@ def _cmd_estimate(args) -> int:
 
 
 # ------------------------------------------------------------------------ simulate
+def _problem_title(summary, args) -> str:
+    parts = []
+    for k in ("start", "tip_mass", "pin_motion", "gravity"):
+        if k in summary:
+            parts.append(f"{k}={summary[k]}")
+    return ", ".join(parts) or "general problem"
+
+
+
 def _add_simulate(sub) -> None:
     p = sub.add_parser(
         "simulate",
@@ -173,6 +182,17 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2\n"
             "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
             "\n"
+            "other chains, starts and held ends (method fast; every option is nondimensional:\n"
+            "lengths in chain lengths, masses in chain masses, time in sqrt(length/g)):\n"
+            "  snapping simulate --chi 0.3 --N 500 --method fast --tip-mass 0.2       # a payload at the end\n"
+            "  snapping simulate --chi 0.3 --N 500 --method fast --taper 0.1          # a whip, linear taper\n"
+            "  snapping simulate --chi 0.3 --N 500 --method fast --taper 0.1:2        # power-law taper\n"
+            "  snapping simulate --supports 0.4,0.2 --N 300 --method fast             # 2nd support 0.2 lower\n"
+            "  snapping simulate --shape start.csv --N 300 --method fast              # x,y from the held end\n"
+            "  snapping simulate --chi 0.5 --N 300 --method fast --pin-motion flick:3,0,0.25  # flick the end\n"
+            "  snapping simulate --chi 0.5 --N 300 --method fast --pin-motion pull:0,-2,0.3   # yank it up\n"
+            "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
+            "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit."
@@ -193,6 +213,20 @@ def _add_simulate(sub) -> None:
                    help="record a step only if a maximum changed by more than this fraction (default 0: all)")
     p.add_argument("--chords", default="arclength", choices=["arclength", "exact"],
                    help="initial nodes at equal arclength (the paper's) or with exact chords 1/N")
+    p.add_argument("--tip-mass", type=float, default=0.0, metavar="RATIO",
+                   help="point mass at the free end, as a ratio to the chain's mass (default 0)")
+    p.add_argument("--taper", default=None, metavar="RATIO[:POWER]",
+                   help="mass per length falling as (1 - c s)^POWER to RATIO of its value at the held end")
+    p.add_argument("--lumping", default=None, choices=["shared", "paper"],
+                   help="node masses: each node's share of its two links (default with --taper) or the "
+                        "paper's whole link per node (default otherwise)")
+    p.add_argument("--supports", default=None, metavar="DX,DY",
+                   help="start: the catenary between the held end and a support at (DX, DY), y downward")
+    p.add_argument("--shape", default=None, metavar="FILE",
+                   help="start: a curve x,y (CSV or netCDF) listed from the held end; nodes at exact chords")
+    p.add_argument("--pin-motion", default=None, metavar="SPEC",
+                   help="held end: fixed (default), pull:AX,AY[,DURATION[,T0]] or flick:AX,AY,PERIOD[,T0]")
+    p.add_argument("--gravity", type=float, default=1.0, help="gravity along +y in units of g (default 1; 0: none)")
     p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
                    help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
@@ -219,19 +253,31 @@ def _cmd_simulate(args) -> int:
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
     progress = False if args.no_progress else None
-    if args.resume is None and (args.chi is None or args.N is None):
-        raise SnappingInputError("the arguments --chi and --N are required (or --resume RUN.nc)")
+    start_given = args.chi is not None or args.supports is not None or args.shape is not None
+    if args.resume is None and (not start_given or args.N is None):
+        raise SnappingInputError("the arguments --chi (or --supports/--shape) and --N are required (or --resume RUN.nc)")
+    problem = None
+    if args.resume is None:
+        from .simulate.problem import from_options
+
+        taper = None if args.taper is None else _numbers("--taper", args.taper.replace(":", ","), 1, 2)
+        supports = None if args.supports is None else _numbers("--supports", args.supports, 2, 2)
+        problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
+                               tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
+                               pin_motion=args.pin_motion, gravity=args.gravity)
     try:
         if args.resume is not None:
             result = simulate.resume(args.resume, output=args.output, progress=progress,
                                      checkpoint_every=args.checkpoint_every)
             args.output = result.path
             args.chi, args.N = float(result.dataset.attrs["chi"]), int(result.dataset.attrs["N"])
+            if str(result.dataset.attrs.get("initial")) == "problem":
+                problem = True
         else:
             result = simulate.run(
-                args.chi, args.N, tol=args.tol, method=args.method, dt0=args.dt0, t_end=args.t_end,
+                problem if problem is not None else args.chi, None if problem is not None else args.N, tol=args.tol, method=args.method, dt0=args.dt0, t_end=args.t_end,
                 stop_fraction=args.stop_fraction, snapshot_times=times, record_thin=args.record_thin,
-                chords=args.chords, output=args.output, progress=progress, max_link_error=args.max_link_error,
+                chords=args.chords if problem is None else "arclength", output=args.output, progress=progress, max_link_error=args.max_link_error,
                 max_energy_drift=args.max_energy_drift, dt_min=args.dt_min, max_rejections=args.max_rejections,
                 checkpoint_every=args.checkpoint_every,
             )
@@ -252,7 +298,8 @@ def _cmd_simulate(args) -> int:
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         print_table(
             [(k, f"{v:.10g}" if k in precise and isinstance(v, float) else v, units.get(k)) for k, v in summary.items()],
-            title=f"snapping simulate: chi={args.chi:g}, N={args.N}",
+            title=f"snapping simulate: chi={args.chi:g}, N={args.N}" if problem is None else
+            f"snapping simulate: N={args.N}, {_problem_title(summary, args)}",
         )
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
@@ -366,6 +413,20 @@ def _cmd_fit(args) -> int:
 
 
 # --------------------------------------------------------------------------- sweep
+def _numbers(option: str, text: str, lo: int, hi: int) -> list[float]:
+    """Comma-separated numbers of an option (lo to hi of them), or SnappingInputError naming it."""
+    from ._validate import SnappingInputError
+
+    try:
+        vals = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        vals = []
+    if not lo <= len(vals) <= hi:
+        raise SnappingInputError(f"{option}={text!r} must be {lo}{'' if lo == hi else f' to {hi}'} comma-separated "
+                                 f"numbers")
+    return vals
+
+
 def _floats(text: str) -> list[float]:
     try:
         return [float(v) for v in text.split(",") if v.strip()]

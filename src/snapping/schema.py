@@ -87,6 +87,41 @@ LINK_PROFILE_VARS: dict[str, dict[str, str]] = {
     "tension": _v("link tension"),
 }
 
+#: Per accepted step, runs of a general problem only (:mod:`snapping.simulate.problem`).
+PIN_STEP_VARS: dict[str, dict[str, str]] = {
+    "pin_x": _v("position of the held end, e1 component"),
+    "pin_y": _v("position of the held end, e2 component (downward)"),
+    "pin_vx": _v("velocity of the held end, e1 component"),
+    "pin_vy": _v("velocity of the held end, e2 component"),
+    "pin_work": _v("work done on the chain by the held end since t = 0 (energy - pin_work is conserved)"),
+}
+
+#: Dimension of the pin-motion table of a general run (``pin_motion = 'table'``).
+PIN_TABLE_DIM = "pin_sample"
+
+#: Variables describing the problem of a general run (the paper's runs have none: N equal
+#: links of length 1/N and node masses 1/N).
+PROBLEM_VARS: dict[str, dict[str, str]] = {
+    "link_length": _v("length of the link"),
+    "node_mass": _v("mass of the node (tip mass included; 0 at the held end)"),
+    "start_x": _v("node position at t = 0, e1 component (the problem's start, as given)"),
+    "start_y": _v("node position at t = 0, e2 component (downward)"),
+    "start_vx": _v("node velocity at t = 0, e1 component"),
+    "start_vy": _v("node velocity at t = 0, e2 component"),
+    "pin_table_t": _v("times of the samples of the held end's prescribed motion"),
+    "pin_table_x": _v("e1 position of the held end at the sample times (cubic spline between)"),
+    "pin_table_y": _v("e2 position of the held end at the sample times (cubic spline between)"),
+}
+
+#: Global attributes of a general run, besides INPUT_ATTRS (``initial = 'problem'``).
+PROBLEM_ATTRS: dict[str, str] = {
+    "problem": "JSON description of the chain, the start shape, the held end's motion and gravity",
+    "tip_mass": "point mass at the free end (ratio to the chain's mass), included in node_mass",
+    "gravity": "gravity along +e2 (1: the nondimensional g; 0: none)",
+    "pin_motion": "motion of the held end: 'fixed', 'pull', 'flick' or 'table'",
+    "start": "start shape: 'catenary', 'supports', 'curve' or 'nodes'",
+}
+
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
 INPUT_ATTRS: dict[str, str] = {
     "chi": "initial end-to-end separation (fraction of the length), in (0, 1)",
@@ -99,7 +134,8 @@ INPUT_ATTRS: dict[str, str] = {
     "snapshot_times": "requested snapshot times (besides the automatic ones)",
     "record_thin": "relative change below which a step is not recorded (0 = record every step)",
     "chords": "initial node placement on the catenary: 'arclength' (the paper's) or 'exact' (chords 1/N)",
-    "initial": "initial condition: 'catenary' (from chi) or 'snapshot' (the snapshot of kind 'initial' holds it)",
+    "initial": ("initial condition: 'catenary' (from chi), 'snapshot' (the snapshot of kind 'initial' holds it) "
+                "or 'problem' (a general problem: PROBLEM_ATTRS, PROBLEM_VARS and the 'initial' snapshot)"),
     "t_end_max": "hard end time of an automatic (stop after the snap) run",
     "max_link_error": "relative link-length error at which the run fails",
     "max_energy_drift": "energy drift |E(t) - E(0)| at which the run fails (0 = no bound)",
@@ -152,7 +188,7 @@ def result_units(name: str) -> str:
     return RESULT_UNITS.get(name, "1")
 
 
-ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS}
+ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS}
 
 # ---------------------------------------------------------------- checkpoints
 #: Status values of a run file that :func:`snapping.simulate.resume` continues.

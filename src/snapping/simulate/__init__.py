@@ -17,6 +17,7 @@ Example
 from .chain import ChainState, curvature_profile, evaluate, initial_state, link_arclength, node_arclength
 from .dataset import build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save
 from .ensemble import run_ensemble
+from .problem import Links, PinMotion, Problem
 from .stepper import (
     METHODS,
     DriftError,
@@ -38,6 +39,9 @@ from .stepper import (
 
 __all__ = [
     "run",
+    "Problem",
+    "Links",
+    "PinMotion",
     "run_ensemble",
     "rerun",
     "Run",

@@ -218,9 +218,11 @@ def evaluate(state: ChainState) -> dict[str, np.ndarray]:
     return {"ax": Z[K.RAX].copy(), "ay": Z[K.RAY].copy(), "tension": Z[K.RSIG, :-1].copy()}
 
 
-def curvature_profile(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def curvature_profile(x: np.ndarray, y: np.ndarray, h: np.ndarray | None = None) -> np.ndarray:
     """Discrete curvature kappa = N (theta_{k+1} - theta_k) at the nodes (the paper's
-    formula, link angles unwrapped along the chain); NaN at the two end nodes.
+    formula, link angles unwrapped along the chain); NaN at the two end nodes. With link
+    lengths ``h`` (a general chain): the turning angle over the mean of the two links,
+    ``2 (theta_{k+1} - theta_k)/(h_k + h_{k+1})``.
 
     The link angle theta_k = atan2(d_k . e2, d_k . e1); the value for the joint
     between links k and k+1 is stored at their common node k+1.
@@ -239,5 +241,5 @@ def curvature_profile(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     theta = np.unwrap(np.arctan2(np.diff(y), np.diff(x)))
     kappa = np.full(N + 1, np.nan)
     if N >= 2:
-        kappa[1:N] = N * np.diff(theta)
+        kappa[1:N] = N * np.diff(theta) if h is None else 2.0 * np.diff(theta) / (h[:-1] + h[1:])
     return kappa

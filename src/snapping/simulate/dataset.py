@@ -45,12 +45,18 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
     inputs, results : dict
         Global attributes (schema.INPUT_ATTRS, schema.RESULT_ATTRS).
     """
+    from . import general as G
+
+    inputs = dict(inputs)
+    problem = inputs.pop("problem", None)
     t = records[:, K.R_T]
     data_vars = {}
     for col, name in enumerate(K.RECORD_NAMES):
         if name == "t":
             continue
         data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(schema.STEP_VARS[name]))
+    for col, name in enumerate(G.RECORD_NAMES_G[:records.shape[1] - K.NREC], start=K.NREC):
+        data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(schema.PIN_STEP_VARS[name]))
     snapshots = sorted(snapshots, key=lambda s: s[0])
     ns = len(snapshots)
     prof = {name: np.full((ns, N + 1), np.nan) for name in schema.NODE_PROFILE_VARS}
@@ -61,7 +67,8 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
         prof["ax"][i], prof["ay"][i] = Z[K.RAX], Z[K.RAY]
         prof["speed"][i] = np.hypot(Z[K.RVX], Z[K.RVY])
         prof["accel"][i] = np.hypot(Z[K.RAX], Z[K.RAY])
-        prof["curvature"][i] = curvature_profile(Z[K.RX], Z[K.RY])
+        prof["curvature"][i] = curvature_profile(Z[K.RX], Z[K.RY],
+                                                 None if problem is None else problem.links.h)
         tension[i] = Z[K.RSIG, :N]
     for name, arr in prof.items():
         data_vars[name] = ((schema.SNAPSHOT_DIM, schema.NODE_DIM), arr, dict(schema.NODE_PROFILE_VARS[name]))
@@ -79,7 +86,35 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
              "Conventions": "CF-1.8"}
     for k, v in {**inputs, **results}.items():
         attrs[k] = _attr_value(v)
+    if problem is not None:
+        _add_problem(problem, data_vars, coords, attrs)
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _add_problem(problem, data_vars: dict, coords: dict, attrs: dict) -> None:
+    """The problem of a general run: link lengths, node masses, arclength coordinates, the
+    pin table, and its description (schema.PROBLEM_VARS, schema.PROBLEM_ATTRS)."""
+    h, m = problem.links.h, problem.links.m
+    N = h.size
+    s_node = np.zeros(N + 1)
+    s_node[:N] = np.cumsum(h[::-1])[::-1]
+    coords["s_node"] = (schema.NODE_DIM, s_node, dict(schema.COORDS["s_node"]))
+    coords["s_link"] = (schema.LINK_DIM, s_node[1:] + 0.5 * h, dict(schema.COORDS["s_link"]))
+    data_vars["link_length"] = (schema.LINK_DIM, h.copy(), dict(schema.PROBLEM_VARS["link_length"]))
+    data_vars["node_mass"] = (schema.NODE_DIM, np.concatenate([m, [0.0]]), dict(schema.PROBLEM_VARS["node_mass"]))
+    for name, arr in (("start_x", problem.x), ("start_y", problem.y), ("start_vx", problem.vx),
+                      ("start_vy", problem.vy)):
+        data_vars[name] = (schema.NODE_DIM, np.asarray(arr, dtype=float).copy(), dict(schema.PROBLEM_VARS[name]))
+    if problem.pin.kind == "table":
+        tt, xx, yy = problem.pin.table
+        for name, arr in (("pin_table_t", tt), ("pin_table_x", xx), ("pin_table_y", yy)):
+            data_vars[name] = (schema.PIN_TABLE_DIM, np.asarray(arr, dtype=float).copy(),
+                               dict(schema.PROBLEM_VARS[name]))
+    attrs["problem"] = problem.describe_json()
+    attrs["tip_mass"] = float(problem.links.tip_mass)
+    attrs["gravity"] = float(problem.gravity)
+    attrs["pin_motion"] = problem.pin.kind
+    attrs["start"] = str(problem.start.get("kind", ""))
 
 
 def check_writable(path) -> str:
@@ -143,8 +178,11 @@ def save(ds: xr.Dataset, path) -> str:
 def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
     """The per-step record rows (columns ``kernels.RECORD_NAMES``) of a run Dataset:
     the inverse of :func:`build_dataset` for the step variables (exact)."""
-    cols = [np.asarray(ds[name].values, dtype=float) for name in K.RECORD_NAMES]
-    return np.stack(cols, axis=1) if cols[0].size else np.zeros((0, K.NREC))
+    from . import general as G
+
+    names = K.RECORD_NAMES + (G.RECORD_NAMES_G if G.RECORD_NAMES_G[0] in ds.variables else ())
+    cols = [np.asarray(ds[name].values, dtype=float) for name in names]
+    return np.stack(cols, axis=1) if cols[0].size else np.zeros((0, len(names)))
 
 
 def open_netcdf(p: str) -> xr.Dataset:
@@ -232,4 +270,48 @@ def _inputs_from_attrs(ds: xr.Dataset) -> dict:
             out[k] = None if float(v) == 0.0 and k == "max_energy_drift" else float(v)
     if str(a.get("initial", "catenary")) == "snapshot":
         out["initial"] = initial_from_dataset(ds)
+    if str(a.get("initial", "catenary")) == "problem":
+        out["problem"] = problem_from_dataset(ds)
+        out["chi"] = None
+        out["chords"] = "arclength"  # (the default: the problem's start holds its own)
     return out
+
+
+def problem_from_dataset(ds: xr.Dataset):
+    """The :class:`snapping.simulate.problem.Problem` of a general run (the inverse of what
+    :func:`build_dataset` records): links and masses from ``link_length``/``node_mass``,
+    the start from ``start_x`` ... ``start_vy``, the pin motion and gravity from the
+    ``problem`` attribute (and the pin table variables)."""
+    import json
+
+    from .problem import Links, PinMotion, Problem
+
+    for k in ("link_length", "node_mass", "start_x", "start_y", "start_vx", "start_vy"):
+        if k not in ds.variables:
+            raise V.SnappingInputError(f"ds is a general run without its {k!r} variable")
+    try:
+        desc = json.loads(str(ds.attrs["problem"]))
+        h = np.asarray(ds["link_length"].values, dtype=float)
+        m = np.asarray(ds["node_mass"].values, dtype=float)[:-1]
+        tip = float(ds.attrs.get("tip_mass", 0.0))
+        ch = desc["chain"]
+        links = Links(h, m, tip, str(ch.get("kind", "explicit")),
+                      {k: v for k, v in ch.items() if k not in ("kind", "N", "tip_mass")}, None)
+        pd = desc["pin"]
+        kind = pd["kind"]
+        if kind == "fixed":
+            pin = PinMotion.fixed()
+        elif kind == "pull":
+            pin = PinMotion.pull(pd["accel"], pd["duration"], pd["t0"])
+        elif kind == "flick":
+            pin = PinMotion.flick(pd["accel"], pd["period"], pd["t0"])
+        else:
+            pin = PinMotion.from_table(ds["pin_table_t"].values, ds["pin_table_x"].values, ds["pin_table_y"].values)
+        st = dict(desc["start"])
+        p = Problem._make(links, *(ds[f"start_{k}"].values for k in ("x", "y", "vx", "vy")), pin,
+                          float(desc["gravity"]), st, chi=st.get("chi"), chords=st.get("chords"))
+    except (KeyError, TypeError, ValueError, json.JSONDecodeError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise
+        raise V.SnappingInputError(f"ds has a problem description that cannot be read back ({exc})") from None
+    return p

@@ -266,7 +266,7 @@ def _lanes_copy(act, sel, gl, into_lanes, Y0s, Y1s, KKs, ctls, YA, YB, KL):
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs, pks, meass, Zs, rinv0, YA, YB, KL,
-                  yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes):
+                  yEt, ev, c, s, S, C, P, Q, cp, dp, sig, hL, lastL, errL, hx, tolx, codes, mdl):
     """Advance the members ``act`` (one lane each, ``W = act.size`` lanes) together
     until one of them needs Python; ``codes[m]`` then holds the return code of each
     member m that does (-1: none), and those members' rows their two step slots as a
@@ -281,7 +281,8 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
     flips, and the lanes that rejected copy their last step across (so that it is again
     at 1 - g). Lanes marked ``fresh`` are first loaded from their members' rows. Each
     member's diagnostics and bookkeeping (:func:`rk.after_attempt`) run exactly as in a
-    single run, on its lane's columns.
+    single run, on its lane's columns. ``mdl``: the (uniform) model of every member,
+    :func:`snapping.simulate.general.uniform_model`.
     """
     n = 2 * N
     W = act.size
@@ -331,7 +332,7 @@ def advance_lanes(N, act, fresh, par, Y0s, Y1s, KKs, TSs, HSs, DOKs, ctls, recs,
             n_acc += ok
             code = R.after_attempt(N, errL[lane], hL[lane], lastL[lane] != 0.0, 1 - int(ctls[m, R.Q_SLOT]),
                                    yb[:, lane], TSs[m], HSs[m], DOKs[m], c[:, lane], s[:, lane], sig[:, lane],
-                                   Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m])
+                                   Zs[m], rinv0, ctls[m], recs[m], pks[m], meass[m], mdl)
             if code >= 0:
                 codes[m] = code
                 stop = True
@@ -398,7 +399,7 @@ class _Lanes:
                 e = self.engines[int(m)]
                 w = e.w
                 self.codes[m] = R.advance_rk(e.N, e.Y0, e.Y1, e.KK, e.TS, e.HS, e.DOK, e.ytmp, w.c, w.s, w.S, w.cp,
-                                             w.dp, w.sig, e.Z, e.rinv0, e.ctl, e.rec, e.pk, e.meas)
+                                             w.dp, w.sig, e.Z, e.rinv0, e.ctl, e.rec, e.pk, e.meas, e.mdl)
             return
         if not same:
             self._buffers(act.size)
@@ -407,7 +408,7 @@ class _Lanes:
         advance_lanes(self.N, act, fresh, self.par, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ctl,
                       self.rec, self.pk, self.meas, self.Z, self.rinv0, self.YA, self.YB,
                       self.KL, self.yEt, self.ev, *self.work.args(), self.hL, self.lastL, self.errL,
-                      self.hx, self.tolx, self.codes)
+                      self.hx, self.tolx, self.codes, self.engines[0].mdl)
 
 
 def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end: float | None = None,

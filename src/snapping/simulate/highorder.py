@@ -37,6 +37,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from . import angles as AG
+from . import general as G
 from ._engine_common import CheckpointMixin, checkpoint_getter
 from . import kernels as K
 from . import rk as R
@@ -75,10 +76,14 @@ class _Engine(CheckpointMixin):
     """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
-                 dt_min=1e-14, max_energy_drift=None, max_rejections=100):
+                 dt_min=1e-14, max_energy_drift=None, max_rejections=100, mdl=None):
         N = y0.size // 2
         self.N = N
-        n = 2 * N
+        self.mdl = G.uniform_model(N) if mdl is None else mdl
+        self.general = self.mdl[0][G.P_KIND] != G.KIND_UNIFORM
+        n = G.state_dim(self.mdl)
+        if y0.size != n:
+            raise ValueError(f"state of length {y0.size} for a model of {n} unknowns")  # pragma: no cover
         self.Y0 = np.zeros((2, n))
         self.Y1 = np.zeros((2, n))
         self.KK = np.zeros((2, R.NSX, n))
@@ -91,23 +96,26 @@ class _Engine(CheckpointMixin):
         self.rw = AG.Work(N)  # scratch of peak searches and snapshots
         self.Z = np.zeros((K.NROWS, N + 1))
         self.rinv0 = np.full(N, float(N) * float(N))
-        self.meas = np.zeros(K.NMEAS)
-        self.rec = np.zeros((RECORD_CHUNK, K.NREC))
+        self.nmeas = G.NMEAS_G if self.general else K.NMEAS
+        self.nrec = G.NREC_G if self.general else K.NREC
+        self.meas = np.zeros(self.nmeas)
+        self.rec = np.zeros((RECORD_CHUNK, self.nrec))
         self.tol = tol
         self.n_extra = 0
         # initial state: slot 0 holds it as the end of a zero-length step
         self.Y1[0] = y0
         w = self.w
-        AG.angle_rhs(N, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        G.model_rhs(N, t0, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.TS[0] = t0
         self.HS[0] = 0.0
-        AG.measure_angles(N, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas)
+        G.model_measure(N, t0, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas, self.mdl)
         self.meas0 = self.meas.copy()
         self.link_error_initial = float(self.meas[K.M_LINKERR])
         if dt0 is None:
-            dt0 = self._initial_step(y0, self.KK[0, R.NS].copy())
+            dt0 = self._initial_step(y0, self.KK[0, R.NS].copy(), t0)
         self.dt0 = dt0
         K._write_record(self.rec, 0, t0, 0.0, 0.0, self.meas)
+        self.rec[0, K.NREC:] = self.meas[K.NMEAS:]
         c = np.zeros(R.NQ)
         c[R.Q_T] = t0
         c[R.Q_H] = dt0
@@ -154,7 +162,7 @@ class _Engine(CheckpointMixin):
         self.after_fracs = [f for f in AFTER_PEAK_FRACTIONS if f > stop_fraction]
         self.t0 = t0
 
-    def _initial_step(self, y0, f0) -> float:
+    def _initial_step(self, y0, f0, t0) -> float:
         """Hairer's starting step (Solving ODE I, II.4), in the max norm of the run."""
         N = self.N
         sc = self.tol * (1.0 + np.abs(y0))
@@ -164,7 +172,7 @@ class _Engine(CheckpointMixin):
         y1 = y0 + h0 * f0
         f1 = np.empty_like(y0)
         w = self.rw
-        AG.angle_rhs(N, y1, f1, w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        G.model_rhs(N, t0 + h0, y1, f1, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.n_extra += 1
         d2 = np.max(np.abs(f1 - f0) / sc) / h0
         if max(d1, d2) <= 1e-15:
@@ -186,7 +194,7 @@ class _Engine(CheckpointMixin):
 
     def records(self) -> np.ndarray:
         self.drain()
-        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, K.NREC))
+        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, self.nrec))
 
     def state_at(self, t: float) -> np.ndarray:
         """The angle state at time t within the last two accepted steps (dense output)."""
@@ -195,11 +203,11 @@ class _Engine(CheckpointMixin):
             if h > 0.0 and t0 - 1e-14 * max(1.0, abs(t0)) <= t <= t0 + h * (1 + 1e-12) + 1e-300:
                 if self.DOK[slot] == 0.0:
                     w = self.rw
-                    R.dense_build(self.N, h, self.Y0[slot], self.Y1[slot], self.KK[slot], self.F[slot], self.ytmp,
-                                  w.c, w.s, w.S, w.cp, w.dp, w.sig)
+                    R.dense_build(self.N, t0, h, self.Y0[slot], self.Y1[slot], self.KK[slot], self.F[slot],
+                                  self.ytmp, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
                     self.ctl[R.Q_NRHS] += R.NSX - R.NS - 1
                     self.DOK[slot] = 1.0
-                out = np.empty(2 * self.N)
+                out = np.empty(self.Y0.shape[1])
                 x = min(1.0, max(0.0, (t - t0) / h))
                 R.dense_eval(self.N, x, self.Y0[slot], self.F[slot], out)
                 return out
@@ -210,11 +218,11 @@ class _Engine(CheckpointMixin):
         y = self.state_at(t)
         w = self.rw
         f = np.empty_like(y)
-        AG.angle_rhs(self.N, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig)
+        G.model_rhs(self.N, t, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.ctl[R.Q_NRHS] += 1
         Z = np.zeros((K.NROWS, self.N + 1))
-        meas = np.zeros(K.NMEAS)
-        AG.measure_angles(self.N, y, w.c, w.s, w.sig, Z, self.rinv0, meas)
+        meas = np.zeros(self.nmeas)
+        G.model_measure(self.N, t, y, w.c, w.s, w.sig, Z, self.rinv0, meas, self.mdl)
         return Z, meas
 
     def refine(self) -> None:
@@ -297,7 +305,7 @@ class _Engine(CheckpointMixin):
         while True:
             code = R.advance_rk(self.N, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ytmp,
                                 w.c, w.s, w.S, w.cp, w.dp, w.sig, self.Z, self.rinv0, self.ctl, self.rec, self.pk,
-                                self.meas)
+                                self.meas, self.mdl)
             final = self.handle(code, bar)
             if final is not None:
                 return final
@@ -320,9 +328,15 @@ class _Engine(CheckpointMixin):
         return snaps
 
     def final_state(self) -> ChainState:
+        """The state at the end (for a moving held end: relative to it, which is then in
+        ``extra["pin"]`` as (x, y, vx, vy))."""
         Z = self.Z
-        final = ChainState(Z[K.RX].copy(), Z[K.RY].copy(), Z[K.RVX].copy(), Z[K.RVY].copy(), self.t)
+        pin = Z[:4, self.N].copy()
+        rel = Z[:4] - pin[:, None]
+        final = ChainState(rel[0].copy(), rel[1].copy(), rel[2].copy(), rel[3].copy(), self.t)
         final.x[-1] = final.y[-1] = final.vx[-1] = final.vy[-1] = 0.0
+        if np.any(pin != 0.0):
+            final.extra["pin"] = tuple(float(v) for v in pin)
         final.extra["angles"] = self.Y1[int(self.ctl[R.Q_SLOT])].copy()
         return final
 
@@ -367,14 +381,14 @@ class _Engine(CheckpointMixin):
         if code == K.RET_FAIL_NAN:
             bad = ~np.all(np.isfinite(Z[:, :N]), axis=0)
             if not bad.any():
-                bad = ~(np.isfinite(att[:N]) & np.isfinite(att[N:]))
+                bad = ~(np.isfinite(att[:N]) & np.isfinite(att[N:2 * N]))
             return int(np.argmax(bad)) if bad.any() else -1
         if code == K.RET_FAIL_DRIFT:
             return int(np.argmax(np.abs(N * np.hypot(np.diff(Z[K.RX]), np.diff(Z[K.RY])) - 1.0)))
         if code == K.RET_FAIL_ENERGY:
             return int(np.argmax(np.hypot(Z[K.RAX, :N], Z[K.RAY, :N])))
         cur = self.Y1[sl]
-        m = np.maximum(np.abs(att[:N] - cur[:N]), np.abs(att[N:] - cur[N:]))
+        m = np.maximum(np.abs(att[:N] - cur[:N]), np.abs(att[N:2 * N] - cur[N:2 * N]))
         return int(np.argmax(np.where(np.isfinite(m), m, np.inf)))
 
     def failure_message(self, code: int, node: int = -1) -> str:
@@ -457,11 +471,20 @@ def _warm_up() -> None:
 
 
 def _setup(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-           max_link_error, chords, initial, dt_min=1e-14, max_energy_drift=None, max_rejections=100):
-    """The input attributes and the engine of an angle-form run (validated arguments)."""
+           max_link_error, chords, initial, dt_min=1e-14, max_energy_drift=None, max_rejections=100, problem=None):
+    """The input attributes and the engine of an angle-form run (validated arguments).
+    ``problem``: a general :class:`snapping.simulate.problem.Problem` (then ``chi``,
+    ``chords`` and ``initial`` are not used)."""
     method = resolve_method(method)
-    state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
-    y0 = AG.state_to_angles(state0)
+    if problem is not None:
+        y0 = problem.initial_angles()
+        mdl = problem.model()
+        t0 = 0.0
+    else:
+        state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+        y0 = AG.state_to_angles(state0)
+        mdl = None
+        t0 = state0.t
     inputs = {
         "chi": chi, "N": N, "method": method, "tol": tol, "dt0": 0.0, "t_end": 0.0 if t_end is None else t_end,
         "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
@@ -469,18 +492,21 @@ def _setup(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapsho
         "max_link_error": max_link_error, "max_energy_drift": 0.0 if max_energy_drift is None else max_energy_drift,
         "dt_min": dt_min, "max_rejections": max_rejections,
     }
+    if problem is not None:
+        inputs.update({"chi": float("nan") if problem.chi is None else problem.chi, "initial": "problem",
+                       "chords": problem.chords or "exact", "problem": problem})
     _warm_up()
-    eng = _Engine(y0, state0.t, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
+    eng = _Engine(y0, t0, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
                   stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
                   max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min,
-                  max_energy_drift=max_energy_drift, max_rejections=max_rejections)
+                  max_energy_drift=max_energy_drift, max_rejections=max_rejections, mdl=mdl)
     inputs["dt0"] = eng.dt0
     return inputs, eng
 
 
 def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
                   max_link_error, chords, initial, output, progress, dt_min=1e-14, max_energy_drift=None,
-                  max_rejections=100, checkpoint_every=None):
+                  max_rejections=100, checkpoint_every=None, problem=None):
     """The body of :func:`snapping.simulate.run` for the angle-form methods (inputs
     already validated by it). Returns a :class:`snapping.simulate.Run`.
 
@@ -502,7 +528,7 @@ def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, 
     inputs, eng = _setup(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
                          t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
                          max_link_error=max_link_error, chords=chords, initial=initial, dt_min=dt_min,
-                         max_energy_drift=max_energy_drift, max_rejections=max_rejections)
+                         max_energy_drift=max_energy_drift, max_rejections=max_rejections, problem=problem)
     return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
 
 

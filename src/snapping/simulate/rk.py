@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dc
 
-from . import angles as AG
+from . import general as G
 from . import kernels as K
 
 NS = _dc.N_STAGES  # 12
@@ -48,6 +48,7 @@ B_RK = np.ascontiguousarray(_dc.B, dtype=np.float64)  # (12,)
 E3_RK = np.ascontiguousarray(_dc.E3, dtype=np.float64)  # (13,)
 E5_RK = np.ascontiguousarray(_dc.E5, dtype=np.float64)  # (13,)
 D_RK = np.ascontiguousarray(_dc.D, dtype=np.float64)  # (4, 16)
+C_RK = np.ascontiguousarray(_dc.C, dtype=np.float64)  # (16,) stage times (fractions of the step)
 #: number of nonzero A entries of each stage row, and their columns (skip the zeros)
 #: (row NSX: the nonzero weights B of the solution, as a 17th row of A_RK)
 A_RK = np.vstack([np.hstack([A_RK, np.zeros((NSX, 1))]), np.zeros((1, NSX + 1))])
@@ -100,16 +101,17 @@ def _stage_state(n, s, h, y0, Kst, out):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def rk_step(N, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol):
-    """One DOP853 step of size h from y0 (with Kst[0] = f(y0)) into y1; Kst[1..12] are
-    filled (Kst[12] = f(y1), and c, s, sig then belong to y1). Returns the scaled
-    error (accept if <= 1)."""
-    n = 2 * N
+def rk_step(N, t, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol, mdl):
+    """One DOP853 step of size h from y0 at time t (with Kst[0] = f(t, y0)) into y1;
+    Kst[1..12] are filled (Kst[12] = f(t + h, y1), and c, s, sig then belong to y1).
+    ``mdl`` is the chain's model (:func:`snapping.simulate.general.model_rhs`); the state
+    has ``y0.shape[0]`` components. Returns the scaled error (accept if <= 1)."""
+    n = y0.shape[0]
     for st in range(1, NS):
         _stage_state(n, st, h, y0, Kst, ytmp)
-        AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
+        G.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
     end_state(n, h, y0, Kst, y1)
-    AG.angle_rhs(N, y1, Kst[NS], c, s, S, cp, dp, sig)
+    G.model_rhs(N, t + h, y1, Kst[NS], c, s, S, cp, dp, sig, mdl)
     return step_error(n, h, tol, y0, y1, Kst, ytmp)
 
 
@@ -165,12 +167,12 @@ def scaled_error(Kst, i, y0i, y1i, h, tol):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def dense_build(N, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig):
-    """The 7 dense-output coefficient vectors F of a step (3 more evaluations)."""
-    n = 2 * N
+def dense_build(N, t, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig, mdl):
+    """The 7 dense-output coefficient vectors F of a step from time t (3 more evaluations)."""
+    n = y0.shape[0]
     for st in range(NS + 1, NSX):
         _stage_state(n, st, h, y0, Kst, ytmp)
-        AG.angle_rhs(N, ytmp, Kst[st], c, s, S, cp, dp, sig)
+        G.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
     for i in range(n):
         dy = y1[i] - y0[i]
         f0 = Kst[0, i]
@@ -188,7 +190,7 @@ def dense_build(N, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig):
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def dense_eval(N, x, y0, F, out):
     """The dense output at the fraction x in [0, 1] of the step (scipy's Horner form)."""
-    n = 2 * N
+    n = y0.shape[0]
     for i in range(n):
         v = 0.0
         for k in range(NI):
@@ -222,13 +224,16 @@ def accepted(err) -> bool:
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas):
+def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas, mdl):
     """Everything after the stages of an attempted step of size h into slot ``ns``
     (``y1`` the new state, c, s, sig its trigonometry and tension; any strides):
     rejection and step-size control, or acceptance with the diagnostics, the record,
     peak detection, invariants and the stop rules. Returns :data:`GO_REJECTED`,
     :data:`GO_ON` or a return code for Python. Shared by the single-run loop
-    :func:`advance_rk` and the ensemble loop (:mod:`snapping.simulate.ensemble`)."""
+    :func:`advance_rk` and the ensemble loop (:mod:`snapping.simulate.ensemble`).
+    For a general chain (``meas`` of length ``general.NMEAS_G``) the energy bound applies
+    to the balance ``E - W`` (W: the work done by the held end) and the record carries the
+    held end's position, velocity and work (``rec`` of width ``general.NREC_G``)."""
     ctl[Q_NRHS] += float(NS)
     dtmin = ctl[Q_DTMIN]
     if not (err - err == 0.0):  # NaN/inf in the stages: reject, shrink hard
@@ -280,7 +285,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         ctl[Q_DT_MAX_ACC] = h
     if err > ctl[Q_ERR_MAX_ACC]:
         ctl[Q_ERR_MAX_ACC] = err
-    AG.measure_angles(N, y1, c, s, sig, Z, rinv0, meas)
+    G.model_measure(N, t, y1, c, s, sig, Z, rinv0, meas, mdl)
     # ---- running peaks (every accepted step)
     for qi in range(4):
         if qi == 0:
@@ -311,7 +316,10 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     dl = abs(meas[K.M_LENGTH] - l0) / l0
     if dl > ctl[Q_DRIFT_LEN]:
         ctl[Q_DRIFT_LEN] = dl
-    de = abs(meas[K.M_ENERGY] - ctl[Q_E0])
+    ebal = meas[K.M_ENERGY]
+    if meas.shape[0] > K.NMEAS:
+        ebal -= meas[G.M_WORK]
+    de = abs(ebal - ctl[Q_E0])
     if de > ctl[Q_DRIFT_E]:
         ctl[Q_DRIFT_E] = de
     # ---- why stop here?
@@ -347,6 +355,8 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
             or _changed(vmax, ctl[Q_LAST_V], thin) or _changed(meas[K.M_AMAX], ctl[Q_LAST_A], thin)
             or _changed(meas[K.M_SIGMAX], ctl[Q_LAST_S], thin) or _changed(meas[K.M_KMAX], ctl[Q_LAST_K], thin)):
         K._write_record(rec, nrec, t, h, err * ctl[Q_TOL], meas)
+        for q in range(rec.shape[1] - K.NREC):
+            rec[nrec, K.NREC + q] = meas[K.NMEAS + q]
         nrec += 1
         ctl[Q_NREC] = float(nrec)
         ctl[Q_LAST_V] = vmax
@@ -363,7 +373,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas):
+def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas, mdl):
     """Advance the angle-form chain with DOP853 until something needs Python.
 
     Two step slots (arrays indexed [slot]): ``Y0``/``Y1`` start and end states, ``KK``
@@ -375,7 +385,7 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
     bit mask of the quantities v, a, sigma, kappa whose peak is to be located on
     ``[pk[q, PK_TA], pk[q, PK_TB]]``, which the two slots cover).
     """
-    n = 2 * N
+    n = Y0.shape[1]
     tol = ctl[Q_TOL]
     ctl[Q_NCALL] = 0.0
     while True:
@@ -387,7 +397,8 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
         for i in range(n):
             y0[i] = ycur[i]
             KK[ns, 0, i] = KK[sl, NS, i]
-        err = rk_step(N, h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol)
-        code = after_attempt(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas)
+        err = rk_step(N, ctl[Q_T], h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol, mdl)
+        code = after_attempt(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas,
+                             mdl)
         if code >= 0:
             return code

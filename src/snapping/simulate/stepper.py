@@ -183,6 +183,7 @@ SUMMARY_KEYS = (
     "t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_max_0",
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
+    "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
 )
 
 
@@ -225,9 +226,54 @@ def _validate_guards(max_energy_drift, dt_min, max_rejections, checkpoint_every)
     return max_energy_drift, dt_min, max_rejections, checkpoint_every
 
 
+def _resolve_problem(chi, N, chords, initial, problem, method):
+    """(chi, N, chords, initial, problem) of a run given a Problem: the paper's problem
+    becomes (chi, N, chords) (today's runs, bit for bit); a uniform chain with a fixed held
+    end from another start becomes ``initial`` for Euler-Richardson; any other problem
+    stays a problem, which only the angle-form methods take."""
+    from .problem import Problem
+
+    if isinstance(chi, Problem):
+        if problem is not None:
+            raise V.SnappingInputError("a Problem was given twice (as chi and as problem=)")
+        chi, problem = None, chi
+    if problem is None:
+        return chi, N, chords, initial, None
+    if not isinstance(problem, Problem):
+        raise V.SnappingInputError(f"problem={type(problem).__name__} is not a snapping.simulate.Problem")
+    if chi is not None:
+        raise V.SnappingInputError(f"chi={chi!r} given with a Problem: the problem's start sets the shape")
+    if initial is not None:
+        raise V.SnappingInputError("initial= given with a Problem: the problem's start is the initial state")
+    if chords != "arclength":
+        raise V.SnappingInputError(f"chords={chords!r} given with a Problem: use Problem.catenary(chi, N, "
+                                   f"chords={chords!r})")
+    if N is not None and V.integer("N", N, 1) != problem.N:
+        raise V.SnappingInputError(f"N={N!r} disagrees with the problem's {problem.N} links")
+    if problem.is_paper:
+        return problem.chi, problem.N, problem.chords, None, None
+    if method in ("euler-richardson", "euler-richardson-fixed"):
+        why = []
+        if not problem.links.is_paper:
+            why.append("links or masses other than N equal links and masses 1/N" if problem.links.tip_mass == 0
+                       else f"a tip mass ({problem.links.tip_mass:g})")
+        if not problem.pin.is_fixed:
+            why.append(f"a moving held end (pin motion {problem.pin.kind!r})")
+        if problem.gravity != 1.0:
+            why.append(f"gravity={problem.gravity:g} (it takes g = 1)")
+        if why:
+            raise V.SnappingInputError(f"method={method!r} takes only the paper's chain with a fixed held end and "
+                                       f"g = 1; this problem has {', '.join(why)}: use method='fast' (dop853)")
+        return None, problem.N, chords, ChainState(problem.x, problem.y, problem.vx, problem.vy, 0.0), None
+    return None, problem.N, chords, None, problem
+
+
 def _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-              max_link_error, chords, initial, output):
-    if initial is None:
+              max_link_error, chords, initial, output, problem=None):
+    if problem is not None:
+        N = problem.N
+        chi = float("nan")
+    elif initial is None:
         chi = V.open_interval("chi", chi, 0.0, 1.0)
         N = V.integer("N", N, 1)
     else:
@@ -557,6 +603,7 @@ def run(
     dt_min: float = 1e-14,
     max_rejections: int = 100,
     checkpoint_every: float | None = CHECKPOINT_EVERY,
+    problem=None,
 ) -> Run:
     """Simulate the falling chain released from the paper's catenary, to the snap and a bit after.
 
@@ -590,10 +637,17 @@ def run(
 
     Parameters
     ----------
-    chi : float
-        Initial end separation / length, in (0, 1).
+    chi : float or Problem
+        Initial end separation / length, in (0, 1); or a
+        :class:`snapping.simulate.problem.Problem` (any chain, start, held end, gravity).
     N : int
         Number of links, >= 1.
+    problem : Problem, optional
+        The problem to solve (the same as passing it as ``chi``): unequal links and
+        masses, a tip mass, any start shape and velocities, a moving held end, any
+        gravity. ``run(Problem.catenary(chi, N))`` is ``run(chi, N)``, bit for bit.
+        Methods ``dop853``/``fast`` take every problem; ``euler-richardson`` only the
+        paper's chain (N equal links and masses) with a fixed held end and g = 1.
     tol : float
         Stepper tolerance eps_tol (paper: 1e-8).
     method : {"euler-richardson", "euler-richardson-fixed"}
@@ -668,9 +722,10 @@ def run(
     >>> round(snap["t_snap_v"], 3), snap["stop_reason"]
     (1.144, 'snap detected: v_max fell below 0.5 of its peak')
     """
+    chi, N, chords, initial, problem = _resolve_problem(chi, N, chords, initial, problem, method)
     (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
      chords, output) = _validate(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times,
-                                 record_thin, max_link_error, chords, initial, output)
+                                 record_thin, max_link_error, chords, initial, output, problem)
     max_energy_drift, dt_min, max_rejections, checkpoint_every = _validate_guards(
         max_energy_drift, dt_min, max_rejections, checkpoint_every)
     progress = _check_progress(progress)
@@ -681,7 +736,8 @@ def run(
                              t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
                              max_link_error=max_link_error, chords=chords, initial=initial, output=output,
                              progress=progress, dt_min=dt_min, max_energy_drift=max_energy_drift,
-                             max_rejections=max_rejections, checkpoint_every=checkpoint_every)
+                             max_rejections=max_rejections, checkpoint_every=checkpoint_every,
+                             problem=problem)
     if dt0 is None:
         dt0 = math.sqrt(tol)
     _check_memory(N, chi=chi, tol=tol, method=method, dt0=dt0, t_end=t_end, t_end_max=t_end_max,
@@ -1087,7 +1143,7 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
         (chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error,
          chords, _) = _validate(kw["chi"], kw["N"], kw["tol"], kw["method"], kw["dt0"], kw["t_end"],
                                 kw["stop_fraction"], kw["t_end_max"], kw["snapshot_times"], kw["record_thin"],
-                                kw["max_link_error"], kw["chords"], kw.get("initial"), None)
+                                kw["max_link_error"], kw["chords"], kw.get("initial"), None, kw.get("problem"))
         max_energy_drift, dt_min, max_rejections, _ = _validate_guards(
             kw["max_energy_drift"], kw["dt_min"], kw["max_rejections"], None)
     except (KeyError, TypeError, ValueError) as exc:
@@ -1103,7 +1159,7 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
                                        snapshot_times=snapshot_times, record_thin=record_thin,
                                        max_link_error=max_link_error, chords=chords, initial=kw.get("initial"),
                                        dt_min=dt_min, max_energy_drift=max_energy_drift,
-                                       max_rejections=max_rejections)
+                                       max_rejections=max_rejections, problem=kw.get("problem"))
     else:
         inputs, eng = _setup(chi, N, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times,
                              record_thin, max_link_error, chords, kw.get("initial"), max_energy_drift, dt_min,

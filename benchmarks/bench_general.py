@@ -1,0 +1,112 @@
+"""Benchmark of the general chain's right-hand side against the paper's uniform kernel.
+
+Prints, for each N: ns per node of one evaluation of ``angles.angle_rhs`` (the paper's
+chain) and of ``general.general_rhs`` on (a) the same uniform chain, (b) a tapered chain
+with a tip mass and unequal (graded) links, fixed held end, (c) the same with a moving
+held end (a flick); then full dop853 runs to the snap of the paper's chain by the uniform
+path and by the general path (the same chain, a zero pull on the held end), with their
+evaluations and wall times, and tapered / tip-mass runs for comparison.
+
+Usage::
+
+    python benchmarks/bench_general.py                  # N = 1000, 20000; runs at N = 1000
+    python benchmarks/bench_general.py --sizes 1000 --runs 0.25:1000,0.1:2000
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+from snapping.simulate import Links, PinMotion, Problem, run
+from snapping.simulate import angles as AG
+from snapping.simulate import general as G
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from bench_simulate import print_machine  # noqa: E402
+
+
+def per_eval(fn, N, min_time=0.3) -> float:
+    """ns per node of one call of fn (best of 5 batches)."""
+    fn()
+    n = 1
+    while True:
+        t = time.perf_counter()
+        for _ in range(n):
+            fn()
+        dt = time.perf_counter() - t
+        if dt > min_time / 5:
+            break
+        n *= 2
+    best = np.inf
+    for _ in range(5):
+        t = time.perf_counter()
+        for _ in range(n):
+            fn()
+        best = min(best, (time.perf_counter() - t) / n)
+    return best * 1e9 / N
+
+
+def kernels(N: int) -> None:
+    rng = np.random.default_rng(1)
+    th = -np.pi / 2 + 0.3 * rng.standard_normal(N)
+    om = rng.standard_normal(N)
+    w = AG.Work(N)
+    f = np.empty(2 * N + 1)
+    y2 = np.concatenate([th, om])
+    y3 = np.concatenate([th, om, [0.0]])
+    t_uni = per_eval(lambda: AG.angle_rhs(N, y2, f, w.c, w.s, w.S, w.cp, w.dp, w.sig), N)
+    mu = G.make_model(np.full(N, 1.0 / N), np.full(N, float(N)))
+    s = np.linspace(0.0, 1.0, N + 1)
+    h = np.diff(1.0 - (1.0 - s) ** 1.5)[::-1]  # graded: fine at the free end
+    links = Links.taper(N, 0.1, tip_mass=0.2, h=h / h.sum())
+    mg = G.make_model(links.h, 1.0 / links.m)
+    mf = G.make_model(links.h, 1.0 / links.m, **PinMotion.flick((1.0, 0.5), 0.3).model_args())
+    t_gu = per_eval(lambda: G.general_rhs(N, 0.1, y3, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, *mu), N)
+    t_gg = per_eval(lambda: G.general_rhs(N, 0.1, y3, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, *mg), N)
+    t_gf = per_eval(lambda: G.general_rhs(N, 0.1, y3, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, *mf), N)
+    print(f"N = {N:6d}: angle_rhs {t_uni:6.2f} ns/node | general_rhs uniform {t_gu:6.2f} ({t_gu / t_uni:5.3f}x), "
+          f"taper+tip+graded {t_gg:6.2f} ({t_gg / t_uni:5.3f}x), + flick {t_gf:6.2f} ({t_gf / t_uni:5.3f}x)")
+
+
+def runs(cases) -> None:
+    print("\nfull runs, dop853 tol 1e-8, exact chords, to the snap (stop_fraction 0.5):")
+    print(f"{'case':<44} {'v_peak':>11} {'a_peak':>12} {'sigma_peak':>11} {'t_snap_v':>10} {'RHS evals':>10} "
+          f"{'wall s':>7}")
+    for chi, N in cases:
+        rows = [
+            ("paper's chain, uniform path", Problem.catenary(chi, N, chords="exact")),
+            ("paper's chain, general path (zero pull)", Problem.catenary(chi, N, chords="exact",
+                                                                          pin=PinMotion.pull((0.0, 0.0)))),
+            ("shared lumping (free end 1/(2N))", Problem.catenary(chi, links=Links.uniform(N, lumping="shared"),
+                                                                  chords="exact")),
+            ("taper ratio 0.1 (linear)", Problem.catenary(chi, links=Links.taper(N, 0.1), chords="exact")),
+            ("tip mass 0.1", Problem.catenary(chi, links=Links.uniform(N, tip_mass=0.1), chords="exact")),
+        ]
+        for name, p in rows:
+            t = time.perf_counter()
+            a = run(p, method="fast", progress=False).dataset.attrs
+            wall = time.perf_counter() - t
+            print(f"chi={chi:<5g} N={N:<6d} {name:<31} {a['v_peak']:11.7f} {a['a_peak']:12.5f} {a['sigma_peak']:11.6f} "
+                  f"{a['t_snap_v']:10.7f} {a['n_rhs']:10d} {wall:7.2f}")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sizes", default="1000,20000", help="N of the kernel timings (comma-separated)")
+    ap.add_argument("--runs", default="0.25:1000,0.1:1000", help="chi:N of the full runs ('' for none)")
+    a = ap.parse_args(argv)
+    print_machine()
+    for N in (int(v) for v in a.sizes.split(",") if v):
+        kernels(N)
+    cases = [(float(c.split(":")[0]), int(c.split(":")[1])) for c in a.runs.split(",") if c]
+    if cases:
+        runs(cases)
+
+
+if __name__ == "__main__":
+    main()

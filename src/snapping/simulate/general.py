@@ -1,0 +1,464 @@
+"""The link-angle equations of a general chain, compiled (numba, ``cache=True``).
+
+Any planar chain of N rigid links and N point masses: link lengths ``h_j``, node masses
+``m_j`` (a tip mass is part of ``m_0``), gravity ``g e2`` of any magnitude (``y`` grows
+downward), and a held end (node N) that is fixed or moves as prescribed, ``r_p(t)``
+with velocity ``v_p`` and acceleration ``A(t)``. Index j = 0 is the free end; link j
+joins node j and node j + 1 with ``d_j = r_{j+1} - r_j = h_j t_j``,
+``t_j = (cos theta_j, sin theta_j)``, ``n_j = (-sin theta_j, cos theta_j)``.
+
+Derivation (the rows of :mod:`snapping.simulate.angles` generalised). Node j moves by
+``m_j r_j'' = T_j t_j - T_{j-1} t_{j-1} + m_j g e2`` (``T_{-1} = 0``), with ``T_j`` the
+tension of link j. For a link j < N - 1, ``d_j'' = r_{j+1}'' - r_j''``
+``= T_{j+1} t_{j+1}/m_{j+1} - T_j t_j (1/m_j + 1/m_{j+1}) + T_{j-1} t_{j-1}/m_j``, while
+``d_j = h_j t_j`` gives ``d_j'' = h_j (theta_j'' n_j - theta_j'^2 t_j)``. On ``t_j``
+(``C_j = t_{j+1}.t_j = cos(theta_{j+1} - theta_j)``) these are the tension rows, on ``n_j``
+(``S_j = t_{j+1}.n_j = sin(theta_{j+1} - theta_j)``) the angular accelerations::
+
+    C_{j-1}/m_j T_{j-1} - (1/m_j + 1/m_{j+1}) T_j + C_j/m_{j+1} T_{j+1} = -h_j theta_j'^2
+    h_j theta_j'' = S_j T_{j+1}/m_{j+1} - S_{j-1} T_{j-1}/m_j
+
+For the held link (j = N - 1), ``d_{N-1}'' = A - r_{N-1}''``, so with ``E = A - g e2``::
+
+    C_{N-2}/m_{N-1} T_{N-2} - T_{N-1}/m_{N-1} = -h_{N-1} theta_{N-1}'^2 - E.t_{N-1}
+    h_{N-1} theta_{N-1}'' = E.n_{N-1} - S_{N-2} T_{N-2}/m_{N-1}
+
+The system is symmetric (row j's coefficient of ``T_{j+1}`` and row j+1's of ``T_j`` are
+both ``C_j/m_{j+1}``) and weakly diagonally dominant, ``-B^T M^{-1} B`` of the constraint
+Jacobian B, so the Thomas elimination is stable: O(N), no allocation. With
+``h_j = m_j = 1/N``, ``g = 1`` and a fixed pin it is the paper's chain
+(:func:`snapping.simulate.angles.angle_rhs`, whose tensions are the same ``T_j``).
+
+The held end does work on the chain at the rate ``P = T_{N-1} t_{N-1}.v_p`` (the force
+of the held link on the chain, times the velocity of the held end). It is integrated with
+the state, as a last component ``W``, so that the energy balance ``E(t) - W(t) = E(0)``
+is a conservation law the stepper can be checked against (``W = 0`` for a fixed pin).
+
+Layout: the state is ``y = [theta (N), theta' (N), W]`` (length 2N + 1); the model is a
+tuple ``mdl = (par, h, invm, snode, tab)`` of float64 arrays built by
+:meth:`snapping.simulate.problem.Problem.model`: scalar parameters (indices ``P_*``),
+link lengths, inverse node masses, the arclength of each node from the held end, and
+the pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
+:func:`model_rhs` and :func:`model_measure` call the uniform kernels of
+:mod:`snapping.simulate.angles` unchanged (bit for bit the runs of before).
+
+Pin motions (``par[P_PIN]``): ``PIN_FIXED``; ``PIN_PULL``: acceleration ``(ax, ay)`` from
+``t0`` for a duration ``T`` (``inf``: for ever), then constant velocity; ``PIN_FLICK``:
+acceleration ``(ax, ay) sin(2 pi (t - t0)/T)`` for one period (C^2 everywhere; the end is
+displaced by ``(ax, ay) T^2/(2 pi)`` and at rest again); ``PIN_TABLE``: a cubic spline
+through samples of ``r_p(t)`` (``tab = [t_i, x coefficients, y coefficients]``), then
+constant velocity after the last sample.
+
+Example
+-------
+>>> import numpy as np
+>>> from snapping.simulate import general as G
+>>> N = 3
+>>> h = np.full(N, 1 / N); invm = np.full(N, float(N))
+>>> mdl = G.make_model(h, invm)                        # fixed pin, g = 1
+>>> y = np.zeros(2 * N + 1); y[:N] = -np.pi / 2         # hanging straight down, at rest
+>>> w = G.Work(N); f = np.empty(2 * N + 1)
+>>> G.general_rhs(N, 0.0, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, *mdl)
+>>> np.round(w.sig, 12).tolist()                        # tension = weight below
+[0.333333333333, 0.666666666667, 1.0]
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import angles as AG
+from . import kernels as K
+
+__all__ = [
+    "Work", "make_model", "general_rhs", "general_measure", "model_rhs", "model_measure", "pin_kinematics",
+    "general_to_Z", "NMEAS_G", "NREC_G", "M_PX", "M_PY", "M_PVX", "M_PVY", "M_WORK", "RECORD_NAMES_G",
+]
+
+# ---------------------------------------------------------------- the model's scalar parameters
+P_KIND, P_G, P_PIN, P_AX, P_AY, P_T0, P_T1, P_NKNOT, P_EOFF = range(9)
+NPAR = 9
+KIND_UNIFORM, KIND_GENERAL = 0.0, 1.0
+PIN_FIXED, PIN_PULL, PIN_FLICK, PIN_TABLE = 0.0, 1.0, 2.0, 3.0
+
+# ---------------------------------------------------------------- measurements beyond kernels.NMEAS
+M_PX, M_PY, M_PVX, M_PVY, M_WORK = range(K.NMEAS, K.NMEAS + 5)
+NMEAS_G = K.NMEAS + 5
+#: record columns beyond kernels.RECORD_NAMES (the same quantities as M_PX .. M_WORK)
+RECORD_NAMES_G = ("pin_x", "pin_y", "pin_vx", "pin_vy", "pin_work")
+NREC_G = K.NREC + len(RECORD_NAMES_G)
+
+TWO_PI = 2.0 * math.pi
+
+
+class Work:
+    """Work arrays of :func:`general_rhs` for N links (as :class:`snapping.simulate.angles.Work`)."""
+
+    def __init__(self, N: int):
+        self.N = N
+        self.c = np.zeros(N)
+        self.s = np.zeros(N)
+        self.S = np.zeros(max(N - 1, 1))
+        self.cp = np.zeros(N)
+        self.dp = np.zeros(N)
+        self.sig = np.zeros(N)
+
+
+def make_model(h, invm, *, g: float = 1.0, pin=(PIN_FIXED, 0.0, 0.0, 0.0, math.inf), table=None,
+               uniform: bool = False):
+    """The model tuple ``(par, h, invm, snode, tab)`` of the compiled kernels (no checks:
+    :class:`snapping.simulate.problem.Problem` validates and calls this).
+
+    ``pin = (kind, ax, ay, t0, T)`` for the presets; ``table = (t, cx, cy)`` with ``cx``,
+    ``cy`` of shape (4, n - 1) the cubic coefficients (scipy ``CubicSpline.c``) for
+    ``PIN_TABLE``.
+    """
+    h = np.ascontiguousarray(h, dtype=float)
+    invm = np.ascontiguousarray(invm, dtype=float)
+    N = h.size
+    snode = np.zeros(N + 1)
+    snode[:N] = np.cumsum(h[::-1])[::-1]  # node j: sum of the links between it and the held end
+    par = np.zeros(NPAR)
+    par[P_KIND] = KIND_UNIFORM if uniform else KIND_GENERAL
+    par[P_G] = g
+    kind, ax, ay, t0, T = pin
+    par[P_PIN], par[P_AX], par[P_AY], par[P_T0], par[P_T1] = kind, ax, ay, t0, T
+    if table is not None:
+        tt, cx, cy = table
+        tt = np.asarray(tt, dtype=float)
+        par[P_NKNOT] = tt.size
+        tab = np.concatenate([tt, np.asarray(cx, dtype=float).ravel(), np.asarray(cy, dtype=float).ravel()])
+    else:
+        tab = np.zeros(1)
+    par[P_EOFF] = g * float(np.sum(snode[:N] / invm))
+    return par, h, invm, snode, tab
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _spline(tab, n, off, i, u):
+    """Value, first and second derivative of the cubic piece i at local time u."""
+    m = n - 1
+    c0 = tab[off + i]
+    c1 = tab[off + m + i]
+    c2 = tab[off + 2 * m + i]
+    c3 = tab[off + 3 * m + i]
+    return ((c0 * u + c1) * u + c2) * u + c3, (3.0 * c0 * u + 2.0 * c1) * u + c2, 6.0 * c0 * u + 2.0 * c1
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def pin_kinematics(t, par, tab):
+    """(x, y, vx, vy, ax, ay) of the held end at time t."""
+    kind = par[P_PIN]
+    if kind == PIN_FIXED:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    ax = par[P_AX]
+    ay = par[P_AY]
+    t0 = par[P_T0]
+    T = par[P_T1]
+    if kind == PIN_PULL:
+        if t <= t0:
+            return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        tau = t - t0
+        if tau <= T:
+            q = 0.5 * tau * tau
+            return ax * q, ay * q, ax * tau, ay * tau, ax, ay
+        q = 0.5 * T * T + T * (tau - T)
+        return ax * q, ay * q, ax * T, ay * T, 0.0, 0.0
+    if kind == PIN_FLICK:
+        if t <= t0:
+            return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        tau = min(t - t0, T)
+        w = TWO_PI / T
+        sn = math.sin(w * tau)
+        cs = math.cos(w * tau)
+        v = (1.0 - cs) / w
+        r = (tau - sn / w) / w
+        a = sn if t - t0 < T else 0.0
+        return ax * r, ay * r, ax * v, ay * v, ax * a, ay * a
+    # PIN_TABLE: cubic pieces on [t_i, t_{i+1}], constant velocity after the last knot
+    n = int(par[P_NKNOT])
+    m = n - 1
+    if t <= tab[0]:  # (t = 0: the first piece's start; before it, its tangent)
+        x, vx, axx = _spline(tab, n, n, 0, 0.0)
+        y, vy, ayy = _spline(tab, n, n + 4 * m, 0, 0.0)
+        if t == tab[0]:
+            return x, y, vx, vy, axx, ayy
+        dt = t - tab[0]
+        return x + vx * dt, y + vy * dt, vx, vy, 0.0, 0.0
+    if t >= tab[n - 1]:
+        i = m - 1
+        u = tab[n - 1] - tab[i]
+        x, vx, _ = _spline(tab, n, n, i, u)
+        y, vy, _ = _spline(tab, n, n + 4 * m, i, u)
+        dt = t - tab[n - 1]
+        return x + vx * dt, y + vy * dt, vx, vy, 0.0, 0.0
+    i = np.searchsorted(tab[:n], t) - 1
+    if i < 0:
+        i = 0
+    u = t - tab[i]
+    x, vx, axx = _spline(tab, n, n, i, u)
+    y, vy, ayy = _spline(tab, n, n + 4 * m, i, u)
+    return x, y, vx, vy, axx, ayy
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, snode, tab):
+    """Derivative ``f = [theta', theta'', W']`` of the state ``y`` (length 2N + 1) at time t.
+
+    Leaves cos/sin of the angles in ``c``/``s``, ``S_j`` in ``S`` and the tensions in ``sig``.
+    Pass 0: trigonometry; pass 1: coefficients and Thomas forward elimination (one division
+    per row); pass 2: back substitution fused with the angular accelerations.
+    """
+    AG.sincos(N, y, c, s)
+    for j in range(N):
+        f[j] = y[N + j]
+    g = par[P_G]
+    px, py, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)
+    ex = pax
+    ey = pay - g
+    jl = N - 1
+    if N == 1:
+        w = y[1]
+        T = (h[0] * w * w + ex * c[0] + ey * s[0]) / invm[0]
+        sig[0] = T
+        f[1] = (ey * c[0] - ex * s[0]) / h[0]
+        f[2] = T * (c[0] * pvx + s[0] * pvy)
+        return
+    # ---- pass 1: rows j = 0 .. N-2, a_j T_{j-1} + b_j T_j + e_j T_{j+1} = r_j
+    eprev = 0.0  # e_{j-1} = C_{j-1}/m_j, which is also a_j
+    cpp = 0.0
+    dpp = 0.0
+    for j in range(N - 1):
+        cj = c[j]
+        sj = s[j]
+        cn = c[j + 1]
+        sn = s[j + 1]
+        C = cn * cj + sn * sj
+        S[j] = sn * cj - cn * sj
+        im = invm[j]
+        imn = invm[j + 1]
+        w = y[N + j]
+        r = -h[j] * w * w
+        a = eprev * im if j > 0 else 0.0  # C_{j-1}/m_j (eprev holds C_{j-1})
+        den = -(im + imn) - a * cpp
+        inv = 1.0 / den
+        cpp = C * imn * inv
+        dpp = (r - a * dpp) * inv
+        cp[j] = cpp
+        dp[j] = dpp
+        eprev = C
+    # last row (the held link): a T_{N-2} - T_{N-1}/m_{N-1} = r
+    im = invm[jl]
+    w = y[N + jl]
+    r = -h[jl] * w * w - (ex * c[jl] + ey * s[jl])
+    a = eprev * im
+    den = -im - a * cpp
+    Tn = (r - a * dpp) / den
+    sig[jl] = Tn
+    f[2 * N] = Tn * (c[jl] * pvx + s[jl] * pvy)
+    # ---- pass 2: back substitution; theta'' of link j + 1 once T_j is known
+    Tnn = 0.0  # T_{j+2}
+    for j in range(N - 2, -1, -1):
+        Tj = dp[j] - cp[j] * Tn
+        sig[j] = Tj
+        k = j + 1
+        if k == jl:
+            f[N + k] = ((ey * c[k] - ex * s[k]) - S[j] * Tj * invm[k]) / h[k]
+        else:
+            f[N + k] = (S[k] * Tnn * invm[k + 1] - S[j] * Tj * invm[k]) / h[k]
+        Tnn = Tn
+        Tn = Tj
+    f[N] = S[0] * Tnn * invm[1] / h[0]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, tab):
+    """Fill the (7, N + 1) position-form state Z (x, y, vx, vy, ax, ay, tension) from the
+    state y with its c, s, sig (as left by :func:`general_rhs`); column N is the held end."""
+    g = par[P_G]
+    px, py, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)
+    Z[K.RX, N] = px
+    Z[K.RY, N] = py
+    Z[K.RVX, N] = pvx
+    Z[K.RVY, N] = pvy
+    Z[K.RAX, N] = pax
+    Z[K.RAY, N] = pay
+    Z[K.RSIG, N] = 0.0
+    x = px
+    yy = py
+    vx = pvx
+    vy = pvy
+    for j in range(N - 1, -1, -1):
+        hj = h[j]
+        w = y[N + j] * hj
+        x -= c[j] * hj
+        yy -= s[j] * hj
+        vx += s[j] * w
+        vy -= c[j] * w
+        Z[K.RX, j] = x
+        Z[K.RY, j] = yy
+        Z[K.RVX, j] = vx
+        Z[K.RVY, j] = vy
+        Z[K.RSIG, j] = sig[j]
+    for j in range(N):
+        sx = sig[j] * c[j]
+        sy = sig[j] * s[j]
+        if j > 0:
+            sx -= sig[j - 1] * c[j - 1]
+            sy -= sig[j - 1] * s[j - 1]
+        Z[K.RAX, j] = invm[j] * sx
+        Z[K.RAY, j] = invm[j] * sy + g
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab):
+    """The per-step diagnostics of :func:`snapping.simulate.kernels.measure` for a general
+    chain (``meas`` of length :data:`NMEAS_G`): maxima of speed, acceleration, tension and
+    curvature (turning angle over the mean of the two adjacent link lengths) with the
+    arclength of their node from the held end, the free end's speed and acceleration, the
+    force of the chain on the held end (``-T_{N-1} t_{N-1}``), the energy
+    ``sum m_j (|v_j|^2/2 - g y_j) + g sum m_j s_j`` (zero hanging at rest from the origin),
+    link errors ``| |t_j| - 1 |``, the length, and the held end's position, velocity and
+    work done on the chain (``y[2N]``). ``rinv0`` is unused (links are exact)."""
+    general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, tab)
+    g = par[P_G]
+    vmax2 = -1.0
+    iv = 0
+    amax2 = -1.0
+    ia = 0
+    ke = 0.0
+    pe = 0.0
+    fin = 0.0
+    for i in range(N):
+        vx = Z[K.RVX, i]
+        vy = Z[K.RVY, i]
+        axx = Z[K.RAX, i]
+        ayy = Z[K.RAY, i]
+        v2 = vx * vx + vy * vy
+        a2 = axx * axx + ayy * ayy
+        mi = 1.0 / invm[i]
+        ke += mi * v2
+        pe += mi * Z[K.RY, i]
+        fin += a2
+        if v2 > vmax2:
+            vmax2 = v2
+            iv = i
+        if a2 > amax2:
+            amax2 = a2
+            ia = i
+    smax = -np.inf
+    emax = 0.0
+    length = 0.0
+    for j in range(N):
+        if sig[j] > smax:
+            smax = sig[j]
+        ln = math.sqrt(c[j] * c[j] + s[j] * s[j])
+        e = abs(ln - 1.0)
+        if e > emax:
+            emax = e
+        length += h[j] * ln
+    # curvature: turning angle phi_j at node j + 1 over (h_j + h_{j+1})/2; phi from atan2 only
+    # where its bound pi/2 |sin phi| (cos phi > 0) can beat the best so far
+    kbest = -1.0
+    ik = -1
+    for j in range(N - 1):
+        C = c[j + 1] * c[j] + s[j + 1] * s[j]
+        Sn = abs(s[j + 1] * c[j] - c[j + 1] * s[j])
+        hb = 2.0 / (h[j] + h[j + 1])
+        if C > 0.0 and 0.5 * math.pi * Sn * hb <= kbest:
+            continue
+        kap = math.atan2(Sn, C) * hb
+        if kap > kbest:
+            kbest = kap
+            ik = j
+    L = snode[0]
+    meas[K.M_VMAX] = math.sqrt(vmax2)
+    meas[K.M_SV] = snode[iv]
+    meas[K.M_AMAX] = math.sqrt(amax2)
+    meas[K.M_SA] = snode[ia]
+    meas[K.M_SIGMAX] = smax
+    if ik >= 0:
+        meas[K.M_KMAX] = kbest
+        meas[K.M_SK] = snode[ik + 1]
+    else:
+        meas[K.M_KMAX] = 0.0
+        meas[K.M_SK] = np.nan
+    meas[K.M_VEND] = math.sqrt(Z[K.RVX, 0] ** 2 + Z[K.RVY, 0] ** 2)
+    meas[K.M_AEND] = math.sqrt(Z[K.RAX, 0] ** 2 + Z[K.RAY, 0] ** 2)
+    meas[K.M_PFX] = -sig[N - 1] * c[N - 1]
+    meas[K.M_PFY] = -sig[N - 1] * s[N - 1]
+    meas[K.M_ENERGY] = 0.5 * ke - g * pe + par[P_EOFF]
+    meas[K.M_LINKERR] = emax
+    meas[K.M_LINKERR0] = emax
+    meas[K.M_LENGTH] = length / L if L > 0.0 else length
+    meas[M_PX] = Z[K.RX, N]
+    meas[M_PY] = Z[K.RY, N]
+    meas[M_PVX] = Z[K.RVX, N]
+    meas[M_PVY] = Z[K.RVY, N]
+    meas[M_WORK] = y[2 * N]
+    tot = fin + ke + pe + smax + length + y[2 * N]
+    meas[K.M_FINITE] = 1.0 if (tot - tot) == 0.0 else 0.0
+
+
+# ---------------------------------------------------------------- dispatch on the model's kind
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def model_rhs(N, t, y, f, c, s, S, cp, dp, sig, mdl):
+    """The derivative of y at t: the paper's uniform kernel (:func:`angles.angle_rhs`, state
+    of length 2N) when ``mdl`` is the uniform model, else :func:`general_rhs`."""
+    par, h, invm, snode, tab = mdl
+    if par[P_KIND] == KIND_UNIFORM:
+        AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)
+    else:
+        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, snode, tab)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
+    """The per-step diagnostics of y at t (:func:`angles.measure_angles` for the uniform
+    model, else :func:`general_measure`)."""
+    par, h, invm, snode, tab = mdl
+    if par[P_KIND] == KIND_UNIFORM:
+        AG.measure_angles(N, y, c, s, sig, Z, rinv0, meas)
+    else:
+        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab)
+
+
+def uniform_model(N: int):
+    """The model tuple of the paper's chain (dispatches to the uniform kernels)."""
+    return make_model(np.full(N, 1.0 / N), np.full(N, float(N)), uniform=True)
+
+
+def state_dim(mdl) -> int:
+    """Length of the state vector of a model with N links: 2N (uniform) or 2N + 1."""
+    par, h = mdl[0], mdl[1]
+    return 2 * h.size + (0 if par[P_KIND] == KIND_UNIFORM else 1)
+
+
+def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
+    """``[theta', theta'', W']`` by a dense solve of the rows above (numpy, O(N^3); for tests)."""
+    par, h, invm, snode, tab = mdl
+    N = h.size
+    th, om = y[:N], y[N:2 * N]
+    _, _, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)
+    ex, ey = pax, pay - par[P_G]
+    A = np.zeros((N, N))
+    r = -h * om**2
+    for j in range(N):
+        A[j, j] = -(invm[j] + invm[j + 1]) if j < N - 1 else -invm[j]
+        if j + 1 < N:
+            A[j, j + 1] = A[j + 1, j] = math.cos(th[j + 1] - th[j]) * invm[j + 1]
+    r[N - 1] -= ex * math.cos(th[N - 1]) + ey * math.sin(th[N - 1])
+    T = np.linalg.solve(A, r)
+    Sd = np.sin(np.diff(th))
+    acc = np.zeros(N)
+    for j in range(N):
+        lo = Sd[j - 1] * T[j - 1] * invm[j] if j >= 1 else 0.0
+        if j == N - 1:
+            acc[j] = ((ey * math.cos(th[j]) - ex * math.sin(th[j])) - lo) / h[j]
+        else:
+            acc[j] = (Sd[j] * T[j + 1] * invm[j + 1] - lo) / h[j]
+    W = T[N - 1] * (math.cos(th[N - 1]) * pvx + math.sin(th[N - 1]) * pvy)
+    return np.concatenate([om, acc, [W]])

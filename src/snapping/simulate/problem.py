@@ -1,0 +1,661 @@
+"""What is solved: the chain, its start, its held end and gravity (nothing numerical).
+
+A :class:`Problem` holds everything physical about a run:
+
+* the chain (:class:`Links`): link lengths ``h_j`` and node masses ``m_j`` (index 0 the
+  free end, as everywhere in :mod:`snapping.simulate`), with an optional point mass at
+  the free end. Masses lumped from a mass per length ``lambda(s)`` take each node's share
+  of its two links, ``m_j = mu_{j-1}/2 + mu_j/2`` with ``mu_j`` the mass of link j
+  (``lumping="shared"``); the paper's rule, node j carrying the whole of link j
+  (``lumping="paper"``), is exact only for equal links;
+* the start: node positions and velocities at t = 0 (a catenary of end separation chi,
+  a catenary between supports at different heights, any curve, or explicit nodes);
+* the held end (:class:`PinMotion`): fixed, or a prescribed motion ``r_p(t)``;
+* gravity ``g`` along +e2 (``y`` grows downward), any value >= 0.
+
+Nondimensional units as everywhere: the paper's chain has length 1, mass 1 and g = 1.
+:meth:`Problem.catenary` with the default links is the paper's problem exactly, so that
+``run(Problem.catenary(chi, N))`` is ``run(chi, N)``.
+
+Examples
+--------
+>>> from snapping.simulate.problem import Links, PinMotion, Problem
+>>> p = Problem.catenary(0.25, 100, links=Links.taper(100, ratio=0.1))   # a tapered whip
+>>> p.is_paper, round(float(p.links.link_mass.sum()), 12), bool(p.links.m[0] < p.links.m[-1])
+(False, 1.0, True)
+>>> Problem.catenary(0.25, 100).is_paper
+True
+>>> q = Problem.catenary(0.3, 50, links=Links.uniform(50, tip_mass=0.5), pin=PinMotion.flick((1.0, 0.0), 0.2))
+>>> q.describe()["pin"]["kind"], q.links.tip_mass
+('flick', 0.5)
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import _validate as V
+from . import general as G
+
+__all__ = ["Links", "PinMotion", "Problem", "LUMPINGS", "PIN_KINDS"]
+
+LUMPINGS = ("shared", "paper")
+PIN_KINDS = ("fixed", "pull", "flick", "table")
+#: relative tolerance of a shape's link lengths against the chain's
+SHAPE_RTOL = 1e-6
+
+
+def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
+    a = np.asarray(V.float_array(name, a), dtype=float).ravel().copy()
+    if a.size == 0 or (n is not None and a.size != n):
+        want = f"{n}" if n is not None else ">= 1"
+        raise V.SnappingInputError(f"{name} has {a.size} entries; expected {want}")
+    bad = np.flatnonzero(~(np.isfinite(a) & (a > 0.0)))
+    if bad.size:
+        raise V.SnappingInputError(f"{name}[{bad[0]}]={a[bad[0]]!r} is out of range: every entry must be finite "
+                                   f"and > 0")
+    return a
+
+
+def _links_count(name: str, N) -> int:
+    return V.integer(name, N, 1)
+
+
+# ---------------------------------------------------------------------------------- the chain
+@dataclass(frozen=True, eq=False)
+class Links:
+    """The chain: link lengths ``h`` and node masses ``m`` (N each, index 0 the free end).
+
+    ``m[0]`` includes ``tip_mass``. ``link_mass``: the mass of each link, where the chain was
+    lumped from a mass per length (None for explicit node masses); with ``lumping="shared"``
+    half of the held link's mass goes to the held end, which carries no mass of its own, so
+    ``m.sum() = link_mass.sum() - link_mass[-1]/2 + tip_mass``. Use the constructors; they
+    validate.
+    """
+
+    h: np.ndarray
+    m: np.ndarray
+    tip_mass: float = 0.0
+    kind: str = "explicit"
+    params: dict = field(default_factory=dict)
+    link_mass: np.ndarray | None = None
+
+    @property
+    def N(self) -> int:
+        """Number of links."""
+        return int(self.h.size)
+
+    @property
+    def length(self) -> float:
+        return float(self.h.sum())
+
+    @property
+    def is_paper(self) -> bool:
+        """The paper's chain: N equal links of length 1/N, N equal node masses 1/N, no tip mass."""
+        N = self.N
+        return bool(np.all(self.h == 1.0 / N) and np.all(self.m == 1.0 / N) and self.tip_mass == 0.0)
+
+    # -- constructors
+    @classmethod
+    def uniform(cls, N: int, *, tip_mass: float = 0.0, lumping: str = "paper") -> "Links":
+        """N equal links of total length 1 and mass 1, plus ``tip_mass`` (a ratio to the
+        chain's mass) at the free end. ``lumping="paper"`` (default): every node carries
+        1/N, the paper's chain; ``"shared"``: the free end carries 1/(2N).
+
+        >>> Links.uniform(4).m.tolist(), Links.uniform(4, lumping="shared").m.tolist()
+        ([0.25, 0.25, 0.25, 0.25], [0.125, 0.25, 0.25, 0.25])
+        """
+        N = _links_count("N", N)
+        h = np.full(N, 1.0 / N)
+        return cls.from_density(h, None, tip_mass=tip_mass, lumping=lumping, kind="uniform", params={})
+
+    @classmethod
+    def taper(cls, N: int, ratio: float, *, power: float = 1.0, tip_mass: float = 0.0,
+              lumping: str = "shared", h=None) -> "Links":
+        """A tapered chain (a whip): mass per length ``lambda(s) = lambda_0 (1 - c s)^power``
+        along the arclength s from the held end (total length 1), with ``c`` set by
+        ``lambda(1)/lambda(0) = ratio``, normalised to total mass 1; link masses are the
+        exact integrals of lambda over each link, lumped by ``lumping``. ``h``: link
+        lengths (default N equal links).
+
+        >>> w = Links.taper(10, 0.5)                # lambda = (1 - s/2)/0.75
+        >>> m_tip = (0.1 - 0.25 * (1 - 0.81)) / 2     # half the integral over [0.9, 1]
+        >>> m_last = (0.2 - 0.25 * 0.04) / 2          # half the integral over [0, 0.2]
+        >>> round(float(w.m[0] / w.m[-1]), 12) == round(m_tip / m_last, 12)
+        True
+        """
+        N = _links_count("N", N)
+        ratio = V.positive("ratio", ratio)
+        power = V.positive("power", power)
+        h = np.full(N, 1.0 / N) if h is None else _positive_array("h", h, N)
+        L = float(h.sum())
+        c = 1.0 - ratio ** (1.0 / power)
+
+        def prim(s):  # integral of (1 - c s/L)^power ds from 0 to s
+            if c == 0.0:
+                return s
+            return L * (1.0 - (1.0 - c * s / L) ** (power + 1.0)) / (c * (power + 1.0))
+
+        edges = np.concatenate([[0.0], np.cumsum(h[::-1])])  # from the held end
+        mu_from_pin = np.diff([prim(float(e)) for e in edges])
+        mu = (mu_from_pin / prim(L))[::-1]  # link masses, index 0 at the free end
+        return cls._lumped(h, mu, tip_mass, lumping, "taper", {"ratio": ratio, "power": power})
+
+    @classmethod
+    def from_density(cls, h, density=None, *, tip_mass: float = 0.0, lumping: str = "shared",
+                     kind: str = "density", params: dict | None = None) -> "Links":
+        """Links of lengths ``h`` (index 0 at the free end) with masses from a mass per length:
+        ``density`` is None (1 everywhere), an array of link masses per length (one per
+        link), or a function of the arclength from the held end (integrated over each link
+        with Gauss-Legendre quadrature, 8 points: exact for polynomials of degree 15).
+
+        >>> l = Links.from_density([0.5, 0.5], lambda s: 2 * s)   # heavier towards the tip
+        >>> l.m.tolist()
+        [0.375, 0.5]
+        """
+        h = _positive_array("h", h)
+        N = h.size
+        if density is None:
+            mu = h.copy()
+        elif callable(density):
+            xg, wg = np.polynomial.legendre.leggauss(8)
+            edges = np.concatenate([[0.0], np.cumsum(h[::-1])])
+            mu_p = np.zeros(N)
+            for k in range(N):
+                a, b = edges[k], edges[k + 1]
+                s = 0.5 * (a + b) + 0.5 * (b - a) * xg
+                vals = np.asarray([density(float(v)) for v in s], dtype=float)
+                if not np.all(np.isfinite(vals) & (vals > 0.0)):
+                    raise V.SnappingInputError(f"density(s) must be finite and > 0 on the chain; got {vals.min()!r} "
+                                               f"on link {N - 1 - k} (s in [{a:.6g}, {b:.6g}])")
+                mu_p[k] = 0.5 * (b - a) * float(np.dot(wg, vals))
+            mu = mu_p[::-1].copy()
+        else:
+            mu = h * _positive_array("density", density, N)
+        return cls._lumped(h, mu, tip_mass, lumping, kind, dict(params or {}))
+
+    @classmethod
+    def explicit(cls, h, m, *, tip_mass: float = 0.0) -> "Links":
+        """Links of lengths ``h`` and node masses ``m`` as given (``tip_mass`` added to ``m[0]``).
+
+        >>> Links.explicit([0.6, 0.4], [1.0, 2.0], tip_mass=0.5).m.tolist()
+        [1.5, 2.0]
+        """
+        h = _positive_array("h", h)
+        m = _positive_array("m", m, h.size)
+        tip = V.real("tip_mass", tip_mass)
+        if tip < 0.0:
+            raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must be >= 0")
+        m[0] += tip
+        return cls(h, m, tip, "explicit", {}, None)
+
+    @classmethod
+    def _lumped(cls, h, mu, tip_mass, lumping, kind, params) -> "Links":
+        if lumping not in LUMPINGS:
+            raise V.SnappingInputError(f"lumping={lumping!r} is not one of {LUMPINGS}")
+        tip = V.real("tip_mass", tip_mass)
+        if tip < 0.0:
+            raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must be >= 0 (a ratio to the chain's mass)")
+        if lumping == "paper":
+            m = mu.copy()
+        else:
+            m = 0.5 * mu
+            m[1:] += 0.5 * mu[:-1]
+        m[0] += tip
+        return cls(h, m, tip, kind, {**params, "lumping": lumping}, np.asarray(mu, dtype=float))
+
+    def describe(self) -> dict:
+        return {"kind": self.kind, "N": self.N, "tip_mass": self.tip_mass, **self.params}
+
+
+# ---------------------------------------------------------------------------------- the held end
+@dataclass(frozen=True, eq=False)
+class PinMotion:
+    """The motion of the held end: ``fixed``, ``pull`` (constant acceleration ``accel`` from
+    ``t0`` for ``duration``, then constant velocity), ``flick`` (acceleration
+    ``accel sin(2 pi (t - t0)/period)`` for one period: twice differentiable everywhere,
+    the end moves by ``accel period^2/(2 pi)`` and is at rest again), or ``table`` (a cubic
+    spline through samples of ``r_p(t)`` from t = 0, constant velocity after the last).
+    The held end starts at the origin."""
+
+    kind: str = "fixed"
+    accel: tuple = (0.0, 0.0)
+    t0: float = 0.0
+    duration: float = math.inf
+    table: tuple | None = None  # (t, x, y) samples
+
+    @classmethod
+    def fixed(cls) -> "PinMotion":
+        return cls()
+
+    @classmethod
+    def pull(cls, accel, duration: float = math.inf, t0: float = 0.0) -> "PinMotion":
+        """A constant-acceleration pull ``accel = (ax, ay)`` (y downward) from ``t0`` for ``duration``.
+
+        >>> PinMotion.pull((0.0, -0.5)).velocity(2.0)
+        (0.0, -1.0)
+        """
+        ax, ay = cls._vector("accel", accel)
+        t0 = V.real("t0", t0)
+        if t0 < 0.0:
+            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
+        d = math.inf if isinstance(duration, (int, float)) and duration == math.inf else \
+            V.positive("duration", duration)
+        return cls("pull", (ax, ay), t0, d)
+
+    @classmethod
+    def flick(cls, accel, period: float, t0: float = 0.0) -> "PinMotion":
+        """One period of a sine in the acceleration, peak ``accel = (ax, ay)``, over ``period``.
+
+        >>> f = PinMotion.flick((1.0, 0.0), 0.5)
+        >>> [round(v, 12) for v in f.position(0.5)], f.velocity(0.5)
+        ([0.039788735773, 0.0], (0.0, 0.0))
+        """
+        ax, ay = cls._vector("accel", accel)
+        T = V.positive("period", period)
+        t0 = V.real("t0", t0)
+        if t0 < 0.0:
+            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
+        return cls("flick", (ax, ay), t0, T)
+
+    @classmethod
+    def from_function(cls, r, t_max: float, samples: int = 2001) -> "PinMotion":
+        """The motion ``r(t) -> (x, y)`` on [0, t_max], sampled at ``samples`` equal times and
+        interpolated by a cubic spline (the motion that is run and recorded; constant velocity
+        after ``t_max``). ``r(0)`` must be the origin.
+
+        >>> import math
+        >>> p = PinMotion.from_function(lambda t: (0.1 * math.sin(t), 0.0), 1.0)
+        >>> round(p.position(0.5)[0], 9) == round(0.1 * math.sin(0.5), 9)
+        True
+        """
+        if not callable(r):
+            raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y))")
+        t_max = V.positive("t_max", t_max)
+        n = V.integer("samples", samples, 4)
+        t = np.linspace(0.0, t_max, n)
+        xy = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
+        if xy.ndim != 2 or xy.shape[1] != 2:
+            raise V.SnappingInputError(f"r(t) must return two numbers (x, y); got shape {xy.shape[1:]}")
+        return cls.from_table(t, xy[:, 0], xy[:, 1])
+
+    @classmethod
+    def from_table(cls, t, x, y) -> "PinMotion":
+        """The motion through samples ``(t_i, x_i, y_i)``, t_0 = 0 and (x_0, y_0) = (0, 0),
+        t increasing, at least 4 samples (a not-a-knot cubic spline through them)."""
+        t = np.asarray(V.float_array("t", t), dtype=float).ravel()
+        x = np.asarray(V.float_array("x", x), dtype=float).ravel()
+        y = np.asarray(V.float_array("y", y), dtype=float).ravel()
+        if not (t.size == x.size == y.size) or t.size < 4:
+            raise V.SnappingInputError(f"pin table t, x, y must have the same length >= 4; got {t.size}, {x.size}, "
+                                       f"{y.size}")
+        for name, a in (("t", t), ("x", x), ("y", y)):
+            if not np.all(np.isfinite(a)):
+                i = int(np.flatnonzero(~np.isfinite(a))[0])
+                raise V.SnappingInputError(f"pin motion {name}[{i}]={a[i]!r} is not finite")
+        if t[0] != 0.0 or not np.all(np.diff(t) > 0.0):
+            raise V.SnappingInputError(f"pin table times must start at 0 and increase; got t[0]={t[0]!r}")
+        scale = max(1.0, float(np.abs(np.concatenate([x, y])).max()))
+        if abs(x[0]) > 1e-12 * scale or abs(y[0]) > 1e-12 * scale:
+            raise V.SnappingInputError(f"the held end must start at the origin: r(0)=({x[0]!r}, {y[0]!r})")
+        x = x.copy()
+        y = y.copy()
+        x[0] = y[0] = 0.0
+        return cls("table", (0.0, 0.0), 0.0, float(t[-1]), (t.copy(), x, y))
+
+    @staticmethod
+    def _vector(name, v):
+        try:
+            a = np.asarray(v, dtype=float).ravel()
+        except (TypeError, ValueError):
+            raise V.SnappingInputError(f"{name}={v!r} is not a pair of numbers (ax, ay)") from None
+        if a.size != 2 or not np.all(np.isfinite(a)):
+            raise V.SnappingInputError(f"{name}={v!r} must be two finite numbers (ax, ay)")
+        return float(a[0]), float(a[1])
+
+    # -- compiled form and evaluation
+    def _spline_table(self):
+        from scipy.interpolate import CubicSpline
+
+        t, x, y = self.table
+        return t, CubicSpline(t, x).c, CubicSpline(t, y).c
+
+    def model_args(self) -> dict:
+        """Keyword arguments of :func:`general.make_model` for this motion."""
+        code = {"fixed": G.PIN_FIXED, "pull": G.PIN_PULL, "flick": G.PIN_FLICK, "table": G.PIN_TABLE}[self.kind]
+        ax, ay = self.accel
+        return {"pin": (code, ax, ay, self.t0, self.duration),
+                "table": self._spline_table() if self.kind == "table" else None}
+
+    def kinematics(self, t: float):
+        """(x, y, vx, vy, ax, ay) of the held end at time t (the compiled evaluation)."""
+        mdl = G.make_model(np.ones(1), np.ones(1), **self.model_args())
+        return tuple(float(v) for v in G.pin_kinematics(float(t), mdl[0], mdl[4]))
+
+    def position(self, t: float):
+        return self.kinematics(t)[:2]
+
+    def velocity(self, t: float):
+        return self.kinematics(t)[2:4]
+
+    @property
+    def is_fixed(self) -> bool:
+        return self.kind == "fixed"
+
+    def describe(self) -> dict:
+        d = {"kind": self.kind}
+        if self.kind in ("pull", "flick"):
+            d.update({"accel": list(self.accel), "t0": self.t0,
+                      ("duration" if self.kind == "pull" else "period"): self.duration})
+        if self.kind == "table":
+            d["samples"] = int(self.table[0].size)
+            d["t_max"] = float(self.table[0][-1])
+        return d
+
+
+# ---------------------------------------------------------------------------------- the problem
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """A chain, its start (node positions ``x, y`` and velocities ``vx, vy`` at t = 0, N + 1
+    each, index N the held end at the origin), the held end's motion and gravity.
+
+    Build it with :meth:`catenary`, :meth:`supports`, :meth:`curve` or :meth:`nodes`.
+    ``start`` describes the start shape (recorded in the run file); ``chi`` and ``chords``
+    are set for the paper's catenary start.
+    """
+
+    links: Links
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    pin: PinMotion = field(default_factory=PinMotion)
+    gravity: float = 1.0
+    start: dict = field(default_factory=dict)
+    chi: float | None = None
+    chords: str | None = None
+
+    @property
+    def N(self) -> int:
+        return self.links.N
+
+    @property
+    def is_paper(self) -> bool:
+        """The paper's problem: its chain from the catenary, at rest, fixed pin, g = 1."""
+        return bool(self.links.is_paper and self.start.get("kind") == "catenary" and self.pin.is_fixed
+                    and self.gravity == 1.0 and not self.start.get("velocities"))
+
+    @property
+    def is_uniform_fixed(self) -> bool:
+        """The paper's chain and held end with g = 1, from any start (what Euler-Richardson takes)."""
+        return bool(self.links.is_paper and self.pin.is_fixed and self.gravity == 1.0)
+
+    # -- constructors
+    @classmethod
+    def catenary(cls, chi: float, N: int | None = None, *, chords: str = "arclength", links: Links | None = None,
+                 pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
+        """The paper's start: the level catenary of end separation ``chi``, at rest. With the
+        paper's links (default: ``Links.uniform(N)``) the nodes are those of
+        :func:`snapping.simulate.initial_state` (``chords`` as there); other links are placed
+        on the same curve with chords exactly ``h_j`` (walking from the held end)."""
+        from .chain import initial_state
+
+        if links is None:
+            links = Links.uniform(_links_count("N", N))
+        elif N is not None and V.integer("N", N, 1) != links.N:
+            raise V.SnappingInputError(f"N={N!r} disagrees with the chain's {links.N} links")
+        chi = V.open_interval("chi", chi, 0.0, 1.0)
+        if links.is_paper:
+            st = initial_state(chi, links.N, chords)
+            x, y = st.x, st.y
+        else:
+            from .. import estimates
+            from . import shapes
+            from .chain import CHORDS, _catenary_xy
+
+            if chords not in CHORDS:
+                raise V.SnappingInputError(f"chords={chords!r} is not one of {CHORDS}")
+            L = links.length
+            if chords == "exact":
+                a = estimates.catenary_parameter(chi)
+
+                def cat(s):
+                    cx, cy = _catenary_xy(np.asarray(s, dtype=float) / L, chi, a)
+                    return L * cx, L * cy
+
+                x, y = shapes.place_on_curve(cat, links.h)
+            else:  # nodes at their arclength on the curve (chords a little shorter than h_j)
+                s = np.clip(np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]]) / L, 0.0, 1.0)
+                xs, ys = estimates.catenary_shape(s, chi)
+                x, y = L * np.asarray(xs, dtype=float), L * np.asarray(ys, dtype=float)
+                x[-1] = y[-1] = 0.0
+        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "catenary", "chi": chi, "chords": chords},
+                         chi=chi, chords=chords)
+
+    @classmethod
+    def supports(cls, dx: float, dy: float, N: int | None = None, *, links: Links | None = None,
+                 pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
+        """The catenary hanging between the held end (origin) and a second support at
+        ``(dx, dy)`` (``dy > 0``: lower, y grows downward), released at rest from there;
+        nodes at chords exactly ``h_j``."""
+        from . import shapes
+
+        links = links if links is not None else Links.uniform(_links_count("N", N))
+        dx = V.positive("dx", dx)
+        dy = V.real("dy", dy)
+        curve = shapes.catenary_between(dx, dy, links.length)
+        x, y = shapes.place_on_curve(curve, links.h)
+        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "supports", "dx": dx, "dy": dy})
+
+    @classmethod
+    def curve(cls, curve, N: int | None = None, *, links: Links | None = None, vx=None, vy=None,
+              pin: PinMotion | None = None, gravity: float = 1.0, name: str = "curve") -> "Problem":
+        """Any start curve: a function ``s -> (x, y)`` of the arclength from the held end (at
+        the origin), or a polyline ``(xc, yc)`` starting at the held end; nodes at chords
+        exactly ``h_j`` along it."""
+        from . import shapes
+
+        links = links if links is not None else Links.uniform(_links_count("N", N))
+        x, y = shapes.place_on_curve(curve, links.h)
+        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "curve", "name": str(name)})
+
+    @classmethod
+    def nodes(cls, x, y, *, links: Links | None = None, vx=None, vy=None, pin: PinMotion | None = None,
+              gravity: float = 1.0, name: str = "nodes") -> "Problem":
+        """Start from node coordinates (N + 1 each, index 0 the free end, index N the held end
+        at the origin); ``links`` default: the uniform chain of the nodes' count. Link lengths
+        must agree with the chain's ``h`` to ``SHAPE_RTOL``; velocities (default: at rest, or
+        moving with the held end) must keep the links' lengths."""
+        x = np.asarray(V.float_array("x", x), dtype=float).ravel()
+        y = np.asarray(V.float_array("y", y), dtype=float).ravel()
+        if x.size != y.size or x.size < 2:
+            raise V.SnappingInputError(f"shape x and y must have the same length N + 1 >= 2; got {x.size}, {y.size}")
+        links = links if links is not None else Links.uniform(x.size - 1)
+        if x.size != links.N + 1:
+            raise V.SnappingInputError(f"shape has {x.size} nodes but the chain has {links.N} links "
+                                       f"({links.N + 1} nodes)")
+        lens = np.hypot(np.diff(x), np.diff(y))
+        rel = np.abs(lens - links.h) / links.h
+        if rel.size and rel.max() > SHAPE_RTOL:
+            j = int(np.argmax(rel))
+            raise V.SnappingInputError(f"shape link {j} has length {lens[j]:.9g} but the chain's link is "
+                                       f"{links.h[j]:.9g} (relative difference {rel[j]:.3g} > {SHAPE_RTOL:g})")
+        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "nodes", "name": str(name)})
+
+    @classmethod
+    def _make(cls, links, x, y, vx, vy, pin, gravity, start, chi=None, chords=None) -> "Problem":
+        from . import shapes
+
+        if not isinstance(links, Links):
+            raise V.SnappingInputError(f"links={type(links).__name__} is not a Links")
+        pin = PinMotion() if pin is None else pin
+        if not isinstance(pin, PinMotion):
+            raise V.SnappingInputError(f"pin={type(pin).__name__} is not a PinMotion")
+        g = V.real("gravity", gravity)
+        if g < 0.0:
+            raise V.SnappingInputError(f"gravity={g!r} is out of range: must be >= 0 (along +e2, y downward)")
+        x = np.array(x, dtype=float)
+        y = np.array(y, dtype=float)
+        N = links.N
+        if x.size != N + 1:
+            raise V.SnappingInputError(f"start has {x.size} nodes, the chain {N + 1}")
+        if x[-1] != 0.0 or y[-1] != 0.0:
+            raise V.SnappingInputError(f"the held end (node {N}) must start at the origin; got ({x[-1]!r}, {y[-1]!r})")
+        shapes.check_curve(x, y, name=start.get("name", start["kind"]))
+        pvx, pvy = pin.velocity(0.0)
+        moving = vx is not None or vy is not None
+        vx = np.full(N + 1, pvx) if vx is None else np.array(V.float_array("vx", vx), dtype=float).ravel()
+        vy = np.full(N + 1, pvy) if vy is None else np.array(V.float_array("vy", vy), dtype=float).ravel()
+        for name, v in (("vx", vx), ("vy", vy)):
+            if v.size != N + 1 or not np.all(np.isfinite(v)):
+                raise V.SnappingInputError(f"{name} must be {N + 1} finite numbers (one per node); got {v.size}")
+        if abs(vx[-1] - pvx) > 1e-12 or abs(vy[-1] - pvy) > 1e-12:
+            raise V.SnappingInputError(f"the held end's velocity ({vx[-1]!r}, {vy[-1]!r}) must be the pin's, "
+                                       f"({pvx!r}, {pvy!r}), at t = 0")
+        dx, dy = np.diff(x), np.diff(y)
+        stretch = np.abs(dx * np.diff(vx) + dy * np.diff(vy)) / np.hypot(dx, dy)
+        vscale = max(1.0, float(np.abs(np.concatenate([vx, vy])).max()))
+        if stretch.size and stretch.max() > 1e-9 * vscale:
+            j = int(np.argmax(stretch))
+            raise V.SnappingInputError(f"initial velocities stretch link {j} at the rate {stretch[j]:.3g}: they "
+                                       f"must keep every link's length (relative velocity normal to the link)")
+        if moving:
+            start = {**start, "velocities": True}
+        return cls(links, x, y, vx, vy, pin, g, start, chi, chords)
+
+    # -- the compiled form
+    def model(self):
+        """The model tuple of :mod:`snapping.simulate.general` (uniform kernels for the paper's
+        chain with a fixed held end and g = 1, whatever the start)."""
+        if self.is_uniform_fixed:
+            return G.uniform_model(self.N)
+        return G.make_model(self.links.h, 1.0 / self.links.m, g=self.gravity, **self.pin.model_args())
+
+    def initial_angles(self) -> np.ndarray:
+        """The initial state of the link-angle form: ``[theta, theta']`` (paper's chain) or
+        ``[theta, theta', W = 0]`` (general), from the start's nodes."""
+        dx, dy = np.diff(self.x), np.diff(self.y)
+        th = np.unwrap(np.arctan2(dy, dx))
+        dvx, dvy = np.diff(self.vx), np.diff(self.vy)
+        if self.is_uniform_fixed:
+            from . import angles as AG
+            from .chain import ChainState
+
+            return AG.state_to_angles(ChainState(self.x, self.y, self.vx, self.vy, 0.0))
+        om = (-np.sin(th) * dvx + np.cos(th) * dvy) / self.links.h
+        return np.concatenate([th, om, [0.0]]).astype(float)
+
+    def describe(self) -> dict:
+        """JSON-friendly description (recorded in the run file)."""
+        return {"chain": self.links.describe(), "start": dict(self.start), "pin": self.pin.describe(),
+                "gravity": self.gravity}
+
+    def describe_json(self) -> str:
+        return json.dumps(self.describe(), sort_keys=True)
+
+
+# ---------------------------------------------------------------------------------- from options
+def parse_pin_motion(spec: str | None) -> PinMotion:
+    """A :class:`PinMotion` from a command-line spec: ``fixed``, ``pull:AX,AY[,DURATION[,T0]]``
+    or ``flick:AX,AY,PERIOD[,T0]`` (nondimensional; y downward).
+
+    >>> parse_pin_motion("flick:2,0,0.3").describe()["period"]
+    0.3
+    >>> parse_pin_motion("pull:0,-0.5").duration
+    inf
+    """
+    if spec is None or str(spec).strip() in ("", "fixed"):
+        return PinMotion.fixed()
+    kind, _, rest = str(spec).partition(":")
+    kind = kind.strip()
+    try:
+        vals = [float(v) for v in rest.split(",") if v.strip()]
+    except ValueError:
+        raise V.SnappingInputError(f"pin_motion={spec!r}: the parameters after {kind + ':'!r} must be numbers") \
+            from None
+    if kind == "pull" and 2 <= len(vals) <= 4:
+        return PinMotion.pull(vals[:2], *(vals[2:3] or [math.inf]), *(vals[3:4] or [0.0]))
+    if kind == "flick" and 3 <= len(vals) <= 4:
+        return PinMotion.flick(vals[:2], vals[2], *(vals[3:4] or [0.0]))
+    raise V.SnappingInputError(f"pin_motion={spec!r} is not one of 'fixed', 'pull:AX,AY[,DURATION[,T0]]', "
+                               f"'flick:AX,AY,PERIOD[,T0]'")
+
+
+def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
+    """Points (x, y) of a start curve from a CSV file (two columns x, y; a header line is
+    skipped) or a netCDF file (variables ``x`` and ``y``), listed from the held end; the
+    curve is translated so that its first point (the held end) is at the origin."""
+    import os
+
+    p = V.file_path("shape", path)
+    if not os.path.isfile(p):
+        raise V.SnappingInputError(f"shape={p!r} does not exist or is not a file")
+    if p.endswith((".nc", ".nc4", ".cdf")):
+        import xarray as xr
+
+        try:
+            with xr.open_dataset(p) as ds:
+                x, y = (np.asarray(ds[k].values, dtype=float).ravel() for k in ("x", "y"))
+        except (OSError, KeyError, ValueError) as exc:
+            raise V.SnappingInputError(f"shape={p!r}: not a netCDF file with variables x and y ({exc})") from None
+    else:
+        try:
+            a = np.genfromtxt(p, delimiter=",", dtype=float, comments="#")
+        except (OSError, ValueError) as exc:
+            raise V.SnappingInputError(f"shape={p!r}: cannot read it as CSV ({exc})") from None
+        a = np.atleast_2d(a)
+        if a.ndim != 2 or a.shape[1] < 2:
+            raise V.SnappingInputError(f"shape={p!r}: expected two comma-separated columns x, y")
+        a = a[~np.all(np.isnan(a[:, :2]), axis=1)]  # a header line reads as NaN
+        x, y = a[:, 0], a[:, 1]
+    if x.size < 2 or not np.all(np.isfinite(x) & np.isfinite(y)):
+        raise V.SnappingInputError(f"shape={p!r}: needs at least 2 finite points (x, y); got {x.size}")
+    return x - x[0], y - y[0]
+
+
+def from_options(*, chi=None, N=None, chords: str = "arclength", supports=None, shape=None, tip_mass: float = 0.0,
+                 taper=None, lumping: str | None = None, pin_motion=None, gravity: float = 1.0) -> Problem | None:
+    """The problem the command-line options describe (``snapping simulate``), or None when
+    they describe the paper's problem (then ``run(chi, N)``).
+
+    ``supports``: ``(dx, dy)``; ``shape``: a file for :func:`read_shape`; ``taper``:
+    ``ratio`` or ``(ratio, power)``; ``pin_motion``: a spec for :func:`parse_pin_motion`.
+
+    >>> from_options(chi=0.3, N=10) is None
+    True
+    >>> from_options(chi=0.3, N=10, tip_mass=0.5).links.tip_mass
+    0.5
+    """
+    starts = [k for k, v in (("chi", chi), ("supports", supports), ("shape", shape)) if v is not None]
+    if len(starts) != 1:
+        raise V.SnappingInputError(f"give exactly one start: --chi, --supports DX,DY or --shape FILE (got "
+                                   f"{starts or 'none'})")
+    N = _links_count("N", N)
+    if taper is not None:
+        tv = [taper] if np.ndim(taper) == 0 else list(taper)
+        if not 1 <= len(tv) <= 2:
+            raise V.SnappingInputError(f"taper={taper!r} must be a ratio or (ratio, power)")
+        ratio, power = (tv + [1.0])[:2]
+        links = Links.taper(N, ratio, power=power, tip_mass=tip_mass, lumping=lumping or "shared")
+    else:
+        links = Links.uniform(N, tip_mass=tip_mass, lumping=lumping or "paper")
+    pin = pin_motion if isinstance(pin_motion, PinMotion) else parse_pin_motion(pin_motion)
+    if chi is not None:
+        p = Problem.catenary(chi, links=links, chords=chords, pin=pin, gravity=gravity)
+        return None if p.is_paper else p
+    if supports is not None:
+        try:
+            dx, dy = (float(v) for v in supports)
+        except (TypeError, ValueError):
+            raise V.SnappingInputError(f"supports={supports!r} must be two numbers DX,DY") from None
+        return Problem.supports(dx, dy, links=links, pin=pin, gravity=gravity)
+    x, y = read_shape(shape)
+    L = float(np.hypot(np.diff(x), np.diff(y)).sum())
+    if L < links.length * (1.0 - 1e-9):
+        raise V.SnappingInputError(f"shape={shape!r} is {L:.6g} long, shorter than the chain ({links.length:.6g}): "
+                                   f"give the start curve in units of the chain's length")
+    return Problem.curve((x, y), links=links, pin=pin, gravity=gravity, name=str(shape))
