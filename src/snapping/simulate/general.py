@@ -35,10 +35,11 @@ the state, as a last component ``W``, so that the energy balance ``E(t) - W(t) =
 is a conservation law the stepper can be checked against (``W = 0`` for a fixed pin).
 
 Layout: the state is ``y = [theta (N), theta' (N), W]`` (length 2N + 1); the model is a
-tuple ``mdl = (par, h, invm, snode, tab)`` of float64 arrays built by
+tuple ``mdl = (par, h, invm, wlo, whi, snode, tab)`` of float64 arrays built by
 :meth:`snapping.simulate.problem.Problem.model`: scalar parameters (indices ``P_*``),
-link lengths, inverse node masses, the arclength of each node from the held end, and
-the pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
+link lengths, inverse node masses, the couplings ``1/(m_j h_j)`` and ``1/(m_{j+1} h_j)``
+of the angular accelerations, the arclength of each node from the held end, and the
+pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
 :func:`model_rhs` and :func:`model_measure` call the uniform kernels of
 :mod:`snapping.simulate.angles` unchanged (bit for bit the runs of before).
 
@@ -72,6 +73,10 @@ from numba import njit
 
 from . import angles as AG
 from . import kernels as K
+
+#: rows between power-of-two rescalings of the leading minors (node masses within a factor
+#: 1e12 of each other keep them far from overflow: |p_j/p_{j-1}| <= 2 max(1/m))
+BLOCK = 16
 
 __all__ = [
     "Work", "make_model", "general_rhs", "general_measure", "model_rhs", "model_measure", "pin_kinematics",
@@ -109,7 +114,7 @@ class Work:
 
 def make_model(h, invm, *, g: float = 1.0, pin=(PIN_FIXED, 0.0, 0.0, 0.0, math.inf), table=None,
                uniform: bool = False):
-    """The model tuple ``(par, h, invm, snode, tab)`` of the compiled kernels (no checks:
+    """The model tuple ``(par, h, invm, wlo, whi, snode, tab)`` of the compiled kernels (no checks:
     :class:`snapping.simulate.problem.Problem` validates and calls this).
 
     ``pin = (kind, ax, ay, t0, T)`` for the presets; ``table = (t, cx, cy)`` with ``cx``,
@@ -134,7 +139,10 @@ def make_model(h, invm, *, g: float = 1.0, pin=(PIN_FIXED, 0.0, 0.0, 0.0, math.i
     else:
         tab = np.zeros(1)
     par[P_EOFF] = g * float(np.sum(snode[:N] / invm))
-    return par, h, invm, snode, tab
+    wlo = invm / h  # 1/(m_j h_j) and 1/(m_{j+1} h_j): the couplings of theta_j'' to T_{j-1}, T_{j+1}
+    whi = np.zeros(N)
+    whi[:N - 1] = invm[1:] / h[:N - 1]
+    return par, h, invm, wlo, whi, snode, tab
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -205,12 +213,16 @@ def pin_kinematics(t, par, tab):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, snode, tab):
+def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode, tab):
     """Derivative ``f = [theta', theta'', W']`` of the state ``y`` (length 2N + 1) at time t.
 
     Leaves cos/sin of the angles in ``c``/``s``, ``S_j`` in ``S`` and the tensions in ``sig``.
-    Pass 0: trigonometry; pass 1: coefficients and Thomas forward elimination (one division
-    per row); pass 2: back substitution fused with the angular accelerations.
+    Pass 0: trigonometry; pass 1: coefficients and the forward elimination with Thomas's
+    pivots as ratios of leading minors, ``p_j = b_j p_{j-1} - e_{j-1}^2 p_{j-2}`` and
+    ``q_j = r_j p_{j-1} - e_{j-1} q_{j-1}`` (no division in the recurrence, so that the
+    divisions ``1/p_j`` pipeline; as :func:`snapping.simulate.angles.angle_rhs`), rescaled
+    by a power of two every ``BLOCK`` rows; pass 2: back substitution fused with the
+    angular accelerations.
     """
     AG.sincos(N, y, c, s)
     for j in range(N):
@@ -227,55 +239,68 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, snode, tab):
         f[1] = (ey * c[0] - ex * s[0]) / h[0]
         f[2] = T * (c[0] * pvx + s[0] * pvy)
         return
-    # ---- pass 1: rows j = 0 .. N-2, a_j T_{j-1} + b_j T_j + e_j T_{j+1} = r_j
-    eprev = 0.0  # e_{j-1} = C_{j-1}/m_j, which is also a_j
-    cpp = 0.0
-    dpp = 0.0
-    for j in range(N - 1):
-        cj = c[j]
-        sj = s[j]
-        cn = c[j + 1]
-        sn = s[j + 1]
-        C = cn * cj + sn * sj
-        S[j] = sn * cj - cn * sj
-        im = invm[j]
-        imn = invm[j + 1]
-        w = y[N + j]
-        r = -h[j] * w * w
-        a = eprev * im if j > 0 else 0.0  # C_{j-1}/m_j (eprev holds C_{j-1})
-        den = -(im + imn) - a * cpp
-        inv = 1.0 / den
-        cpp = C * imn * inv
-        dpp = (r - a * dpp) * inv
-        cp[j] = cpp
-        dp[j] = dpp
-        eprev = C
-    # last row (the held link): a T_{N-2} - T_{N-1}/m_{N-1} = r
-    im = invm[jl]
+    # ---- pass 1: rows j = 0 .. N-2, e_{j-1} T_{j-1} + b_j T_j + e_j T_{j+1} = r_j
+    eprev = 0.0  # e_{j-1} = C_{j-1}/m_j
+    im = invm[0]
+    pm = 1.0
+    pmm = 0.0
+    q = 0.0
+    j0 = 0
+    while j0 < N - 1:
+        j1 = min(j0 + BLOCK, N - 1)
+        for j in range(j0, j1):
+            cj = c[j]
+            sj = s[j]
+            cn = c[j + 1]
+            sn = s[j + 1]
+            C = cn * cj + sn * sj
+            S[j] = sn * cj - cn * sj
+            imn = invm[j + 1]
+            w = y[N + j]
+            r = -h[j] * (w * w)
+            p = -(im + imn) * pm - (eprev * eprev) * pmm
+            q = r * pm - eprev * q
+            e = C * imn
+            inv = 1.0 / p
+            cp[j] = e * pm * inv
+            dp[j] = q * inv
+            pmm = pm
+            pm = p
+            eprev = e
+            im = imn
+        ex2 = math.frexp(pm)[1]
+        sc = math.ldexp(1.0, -ex2)
+        pm *= sc
+        pmm *= sc
+        q *= sc
+        j0 = j1
+    # last row (the held link): e_{N-2} T_{N-2} - T_{N-1}/m_{N-1} = r
     w = y[N + jl]
-    r = -h[jl] * w * w - (ex * c[jl] + ey * s[jl])
-    a = eprev * im
-    den = -im - a * cpp
-    Tn = (r - a * dpp) / den
+    r = -h[jl] * (w * w) - (ex * c[jl] + ey * s[jl])
+    p = -invm[jl] * pm - (eprev * eprev) * pmm
+    q = r * pm - eprev * q
+    Tn = q / p
     sig[jl] = Tn
     f[2 * N] = Tn * (c[jl] * pvx + s[jl] * pvy)
     # ---- pass 2: back substitution; theta'' of link j + 1 once T_j is known
-    Tnn = 0.0  # T_{j+2}
-    for j in range(N - 2, -1, -1):
+    j = N - 2  # (link j + 1 = N - 1 is the held link)
+    Tj = dp[j] - cp[j] * Tn
+    sig[j] = Tj
+    f[N + jl] = (ey * c[jl] - ex * s[jl]) / h[jl] - S[j] * Tj * wlo[jl]
+    Tnn = Tn  # T_{j+2}
+    Tn = Tj
+    for j in range(N - 3, -1, -1):
         Tj = dp[j] - cp[j] * Tn
         sig[j] = Tj
         k = j + 1
-        if k == jl:
-            f[N + k] = ((ey * c[k] - ex * s[k]) - S[j] * Tj * invm[k]) / h[k]
-        else:
-            f[N + k] = (S[k] * Tnn * invm[k + 1] - S[j] * Tj * invm[k]) / h[k]
+        f[N + k] = S[k] * Tnn * whi[k] - S[j] * Tj * wlo[k]
         Tnn = Tn
         Tn = Tj
-    f[N] = S[0] * Tnn * invm[1] / h[0]
+    f[N] = S[0] * Tnn * whi[0]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, tab):
+def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, wlo, whi, snode, tab):
     """Fill the (7, N + 1) position-form state Z (x, y, vx, vy, ax, ay, tension) from the
     state y with its c, s, sig (as left by :func:`general_rhs`); column N is the held end."""
     g = par[P_G]
@@ -314,7 +339,7 @@ def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, tab):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab):
+def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, snode, tab):
     """The per-step diagnostics of :func:`snapping.simulate.kernels.measure` for a general
     chain (``meas`` of length :data:`NMEAS_G`): maxima of speed, acceleration, tension and
     curvature (turning angle over the mean of the two adjacent link lengths) with the
@@ -323,7 +348,7 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab
     ``sum m_j (|v_j|^2/2 - g y_j) + g sum m_j s_j`` (zero hanging at rest from the origin),
     link errors ``| |t_j| - 1 |``, the length, and the held end's position, velocity and
     work done on the chain (``y[2N]``). ``rinv0`` is unused (links are exact)."""
-    general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, tab)
+    general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, wlo, whi, snode, tab)
     g = par[P_G]
     vmax2 = -1.0
     iv = 0
@@ -408,22 +433,22 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab
 def model_rhs(N, t, y, f, c, s, S, cp, dp, sig, mdl):
     """The derivative of y at t: the paper's uniform kernel (:func:`angles.angle_rhs`, state
     of length 2N) when ``mdl`` is the uniform model, else :func:`general_rhs`."""
-    par, h, invm, snode, tab = mdl
+    par, h, invm, wlo, whi, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)
     else:
-        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, snode, tab)
+        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode, tab)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
 def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
     """The per-step diagnostics of y at t (:func:`angles.measure_angles` for the uniform
     model, else :func:`general_measure`)."""
-    par, h, invm, snode, tab = mdl
+    par, h, invm, wlo, whi, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.measure_angles(N, y, c, s, sig, Z, rinv0, meas)
     else:
-        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, snode, tab)
+        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, snode, tab)
 
 
 def uniform_model(N: int):
@@ -439,7 +464,7 @@ def state_dim(mdl) -> int:
 
 def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
     """``[theta', theta'', W']`` by a dense solve of the rows above (numpy, O(N^3); for tests)."""
-    par, h, invm, snode, tab = mdl
+    par, h, invm, wlo, whi, snode, tab = mdl
     N = h.size
     th, om = y[:N], y[N:2 * N]
     _, _, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)

@@ -334,7 +334,7 @@ class PinMotion:
     def kinematics(self, t: float):
         """(x, y, vx, vy, ax, ay) of the held end at time t (the compiled evaluation)."""
         mdl = G.make_model(np.ones(1), np.ones(1), **self.model_args())
-        return tuple(float(v) for v in G.pin_kinematics(float(t), mdl[0], mdl[4]))
+        return tuple(float(v) for v in G.pin_kinematics(float(t), mdl[0], mdl[-1]))
 
     def position(self, t: float):
         return self.kinematics(t)[:2]
