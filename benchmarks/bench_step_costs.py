@@ -28,7 +28,7 @@ import numpy as np
 
 from snapping.simulate import angles as AG
 from snapping.simulate import ensemble as E
-from snapping.simulate import highorder as HO
+from snapping.simulate.methods import dop853 as HO
 from snapping.simulate import rk as R
 from snapping.simulate.chain import initial_state
 
@@ -55,7 +55,7 @@ def engines(chis, N, tol, steps_per_call):
     """Fresh engines of the members, returning to Python every ``steps_per_call`` steps."""
     out = []
     for chi in chis:
-        e = HO._Engine(AG.state_to_angles(initial_state(chi, N, chords="exact")), 0.0, tol=tol, dt0=None,
+        e = HO.Engine(AG.state_to_angles(initial_state(chi, N, chords="exact")), 0.0, tol=tol, dt0=None,
                        t_end=10.0, stop_fraction=0.0, thin=0.0, max_link_error=1e-2, snapshot_times=())
         e.start()
         e.ctl[R.Q_STEPS_PER_CALL] = steps_per_call

@@ -15,6 +15,7 @@ import pytest
 from snapping import SnappingInputError, schema
 from snapping import sweep as S
 from snapping.simulate import (
+    memory_need,
     DriftError,
     EnergyDriftError,
     NonFiniteError,
@@ -28,7 +29,8 @@ from snapping.simulate import (
     run,
 )
 from snapping.simulate import kernels as K
-from snapping.simulate import stepper
+from snapping.simulate import driver as stepper
+from snapping.simulate.methods import euler_richardson as ER
 
 
 def assert_same_run(a, b):
@@ -68,7 +70,7 @@ class _Killed(Exception):
 @pytest.fixture
 def small_chunks(monkeypatch):
     # about 400 steps per return of the compiled loop at N = 50
-    monkeypatch.setattr(stepper, "NODE_STEPS_PER_CALL", 50 * 400)
+    monkeypatch.setattr(ER, "NODE_STEPS_PER_CALL", 50 * 400)
     yield
     stepper._chunk_hook = None
 
@@ -267,7 +269,9 @@ def test_non_finite_state(tmp_path, small_chunks, monkeypatch):
 
 # ---------------------------------------------------------------- resource guard
 def test_memory_guard_refuses_with_numbers(monkeypatch):
-    monkeypatch.setattr(stepper, "_available_memory", lambda: 10 * 2**20)
+    from snapping.simulate import options
+
+    monkeypatch.setattr(options, "_available_memory", lambda: 10 * 2**20)
     with pytest.raises(SnappingInputError, match=r"GiB.*available.*record_thin") as info:
         run(0.25, 100)
     msg = str(info.value)
@@ -282,5 +286,7 @@ def test_memory_guard_against_the_real_machine():
         run(0.5, 10, method="euler-richardson-fixed", dt0=1e-12, t_end=10.0)
     with pytest.raises(SnappingInputError, match="would need about"):
         run(0.5, 10**10)
-    need = stepper.memory_need(10, chi=0.5, method="euler-richardson-fixed", dt0=1e-12, t_end=10.0, record_thin=1e-3)
+    with pytest.raises(SnappingInputError, match="would need about"):  # every method has the guard
+        run(0.5, 10**9, method="fast")
+    need = memory_need(10, chi=0.5, method="euler-richardson-fixed", dt0=1e-12, t_end=10.0, record_thin=1e-3)
     assert need["records"] < 10**6

@@ -22,9 +22,9 @@ from snapping.simulate import (
     resume,
     run,
 )
-from snapping.simulate import highorder as HO
+from snapping.simulate.methods import dop853 as HO
 from snapping.simulate import rk as R
-from snapping.simulate import stepper
+from snapping.simulate import driver as stepper
 from test_checkpoint import _check_failure, _Killed, _StopAt, _wait_for, assert_same_run
 
 CASE = dict(chi=0.3, N=50, snapshot_times=[0.2, 0.9], tol=1e-7, method="dop853")
@@ -44,13 +44,13 @@ def reference():
 
 
 def _steps_per_call_floor(monkeypatch):
-    real = HO._Engine.__init__
+    real = HO.Engine.__init__
 
     def init(self, *a, **k):
         real(self, *a, **k)
         self.ctl[R.Q_STEPS_PER_CALL] = max(1.0, HO.NODE_EVALS_PER_CALL // (R.NS * self.N))
 
-    monkeypatch.setattr(HO._Engine, "__init__", init)
+    monkeypatch.setattr(HO.Engine, "__init__", init)
 
 
 def test_dop853_files_have_the_failure_attrs(reference):

@@ -311,7 +311,7 @@ def test_ensemble_bad_input():
         run_ensemble([], 10)
 
 
-@pytest.mark.parametrize("name", ["angles", "rk", "highorder", "ensemble"])
+@pytest.mark.parametrize("name", ["angles", "rk", "methods", "methods.dop853", "ensemble", "options"])
 def test_docstring_examples(name):
     import doctest
     import importlib

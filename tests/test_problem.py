@@ -15,24 +15,13 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import reference_chain as RC  # noqa: E402
+from test_reference_chain import chain_from_angles as _nodes_from_angles  # noqa: E402
 
 from snapping._validate import SnappingInputError  # noqa: E402
 from snapping.simulate import Links, PinMotion, Problem, load_run, rerun, resume, run  # noqa: E402
 from snapping.simulate import general as G  # noqa: E402
 
 FAST = dict(method="fast", progress=False)
-
-
-def _nodes_from_angles(th, om, h, pin=(0.0, 0.0), pin_vel=(0.0, 0.0)):
-    N = th.size
-    x, y, vx, vy = (np.zeros(N + 1) for _ in range(4))
-    x[N], y[N] = pin
-    vx[N], vy[N] = pin_vel
-    for j in range(N - 1, -1, -1):
-        c, s = math.cos(th[j]), math.sin(th[j])
-        x[j], y[j] = x[j + 1] - h[j] * c, y[j + 1] - h[j] * s
-        vx[j], vy[j] = vx[j + 1] + h[j] * om[j] * s, vy[j + 1] - h[j] * om[j] * c
-    return x, y, vx, vy
 
 
 def _rhs(N, t, y, mdl):
@@ -247,7 +236,7 @@ def test_general_run_file_reproduces_and_resumes(tmp_path):
     assert np.array_equal(again.v_max.values, r.dataset.v_max.values)
     assert np.array_equal(again.pin_work.values, r.dataset.pin_work.values)
     # interrupted at a step boundary and resumed: the same Dataset
-    from snapping.simulate import stepper
+    from snapping.simulate import driver as stepper
 
     calls = {"n": 0}
 
@@ -258,8 +247,7 @@ def test_general_run_file_reproduces_and_resumes(tmp_path):
     out2 = tmp_path / "i.nc"
     stepper._chunk_hook = hook
     try:
-        from snapping.simulate.highorder import NODE_EVALS_PER_CALL  # noqa: F401
-        import snapping.simulate.highorder as HO
+        import snapping.simulate.methods.dop853 as HO
 
         old = HO.NODE_EVALS_PER_CALL
         HO.NODE_EVALS_PER_CALL = 2000
@@ -309,7 +297,7 @@ def test_euler_richardson_refuses_what_it_cannot_take():
         run(0.3, problem=q)
 
 
-@pytest.mark.parametrize("name", ["problem", "general", "shapes"])
+@pytest.mark.parametrize("name", ["problem", "pin", "general", "shapes", "errors", "driver"])
 def test_docstring_examples_run(name):
     import doctest
     import importlib
@@ -317,3 +305,27 @@ def test_docstring_examples_run(name):
     module = importlib.import_module(f"snapping.simulate.{name}")
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     assert result.failed == 0 and result.attempted > 0
+
+
+def test_tapered_chain_available_energy_against_quadrature():
+    """P of a tapered chain on the catenary (masses lumped consistently) converges to the
+    quadrature of lambda(s) (s - y(s)) at second order; the paper's lumping is first order."""
+    from scipy.integrate import quad
+
+    from snapping import estimates
+
+    chi, ratio, power = 0.3, 0.2, 1.5
+    c = 1.0 - ratio ** (1.0 / power)
+    norm = (1.0 - (1.0 - c) ** (power + 1.0)) / (c * (power + 1.0))
+    lam = lambda s: (1.0 - c * s) ** power / norm  # noqa: E731
+    exact = quad(lambda s: lam(s) * (s - float(estimates.catenary_shape(s, chi)[1])), 0.0, 1.0,
+                 epsabs=1e-14, epsrel=1e-13, limit=200)[0]
+    errs = {}
+    for lumping in ("shared", "paper"):
+        errs[lumping] = []
+        for N in (100, 200, 400):
+            p = Problem.catenary(chi, links=Links.taper(N, ratio, power=power, lumping=lumping))
+            errs[lumping].append(abs(p.estimate()["P"] - exact))
+    order = lambda e: math.log2(e[1] / e[2])  # noqa: E731
+    assert 1.9 < order(errs["shared"]) < 2.1 and errs["shared"][-1] < 1e-6
+    assert 0.9 < order(errs["paper"]) < 1.1

@@ -283,7 +283,7 @@ def _cmd_simulate(args) -> int:
             )
         summary, failed = result.summary(), None
     except simulate.RunInterrupted as exc:
-        how = (f"resume with: {simulate.stepper._resume_command(exc.path)}" if exc.path
+        how = (f"resume with: {simulate.driver._resume_command(exc.path)}" if exc.path
                else "nothing was saved (no -o RUN.nc)")
         print(f"snapping simulate: {exc.args[0].split(';')[0]}; {how}", file=sys.stderr)
         return exc.exit_status

@@ -643,3 +643,52 @@ def kappa_m0_shape(x, y) -> float:
 
 
 __all__ += ["available_energy_shape", "kappa_m0_shape"]
+
+
+def shape_estimate(x, y, m, g: float = 1.0) -> dict:
+    """The paper's estimates from any start shape and node masses (no simulation).
+
+    The available energy P (:func:`available_energy_shape`), the initial maximum
+    curvature kappa_m(0) (:func:`kappa_m0_shape`), the scales delta_kappa0 =
+    (pi/2)/kappa_m(0) and delta_c = (1/2)(pi/kappa_m(0))^(4/3), and the whirling-rod
+    peaks (:func:`whirling_rod`, eq. estimates) for each scale. The rod model is the
+    paper's (a unit mass per length near the tip): for a chain whose mass per length
+    near the free end differs from 1, or with a tip mass, it is that model applied to
+    this shape's P and kappa_m(0), not a result for such chains.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (N + 1,)
+        Node positions (index 0 the free end, N the held end).
+    m : array_like, shape (N + 1,)
+        Node masses (``m[N]``, the held end's, is irrelevant).
+    g : float
+        Gravity (the unit of P is then M g l).
+
+    Returns
+    -------
+    dict
+        ``P``, ``kappa_m0``, ``delta_kappa0``, ``delta_c`` and ``predictions``
+        (``{"delta_kappa0": {"v", "a", "sigma"}, "delta_c": {...}}``).
+
+    Examples
+    --------
+    The catenary of chi = 0.25 sampled finely reproduces the closed forms:
+
+    >>> s = np.linspace(1.0, 0.0, 2001)                    # node arclengths, free end first
+    >>> xs, ys = catenary_shape(s, 0.25)
+    >>> m = np.full(2001, 1 / 2000); m[0] = m[-1] = 1 / 4000
+    >>> e = shape_estimate(xs, ys, m)
+    >>> round(e["P"], 6), round(available_energy(0.25), 6), round(e["kappa_m0"], 3), round(kappa_m0(0.25), 3)
+    (0.254055, 0.254055, 26.11, 26.11)
+    """
+    P = available_energy_shape(x, y, m, g)
+    k0 = kappa_m0_shape(x, y)
+    if not k0 > 0.0:
+        raise V.SnappingInputError("the start shape is straight (kappa_m(0) = 0): the curvature scales are undefined")
+    scales = {"delta_kappa0": 0.5 * math.pi / k0, "delta_c": 0.5 * (math.pi / k0) ** (4.0 / 3.0)}
+    preds = {k: whirling_rod(P, d) for k, d in scales.items()} if P > 0.0 else {}
+    return {"P": P, "kappa_m0": k0, **scales, "predictions": preds}
+
+
+__all__ += ["shape_estimate"]

@@ -112,7 +112,7 @@ class Grid:
         if not isinstance(self.options, dict):
             raise V.SnappingInputError(f"options={self.options!r} must be a dict of keywords of simulate.run")
         json.dumps(self.options, default=str)  # options must be describable in a file name hash
-        from .simulate.stepper import check_inputs
+        from .simulate.driver import check_inputs
 
         if "output" in self.options:
             raise V.SnappingInputError("options must not contain 'output': the sweep names each run's file")
@@ -168,7 +168,7 @@ def _check_ensemble(grid: Grid, ensemble) -> int:
     size = V.integer("ensemble", ensemble, 1)
     if size == 1:
         return 0
-    from .simulate.highorder import HIGH_ORDER_METHODS
+    from .simulate.methods.dop853 import NAMES as HIGH_ORDER_METHODS
 
     method = grid.options.get("method", "euler-richardson")
     if method not in HIGH_ORDER_METHODS:

@@ -1,10 +1,25 @@
 """The compiled N-link chain simulator, writing self-describing xarray Datasets.
 
-The discrete chain is the N-pendulum of the paper's appendix (N equal masses of
-total mass 1, N rigid links of length 1/N, the node N+1 pinned at the origin,
-gravity along +e2), integrated with the paper's Euler-Richardson adaptive
-scheme. Kernels are compiled with numba (``cache=True``); the result of a run
-is an :class:`xarray.Dataset` with the names of :mod:`snapping.schema`.
+The paper's chain is the N-pendulum of its appendix (N equal masses of total mass 1,
+N rigid links of length 1/N, the node N+1 pinned at the origin, gravity along +e2);
+:class:`Problem` holds any other (unequal links and masses, a tip mass, a taper, any
+start shape, a moving held end, any gravity). Kernels are compiled with numba
+(``cache=True``); the result of a run is an :class:`xarray.Dataset` with the names of
+:mod:`snapping.schema`.
+
+Layout (what is solved, how it is stepped, what is recorded, kept apart):
+
+* ``problem``: :class:`Problem`, :class:`Links`, :class:`PinMotion` (physics only);
+  ``chain``: the paper's initial catenary and state; ``shapes``: start curves;
+* ``kernels`` (position form), ``angles`` (link-angle form, the paper's chain),
+  ``general`` (link-angle form, any chain and held end): the compiled equations;
+* ``methods``: the table of methods, ``methods.euler_richardson`` and
+  ``methods.dop853`` (with ``rk``, the compiled DOP853 loop): how a run is stepped;
+* ``options``: :class:`RunOptions`, the validated options every method shares;
+* ``driver``: the one loop for every method (:func:`run`, :func:`resume`, stop rules,
+  progress, signals, checkpoints); ``errors``: the failures;
+* ``dataset``: building, saving and loading the run Dataset; ``ensemble``: several
+  chains in one vectorised kernel.
 
 Example
 -------
@@ -15,33 +30,20 @@ Example
 """
 
 from .chain import ChainState, curvature_profile, evaluate, initial_state, link_arclength, node_arclength
-from .dataset import build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save
+from .dataset import Run, build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save, summary
+from .driver import METHODS, integrate_fixed, is_resumable, rerun, resume, run
 from .ensemble import run_ensemble
+from .errors import (DriftError, EnergyDriftError, NonFiniteError, RejectionError, RunInterrupted, SimulationError,
+                     StepSizeError)
+from .options import RunOptions, memory_need
 from .problem import Links, PinMotion, Problem
-from .stepper import (
-    METHODS,
-    DriftError,
-    EnergyDriftError,
-    NonFiniteError,
-    RejectionError,
-    Run,
-    RunInterrupted,
-    SimulationError,
-    StepSizeError,
-    integrate_fixed,
-    is_resumable,
-    memory_need,
-    rerun,
-    resume,
-    run,
-    summary,
-)
 
 __all__ = [
     "run",
     "Problem",
     "Links",
     "PinMotion",
+    "RunOptions",
     "run_ensemble",
     "rerun",
     "Run",

@@ -1,7 +1,8 @@
-"""Checkpoint bookkeeping shared by the two simulation engines.
+"""What the engines of every method share: the automatic-snapshot and record constants,
+and the checkpoint bookkeeping.
 
-:class:`snapping.simulate.stepper._Engine` (Euler-Richardson) and
-:class:`snapping.simulate.highorder._Engine` (DOP853) keep the same run state
+:class:`snapping.simulate.methods.euler_richardson.Engine` and
+:class:`snapping.simulate.methods.dop853.Engine` keep the same run state
 besides their method-specific arrays: the control vector ``ctl``, the peak table
 ``pk``, the measures ``meas``/``meas0``, ``rinv0``, the snapshots so far and the
 pending snapshot requests. :class:`CheckpointMixin` writes and restores that
@@ -15,6 +16,14 @@ import numpy as np
 from .. import _validate as V
 from . import kernels as K
 from .dataset import records_from_dataset
+
+#: automatic snapshots when v_max first reaches SPEED_LEVEL_0 * SPEED_LEVEL_FACTOR**n
+SPEED_LEVEL_0 = 1.0
+SPEED_LEVEL_FACTOR = 1.5
+#: automatic snapshots after the peak, when v_max falls below these fractions of it
+AFTER_PEAK_FRACTIONS = (0.9, 0.7)
+#: record buffer rows handed back to Python at a time
+RECORD_CHUNK = 8192
 
 
 def _pad(vals) -> np.ndarray:

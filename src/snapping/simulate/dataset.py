@@ -6,6 +6,7 @@ All names, units and long names come from :mod:`snapping.schema`.
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -15,7 +16,55 @@ from .. import schema
 from . import kernels as K
 from .chain import ChainState, curvature_profile, link_arclength, node_arclength
 
-__all__ = ["build_dataset", "save", "load_run", "inputs_from_attrs", "initial_from_dataset"]
+__all__ = ["Run", "summary", "build_dataset", "save", "load_run", "inputs_from_attrs", "initial_from_dataset",
+           "problem_from_dataset"]
+
+
+@dataclass
+class Run:
+    """Result of :func:`run`: the run Dataset, and the final state to continue from.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset
+        The run (see :mod:`snapping.schema`).
+    state : ChainState
+        The state at the last accepted step.
+    path : str or None
+        Where the dataset was saved, if anywhere.
+    """
+
+    dataset: xr.Dataset
+    state: ChainState
+    path: str | None = None
+
+    def summary(self) -> dict:
+        """The detected results and inputs as a plain dict (also the CLI's --json)."""
+        return summary(self.dataset)
+
+    def save(self, path) -> str:
+        """Write the dataset as netCDF4."""
+        self.path = save(self.dataset, path)
+        return self.path
+
+
+SUMMARY_KEYS = (
+    "chi", "N", "method", "tol", "dt0", "status", "stop_reason",
+    "t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_max_0",
+    "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
+    "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
+    "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
+)
+
+
+def summary(ds: xr.Dataset) -> dict:
+    """Inputs and detected results of a run Dataset, as a dict of plain Python values."""
+    out = {}
+    for k in SUMMARY_KEYS:
+        if k in ds.attrs:
+            v = ds.attrs[k]
+            out[k] = v.item() if isinstance(v, np.generic) else v
+    return out
 
 
 def _attr_value(v):

@@ -1,6 +1,6 @@
 """Ensembles: several chains of the same N (e.g. a sweep over chi) in one vectorised kernel.
 
-Every member is a full DOP853 angle-form run (:mod:`snapping.simulate.highorder`) with
+Every member is a full DOP853 angle-form run (:mod:`snapping.simulate.methods.dop853`) with
 its own adaptive step, its own record, peaks, snapshots and stop; only the arithmetic is
 shared. The members' states are stored interleaved, ``y[i, lane]``: the elementwise
 passes of a step (stage sums, sines and cosines, coupling coefficients, accelerations,
@@ -44,9 +44,11 @@ from numba import njit
 
 from .. import _validate as V
 from . import angles as AG
-from . import highorder as HO
+from . import kernels as K
 from . import rk as R
 from .chain import initial_state
+from .methods import dop853 as DOP
+from .options import RunOptions
 
 __all__ = ["run_ensemble", "rhs_lanes", "LaneWork"]
 
@@ -453,10 +455,10 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     >>> [ds.attrs["status"] for ds in dss], [ds.attrs["method"] for ds in dss]
     (['completed', 'completed'], ['dop853', 'dop853'])
     """
-    from .stepper import _validate
+    from .dataset import check_writable
 
-    if method not in HO.HIGH_ORDER_METHODS:
-        raise V.SnappingInputError(f"method={method!r}: ensembles run the angle-form methods {HO.HIGH_ORDER_METHODS}")
+    if method not in DOP.NAMES:
+        raise V.SnappingInputError(f"method={method!r}: ensembles run the angle-form methods {DOP.NAMES}")
     try:
         chis = [float(c) for c in np.atleast_1d(np.asarray(chis, dtype=float))]
     except (TypeError, ValueError):
@@ -465,33 +467,26 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
         raise V.SnappingInputError("chis=[] is empty: give at least one chi")
     if outputs is not None and len(outputs) != len(chis):
         raise V.SnappingInputError(f"outputs has {len(outputs)} paths for {len(chis)} members")
-    checked = []
-    for i, chi in enumerate(chis):
-        checked.append(_validate(chi, N, tol, method, None, t_end, stop_fraction, t_end_max, snapshot_times,
-                                 record_thin, max_link_error, chords, None,
-                                 None if outputs is None else outputs[i]))
-    N = checked[0][1]
-    tol, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error, chords = (
-        checked[0][2], checked[0][5], checked[0][6], checked[0][7], checked[0][8], checked[0][9], checked[0][10],
-        checked[0][11])
-    method = HO.resolve_method(method)
-    HO._warm_up()
+    chis = [V.open_interval("chi", chi, 0.0, 1.0) for chi in chis]
+    N = V.integer("N", N, 1)
+    if not isinstance(chords, str) or chords not in ("arclength", "exact"):
+        raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")
+    opts = RunOptions(tol=tol, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
+                      snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
+                      dt_min=dt_min)
+    if outputs is not None:
+        outputs = [check_writable(o) for o in outputs]
+    method = DOP.resolve_method(method)
+    DOP._warm_up()
     _warm_up()
     wall0 = time.perf_counter()
     engines, inputs = [], []
     for chi in chis:
-        st = initial_state(chi, N, chords)
-        eng = HO._Engine(AG.state_to_angles(st), 0.0, tol=tol, dt0=None,
-                         t_end=(t_end if t_end is not None else t_end_max),
-                         stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
-                         max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min)
+        eng = DOP.Engine(AG.state_to_angles(initial_state(chi, N, chords)), 0.0, **opts.engine_kwargs())
         engines.append(eng)
-        inputs.append({
-            "chi": chi, "N": N, "method": method, "tol": tol, "dt0": eng.dt0,
-            "t_end": 0.0 if t_end is None else t_end, "stop_fraction": stop_fraction,
-            "snapshot_times": list(snapshot_times), "record_thin": record_thin, "chords": chords,
-            "initial": "catenary", "t_end_max": t_end_max, "max_link_error": max_link_error,
-        })
+        inputs.append({"chi": chi, "N": N, "method": method, **opts.input_attrs(), "chords": chords,
+                       "initial": "catenary"})
+        inputs[-1]["dt0"] = eng.dt0
     lanes = _Lanes(engines)
     for e in engines:
         e.start()
@@ -518,8 +513,7 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     wall = (time.perf_counter() - wall0) / len(chis)
     out = []
     for m, eng in enumerate(engines):
-        r = HO._finish(eng, inputs[m], final_codes.get(m), "completed", "", wall,
-                       None if outputs is None else outputs[m], stop_fraction, t_end, raise_on_failure=False)
+        r = _finish(eng, inputs[m], final_codes.get(m), wall, None if outputs is None else outputs[m], opts)
         if r.dataset.attrs["status"] == "failed":
             warnings.warn(f"ensemble member chi={chis[m]:g} failed: {r.dataset.attrs['stop_reason']}", stacklevel=2)
         out.append(r.dataset)
@@ -534,7 +528,7 @@ def _warm_up() -> None:
     global _compiled
     if _compiled:
         return
-    engines = [HO._Engine(AG.state_to_angles(initial_state(c, 3, chords="exact")), 0.0, tol=1e-6, dt0=None,
+    engines = [DOP.Engine(AG.state_to_angles(initial_state(c, 3, chords="exact")), 0.0, tol=1e-6, dt0=None,
                           t_end=0.01, stop_fraction=0.0, thin=0.0, max_link_error=0.5, snapshot_times=())
                for c in (0.4, 0.5, 0.6)]  # (more than SINGLE_BELOW: the lanes' kernel)
     lanes = _Lanes(engines)
@@ -542,3 +536,27 @@ def _warm_up() -> None:
         e.start()
     lanes.advance(np.arange(3, dtype=np.int64))
     _compiled = True
+
+
+def _finish(eng, inputs: dict, code, wall: float, output, opts):
+    """The run Dataset of a finished member (saved to ``output`` if given), as a Run; a
+    numerical failure gives status 'failed' (no exception: the ensemble goes on)."""
+    from .dataset import Run, build_dataset, save
+    from .errors import FAILURES, SimulationError
+
+    status, reason, failure, node = "completed", "", "", -1
+    if code is not None:
+        if code == K.RET_STOP:
+            reason = f"snap detected: v_max fell below {opts.stop_fraction:g} of its peak"
+        elif code == K.RET_END:
+            reason = "t_end reached" if opts.t_end is not None else \
+                "t_end_max reached before the speed fell after a peak"
+        else:
+            status = "failed"
+            node = eng.worst_node(code)
+            reason = eng.failure_message(code, node)
+            failure = FAILURES.get(code, SimulationError).kind
+    ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs,
+                       eng.results(status, reason, wall, failure, node))
+    path = save(ds, output) if output is not None else None
+    return Run(ds, eng.final_state(), path)

@@ -33,18 +33,17 @@ True
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import _validate as V
 from . import general as G
+from .pin import PIN_KINDS, PinMotion, parse_pin_motion
 
 __all__ = ["Links", "PinMotion", "Problem", "LUMPINGS", "PIN_KINDS"]
 
 LUMPINGS = ("shared", "paper")
-PIN_KINDS = ("fixed", "pull", "flick", "table")
 #: relative tolerance of a shape's link lengths against the chain's
 SHAPE_RTOL = 1e-6
 
@@ -61,8 +60,20 @@ def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
     return a
 
 
+#: bytes a chain needs per link, about (its arrays, the start, a run's state and stages)
+BYTES_PER_LINK = 1000
+
+
 def _links_count(name: str, N) -> int:
-    return V.integer(name, N, 1)
+    """N >= 1, and small enough that a chain of N links fits in the available memory."""
+    from .options import MEMORY_MARGIN, _available_memory
+
+    N = V.integer(name, N, 1)
+    avail = _available_memory()
+    if avail is not None and N * BYTES_PER_LINK > MEMORY_MARGIN * avail:
+        raise V.SnappingInputError(f"{name}={N} links would need about {N * BYTES_PER_LINK / 2**30:.3g} GiB of "
+                                   f"memory, but only {avail / 2**30:.3g} GiB is available")
+    return N
 
 
 # ---------------------------------------------------------------------------------- the chain
@@ -210,151 +221,6 @@ class Links:
 
     def describe(self) -> dict:
         return {"kind": self.kind, "N": self.N, "tip_mass": self.tip_mass, **self.params}
-
-
-# ---------------------------------------------------------------------------------- the held end
-@dataclass(frozen=True, eq=False)
-class PinMotion:
-    """The motion of the held end: ``fixed``, ``pull`` (constant acceleration ``accel`` from
-    ``t0`` for ``duration``, then constant velocity), ``flick`` (acceleration
-    ``accel sin(2 pi (t - t0)/period)`` for one period: twice differentiable everywhere,
-    the end moves by ``accel period^2/(2 pi)`` and is at rest again), or ``table`` (a cubic
-    spline through samples of ``r_p(t)`` from t = 0, constant velocity after the last).
-    The held end starts at the origin."""
-
-    kind: str = "fixed"
-    accel: tuple = (0.0, 0.0)
-    t0: float = 0.0
-    duration: float = math.inf
-    table: tuple | None = None  # (t, x, y) samples
-
-    @classmethod
-    def fixed(cls) -> "PinMotion":
-        return cls()
-
-    @classmethod
-    def pull(cls, accel, duration: float = math.inf, t0: float = 0.0) -> "PinMotion":
-        """A constant-acceleration pull ``accel = (ax, ay)`` (y downward) from ``t0`` for ``duration``.
-
-        >>> PinMotion.pull((0.0, -0.5)).velocity(2.0)
-        (0.0, -1.0)
-        """
-        ax, ay = cls._vector("accel", accel)
-        t0 = V.real("t0", t0)
-        if t0 < 0.0:
-            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
-        d = math.inf if isinstance(duration, (int, float)) and duration == math.inf else \
-            V.positive("duration", duration)
-        return cls("pull", (ax, ay), t0, d)
-
-    @classmethod
-    def flick(cls, accel, period: float, t0: float = 0.0) -> "PinMotion":
-        """One period of a sine in the acceleration, peak ``accel = (ax, ay)``, over ``period``.
-
-        >>> f = PinMotion.flick((1.0, 0.0), 0.5)
-        >>> [round(v, 12) for v in f.position(0.5)], f.velocity(0.5)
-        ([0.039788735773, 0.0], (0.0, 0.0))
-        """
-        ax, ay = cls._vector("accel", accel)
-        T = V.positive("period", period)
-        t0 = V.real("t0", t0)
-        if t0 < 0.0:
-            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
-        return cls("flick", (ax, ay), t0, T)
-
-    @classmethod
-    def from_function(cls, r, t_max: float, samples: int = 2001) -> "PinMotion":
-        """The motion ``r(t) -> (x, y)`` on [0, t_max], sampled at ``samples`` equal times and
-        interpolated by a cubic spline (the motion that is run and recorded; constant velocity
-        after ``t_max``). ``r(0)`` must be the origin.
-
-        >>> import math
-        >>> p = PinMotion.from_function(lambda t: (0.1 * math.sin(t), 0.0), 1.0)
-        >>> round(p.position(0.5)[0], 9) == round(0.1 * math.sin(0.5), 9)
-        True
-        """
-        if not callable(r):
-            raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y))")
-        t_max = V.positive("t_max", t_max)
-        n = V.integer("samples", samples, 4)
-        t = np.linspace(0.0, t_max, n)
-        xy = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
-        if xy.ndim != 2 or xy.shape[1] != 2:
-            raise V.SnappingInputError(f"r(t) must return two numbers (x, y); got shape {xy.shape[1:]}")
-        return cls.from_table(t, xy[:, 0], xy[:, 1])
-
-    @classmethod
-    def from_table(cls, t, x, y) -> "PinMotion":
-        """The motion through samples ``(t_i, x_i, y_i)``, t_0 = 0 and (x_0, y_0) = (0, 0),
-        t increasing, at least 4 samples (a not-a-knot cubic spline through them)."""
-        t = np.asarray(V.float_array("t", t), dtype=float).ravel()
-        x = np.asarray(V.float_array("x", x), dtype=float).ravel()
-        y = np.asarray(V.float_array("y", y), dtype=float).ravel()
-        if not (t.size == x.size == y.size) or t.size < 4:
-            raise V.SnappingInputError(f"pin table t, x, y must have the same length >= 4; got {t.size}, {x.size}, "
-                                       f"{y.size}")
-        for name, a in (("t", t), ("x", x), ("y", y)):
-            if not np.all(np.isfinite(a)):
-                i = int(np.flatnonzero(~np.isfinite(a))[0])
-                raise V.SnappingInputError(f"pin motion {name}[{i}]={a[i]!r} is not finite")
-        if t[0] != 0.0 or not np.all(np.diff(t) > 0.0):
-            raise V.SnappingInputError(f"pin table times must start at 0 and increase; got t[0]={t[0]!r}")
-        scale = max(1.0, float(np.abs(np.concatenate([x, y])).max()))
-        if abs(x[0]) > 1e-12 * scale or abs(y[0]) > 1e-12 * scale:
-            raise V.SnappingInputError(f"the held end must start at the origin: r(0)=({x[0]!r}, {y[0]!r})")
-        x = x.copy()
-        y = y.copy()
-        x[0] = y[0] = 0.0
-        return cls("table", (0.0, 0.0), 0.0, float(t[-1]), (t.copy(), x, y))
-
-    @staticmethod
-    def _vector(name, v):
-        try:
-            a = np.asarray(v, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise V.SnappingInputError(f"{name}={v!r} is not a pair of numbers (ax, ay)") from None
-        if a.size != 2 or not np.all(np.isfinite(a)):
-            raise V.SnappingInputError(f"{name}={v!r} must be two finite numbers (ax, ay)")
-        return float(a[0]), float(a[1])
-
-    # -- compiled form and evaluation
-    def _spline_table(self):
-        from scipy.interpolate import CubicSpline
-
-        t, x, y = self.table
-        return t, CubicSpline(t, x).c, CubicSpline(t, y).c
-
-    def model_args(self) -> dict:
-        """Keyword arguments of :func:`general.make_model` for this motion."""
-        code = {"fixed": G.PIN_FIXED, "pull": G.PIN_PULL, "flick": G.PIN_FLICK, "table": G.PIN_TABLE}[self.kind]
-        ax, ay = self.accel
-        return {"pin": (code, ax, ay, self.t0, self.duration),
-                "table": self._spline_table() if self.kind == "table" else None}
-
-    def kinematics(self, t: float):
-        """(x, y, vx, vy, ax, ay) of the held end at time t (the compiled evaluation)."""
-        mdl = G.make_model(np.ones(1), np.ones(1), **self.model_args())
-        return tuple(float(v) for v in G.pin_kinematics(float(t), mdl[0], mdl[-1]))
-
-    def position(self, t: float):
-        return self.kinematics(t)[:2]
-
-    def velocity(self, t: float):
-        return self.kinematics(t)[2:4]
-
-    @property
-    def is_fixed(self) -> bool:
-        return self.kind == "fixed"
-
-    def describe(self) -> dict:
-        d = {"kind": self.kind}
-        if self.kind in ("pull", "flick"):
-            d.update({"accel": list(self.accel), "t0": self.t0,
-                      ("duration" if self.kind == "pull" else "period"): self.duration})
-        if self.kind == "table":
-            d["samples"] = int(self.table[0].size)
-            d["t_max"] = float(self.table[0][-1])
-        return d
 
 
 # ---------------------------------------------------------------------------------- the problem
@@ -549,6 +415,21 @@ class Problem:
         om = (-np.sin(th) * dvx + np.cos(th) * dvy) / self.links.h
         return np.concatenate([th, om, [0.0]]).astype(float)
 
+    def estimate(self) -> dict:
+        """The paper's estimates from this start shape and these masses
+        (:func:`snapping.estimates.shape_estimate`): P, kappa_m(0), the delta scales and
+        the whirling-rod peaks.
+
+        >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared")).estimate()
+        >>> round(shared["P"], 5), round(shared["kappa_m0"], 2)     # the closed forms: 0.254055, 26.11
+        (0.25405, 26.11)
+        >>> round(Problem.catenary(0.25, 2000).estimate()["P"], 5)   # the paper's lumping: O(1/N) off
+        0.2543
+        """
+        from .. import estimates
+
+        return estimates.shape_estimate(self.x, self.y, np.concatenate([self.links.m, [0.0]]), self.gravity)
+
     def describe(self) -> dict:
         """JSON-friendly description (recorded in the run file)."""
         return {"chain": self.links.describe(), "start": dict(self.start), "pin": self.pin.describe(),
@@ -559,32 +440,6 @@ class Problem:
 
 
 # ---------------------------------------------------------------------------------- from options
-def parse_pin_motion(spec: str | None) -> PinMotion:
-    """A :class:`PinMotion` from a command-line spec: ``fixed``, ``pull:AX,AY[,DURATION[,T0]]``
-    or ``flick:AX,AY,PERIOD[,T0]`` (nondimensional; y downward).
-
-    >>> parse_pin_motion("flick:2,0,0.3").describe()["period"]
-    0.3
-    >>> parse_pin_motion("pull:0,-0.5").duration
-    inf
-    """
-    if spec is None or str(spec).strip() in ("", "fixed"):
-        return PinMotion.fixed()
-    kind, _, rest = str(spec).partition(":")
-    kind = kind.strip()
-    try:
-        vals = [float(v) for v in rest.split(",") if v.strip()]
-    except ValueError:
-        raise V.SnappingInputError(f"pin_motion={spec!r}: the parameters after {kind + ':'!r} must be numbers") \
-            from None
-    if kind == "pull" and 2 <= len(vals) <= 4:
-        return PinMotion.pull(vals[:2], *(vals[2:3] or [math.inf]), *(vals[3:4] or [0.0]))
-    if kind == "flick" and 3 <= len(vals) <= 4:
-        return PinMotion.flick(vals[:2], vals[2], *(vals[3:4] or [0.0]))
-    raise V.SnappingInputError(f"pin_motion={spec!r} is not one of 'fixed', 'pull:AX,AY[,DURATION[,T0]]', "
-                               f"'flick:AX,AY,PERIOD[,T0]'")
-
-
 def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
     """Points (x, y) of a start curve from a CSV file (two columns x, y; a header line is
     skipped) or a netCDF file (variables ``x`` and ``y``), listed from the held end; the
@@ -631,6 +486,9 @@ def from_options(*, chi=None, N=None, chords: str = "arclength", supports=None, 
     0.5
     """
     starts = [k for k, v in (("chi", chi), ("supports", supports), ("shape", shape)) if v is not None]
+    if (starts == ["chi"] and taper is None and lumping in (None, "paper") and pin_motion in (None, "", "fixed")
+            and V.real("tip_mass", tip_mass) == 0.0 and V.real("gravity", gravity) == 1.0):
+        return None  # the paper's problem: run(chi, N) (checks chi and N itself)
     if len(starts) != 1:
         raise V.SnappingInputError(f"give exactly one start: --chi, --supports DX,DY or --shape FILE (got "
                                    f"{starts or 'none'})")

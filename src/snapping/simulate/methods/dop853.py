@@ -17,7 +17,7 @@ Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
   Euler-Richardson runs at ``chords="exact"``.
 
 Long runs behave as the Euler-Richardson ones (the same driver,
-:func:`snapping.simulate.stepper._drive`): periodic atomic checkpoints into the run
+:func:`snapping.simulate.driver._drive`): periodic atomic checkpoints into the run
 file (``checkpoint_every``; names :data:`snapping.schema.CHECKPOINT_VARS_DOP853`: the
 two last steps with their stages, the first-same-as-last stage and the dense output,
 the step controller, the records, snapshots and peak trackers), SIGINT/SIGTERM stop at
@@ -36,24 +36,30 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from . import angles as AG
-from . import general as G
-from ._engine_common import CheckpointMixin, checkpoint_getter
-from . import kernels as K
-from . import rk as R
-from .chain import ChainState, initial_state
-from .dataset import build_dataset, save
+from .. import angles as AG
+from .. import general as G
+from .. import kernels as K
+from .. import rk as R
+from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0, SPEED_LEVEL_FACTOR, CheckpointMixin,
+                              checkpoint_getter)
+from ..chain import ChainState, initial_state
 
-__all__ = ["run_highorder", "HIGH_ORDER_METHODS", "resolve_method"]
+__all__ = ["Engine", "setup", "complete", "resolve_method", "NAMES", "CHECKPOINT_VARS"]
 
-#: the angle-form methods; ``fast`` always names the project's best exact method
-HIGH_ORDER_METHODS = ("dop853", "fast")
+#: the names this method answers to; ``fast`` always names the project's best exact method
+NAMES = ("dop853", "fast")
 FAST = "dop853"
 
-SPEED_LEVEL_0 = 1.0
-SPEED_LEVEL_FACTOR = 1.5
-AFTER_PEAK_FRACTIONS = (0.9, 0.7)
-RECORD_CHUNK = 8192
+
+def _checkpoint_names():
+    from ... import schema
+
+    return schema.CHECKPOINT_VARS_DOP853
+
+
+#: the checkpoint variables of this method's run files
+CHECKPOINT_VARS = _checkpoint_names()
+
 #: node-evaluations per call into the compiled loop (sets how often the progress bar moves)
 NODE_EVALS_PER_CALL = 20_000_000
 #: relative width (of the bracketing interval) to which peaks are located
@@ -72,7 +78,7 @@ def resolve_method(method: str) -> str:
     return FAST if method == "fast" else method
 
 
-class _Engine(CheckpointMixin):
+class Engine(CheckpointMixin):
     """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
@@ -298,7 +304,7 @@ class _Engine(CheckpointMixin):
 
     def loop(self, bar, poll=None) -> int:
         """Run the compiled loop until a stop or failure code; returns it. ``poll()`` is
-        called at every clean step boundary (see :meth:`snapping.simulate.stepper._Engine.loop`);
+        called at every clean step boundary (see :meth:`snapping.simulate.methods.euler_richardson.Engine.loop`);
         a non-None result stops the loop and is returned."""
         self.start()
         w = self.w
@@ -314,7 +320,7 @@ class _Engine(CheckpointMixin):
                 if stop is not None:
                     return stop
 
-    # -- the interface of the shared driver (snapping.simulate.stepper._drive)
+    # -- the interface of the shared driver (snapping.simulate.driver._drive)
     @property
     def n_steps(self) -> int:
         return int(self.ctl[R.Q_NSTEPS])
@@ -342,7 +348,7 @@ class _Engine(CheckpointMixin):
 
     def results(self, status: str, reason: str, wall: float, failure: str = "", node: int = -1) -> dict:
         """The result attributes (schema.RESULT_ATTRS) of the run so far."""
-        from .. import __version__
+        from ... import __version__
 
         c, pk = self.ctl, self.pk
         results = {"status": status, "stop_reason": reason, "failure": failure, "failure_node": int(node)}
@@ -397,7 +403,7 @@ class _Engine(CheckpointMixin):
     # -- checkpoints (the shared part: _engine_common.CheckpointMixin)
     def checkpoint_vars(self) -> dict:
         """The checkpoint variables (schema.CHECKPOINT_VARS_DOP853), to add to the run Dataset so far."""
-        from .. import schema
+        from ... import schema
 
         nd = schema.NODE_DIM
         row, slot, ang = "checkpoint_row", "checkpoint_slot", "checkpoint_angle"
@@ -430,7 +436,7 @@ class _Engine(CheckpointMixin):
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
         self._restore_history(ds, get, R.Q_NREC)
 
-def _failure_message(code: int, eng: _Engine, node: int = -1) -> str:
+def _failure_message(code: int, eng: Engine, node: int = -1) -> str:
     t = eng.t
     c = eng.ctl
     where = f" (step {int(c[R.Q_NSTEPS])}, worst node {node}: s={(eng.N - node) / eng.N:.6g})" if node >= 0 else ""
@@ -461,7 +467,7 @@ def _warm_up() -> None:
     if _compiled:
         return
     y0 = AG.state_to_angles(initial_state(0.5, 3, chords="exact"))
-    eng = _Engine(y0, 0.0, tol=1e-6, dt0=None, t_end=0.05, stop_fraction=0.0, thin=0.0, max_link_error=0.5,
+    eng = Engine(y0, 0.0, tol=1e-6, dt0=None, t_end=0.05, stop_fraction=0.0, thin=0.0, max_link_error=0.5,
                   snapshot_times=(0.01,))
     eng.loop(None)
     eng.pk[0, R.PK_TA], eng.pk[0, R.PK_TB] = eng.t - 0.5 * eng.HS[int(eng.ctl[R.Q_SLOT])], eng.t
@@ -470,11 +476,15 @@ def _warm_up() -> None:
     _compiled = True
 
 
-def _setup(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-           max_link_error, chords, initial, dt_min=1e-14, max_energy_drift=None, max_rejections=100, problem=None):
-    """The input attributes and the engine of an angle-form run (validated arguments).
-    ``problem``: a general :class:`snapping.simulate.problem.Problem` (then ``chi``,
-    ``chords`` and ``initial`` are not used)."""
+def complete(opts, method: str):
+    """The options with this method's defaults filled in (none: the first step is Hairer's)."""
+    return opts
+
+
+def setup(chi, N, method: str, opts, *, chords: str = "arclength", initial=None, problem=None):
+    """The input attributes and the engine of an angle-form run (``opts``: a validated
+    :class:`RunOptions`). ``problem``: a general :class:`snapping.simulate.problem.Problem`
+    (then ``chi``, ``chords`` and ``initial`` are not used)."""
     method = resolve_method(method)
     if problem is not None:
         y0 = problem.initial_angles()
@@ -485,82 +495,12 @@ def _setup(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapsho
         y0 = AG.state_to_angles(state0)
         mdl = None
         t0 = state0.t
-    inputs = {
-        "chi": chi, "N": N, "method": method, "tol": tol, "dt0": 0.0, "t_end": 0.0 if t_end is None else t_end,
-        "stop_fraction": stop_fraction, "snapshot_times": list(snapshot_times), "record_thin": record_thin,
-        "chords": chords, "initial": "catenary" if initial is None else "snapshot", "t_end_max": t_end_max,
-        "max_link_error": max_link_error, "max_energy_drift": 0.0 if max_energy_drift is None else max_energy_drift,
-        "dt_min": dt_min, "max_rejections": max_rejections,
-    }
+    inputs = {"chi": chi, "N": N, "method": method, **opts.input_attrs(), "chords": chords,
+              "initial": "catenary" if initial is None else "snapshot"}
     if problem is not None:
         inputs.update({"chi": float("nan") if problem.chi is None else problem.chi, "initial": "problem",
                        "chords": problem.chords or "exact", "problem": problem})
     _warm_up()
-    eng = _Engine(y0, t0, tol=tol, dt0=dt0, t_end=(t_end if t_end is not None else t_end_max),
-                  stop_fraction=(0.0 if t_end is not None else stop_fraction), thin=record_thin,
-                  max_link_error=max_link_error, snapshot_times=snapshot_times, dt_min=dt_min,
-                  max_energy_drift=max_energy_drift, max_rejections=max_rejections, mdl=mdl)
+    eng = Engine(y0, t0, mdl=mdl, **opts.engine_kwargs())
     inputs["dt0"] = eng.dt0
     return inputs, eng
-
-
-def run_highorder(chi, N, *, tol, method, dt0, t_end, stop_fraction, t_end_max, snapshot_times, record_thin,
-                  max_link_error, chords, initial, output, progress, dt_min=1e-14, max_energy_drift=None,
-                  max_rejections=100, checkpoint_every=None, problem=None):
-    """The body of :func:`snapping.simulate.run` for the angle-form methods (inputs
-    already validated by it). Returns a :class:`snapping.simulate.Run`.
-
-    Driven like the Euler-Richardson runs (:func:`snapping.simulate.stepper._drive`):
-    periodic atomic checkpoints of the full state into ``output`` every
-    ``checkpoint_every`` seconds, SIGINT/SIGTERM stop at a step boundary with a saved,
-    resumable file (:func:`snapping.simulate.resume` continues it bit for bit), and the
-    numerical failures raise the subclasses of :class:`SimulationError`.
-
-    Examples
-    --------
-    >>> from snapping.simulate import run
-    >>> ds = run(0.5, 50, method="fast", chords="exact").dataset
-    >>> ds.attrs["method"], round(ds.attrs["t_snap_v"], 3), bool(ds.attrs["link_drift"] < 1e-14)
-    ('dop853', 1.144, True)
-    """
-    from .stepper import _drive
-
-    inputs, eng = _setup(chi, N, tol=tol, method=method, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction,
-                         t_end_max=t_end_max, snapshot_times=snapshot_times, record_thin=record_thin,
-                         max_link_error=max_link_error, chords=chords, initial=initial, dt_min=dt_min,
-                         max_energy_drift=max_energy_drift, max_rejections=max_rejections, problem=problem)
-    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
-
-
-def _finish(eng: _Engine, inputs: dict, code, status: str, reason: str, wall: float, output, stop_fraction, t_end,
-            raise_on_failure: bool = True):
-    """The run Dataset of a finished engine (saved to ``output`` if given); a Run.
-    (Used by the ensembles; single runs go through :func:`snapping.simulate.stepper._drive`.)"""
-    from .stepper import _FAILURES, Run, SimulationError
-
-    c = eng.ctl
-    inputs = dict(inputs)
-    inputs.setdefault("max_energy_drift", float(c[R.Q_MAXENERGY]) if np.isfinite(c[R.Q_MAXENERGY]) else 0.0)
-    inputs.setdefault("dt_min", float(c[R.Q_DTMIN]))
-    inputs.setdefault("max_rejections", int(c[R.Q_MAXREJ]))
-    failure, node = "", -1
-    if code is not None:
-        if code == K.RET_STOP:
-            reason = f"snap detected: v_max fell below {stop_fraction:g} of its peak"
-        elif code == K.RET_END:
-            reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
-        else:
-            status = "failed"
-            node = eng.worst_node(code)
-            reason = eng.failure_message(code, node)
-            failure = _FAILURES.get(code, SimulationError).kind
-    ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs,
-                       eng.results(status, reason, wall, failure, node))
-    path = save(ds, output) if output is not None else None
-    if status == "failed" and raise_on_failure:
-        where = f"; what was computed is saved in {path}" if path else ""
-        cls = _FAILURES.get(code, SimulationError)
-        raise cls(f"simulation failed: {reason}{where}", dataset=ds, path=path, t=eng.t, step=eng.n_steps, node=node)
-    if status == "interrupted":
-        raise KeyboardInterrupt(reason + (f"; saved in {path}" if path else ""))
-    return Run(ds, eng.final_state(), path)

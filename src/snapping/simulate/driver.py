@@ -1,0 +1,564 @@
+"""The driver: one loop for every method (stop rules, progress, signals, checkpoints,
+recording into the run Dataset, failures), and the entry points :func:`run`,
+:func:`resume`, :func:`rerun`.
+
+What is solved is a :class:`snapping.simulate.problem.Problem` (or the paper's
+``(chi, N)``); how it is stepped is a method of :data:`snapping.simulate.methods.METHODS`
+(an engine: the compiled step loop and its state); the options every method shares are
+one validated :class:`snapping.simulate.options.RunOptions`. The driver calls the
+engine's ``loop(bar, poll)`` and, at every return of the compiled loop, polls for
+signals and due checkpoints; at the end it builds the Dataset
+(:func:`snapping.simulate.dataset.build_dataset`) and saves it.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+import time
+
+import numpy as np
+import xarray as xr
+
+from .. import _validate as V
+from . import kernels as K
+from . import methods as M
+from .chain import ChainState
+from .dataset import Run, build_dataset, check_writable, inputs_from_attrs, open_netcdf, save
+from .errors import FAILURES, RET_SIGNAL, RunInterrupted, SimulationError
+from .options import RunOptions, check_checkpoint_every, check_memory, check_progress
+
+__all__ = ["run", "rerun", "resume", "is_resumable", "check_inputs", "integrate_fixed", "METHODS",
+           "CHECKPOINT_EVERY"]
+
+#: the method names :func:`run` takes (the table: :data:`snapping.simulate.methods.METHODS`)
+METHODS = M.NAMES
+#: default wall-clock seconds between checkpoints of a run with an output file
+CHECKPOINT_EVERY = 300.0
+#: layout version of the checkpoint variables (schema.CHECKPOINT_VARS)
+CHECKPOINT_VERSION = 1
+#: test hook: called with the engine after every return of the compiled loop; may
+#: return a signal number to act as if that signal had arrived
+_chunk_hook = None
+
+
+def _resolve_problem(chi, N, chords, initial, problem, method):
+    """(chi, N, chords, initial, problem) of a run given a Problem: the paper's problem
+    becomes (chi, N, chords) (today's runs, bit for bit); a uniform chain with a fixed held
+    end from another start becomes ``initial`` for Euler-Richardson; any other problem
+    stays a problem, which only the angle-form methods take."""
+    from .problem import Problem
+
+    if isinstance(chi, Problem):
+        if problem is not None:
+            raise V.SnappingInputError("a Problem was given twice (as chi and as problem=)")
+        chi, problem = None, chi
+    if problem is None:
+        return chi, N, chords, initial, None
+    if not isinstance(problem, Problem):
+        raise V.SnappingInputError(f"problem={type(problem).__name__} is not a snapping.simulate.Problem")
+    if chi is not None:
+        raise V.SnappingInputError(f"chi={chi!r} given with a Problem: the problem's start sets the shape")
+    if initial is not None:
+        raise V.SnappingInputError("initial= given with a Problem: the problem's start is the initial state")
+    if chords != "arclength":
+        raise V.SnappingInputError(f"chords={chords!r} given with a Problem: use Problem.catenary(chi, N, "
+                                   f"chords={chords!r})")
+    if N is not None and V.integer("N", N, 1) != problem.N:
+        raise V.SnappingInputError(f"N={N!r} disagrees with the problem's {problem.N} links")
+    if problem.is_paper:
+        return problem.chi, problem.N, problem.chords, None, None
+    if method in ("euler-richardson", "euler-richardson-fixed"):
+        why = []
+        if not problem.links.is_paper:
+            why.append("links or masses other than N equal links and masses 1/N" if problem.links.tip_mass == 0
+                       else f"a tip mass ({problem.links.tip_mass:g})")
+        if not problem.pin.is_fixed:
+            why.append(f"a moving held end (pin motion {problem.pin.kind!r})")
+        if problem.gravity != 1.0:
+            why.append(f"gravity={problem.gravity:g} (it takes g = 1)")
+        if why:
+            raise V.SnappingInputError(f"method={method!r} takes only the paper's chain with a fixed held end and "
+                                       f"g = 1; this problem has {', '.join(why)}: use method='fast' (dop853)")
+        return None, problem.N, chords, ChainState(problem.x, problem.y, problem.vx, problem.vy, 0.0), None
+    return None, problem.N, chords, None, problem
+
+
+def _validate_start(chi, N, method, chords, initial, problem):
+    """(chi, N) of a run, and the method and chords checked."""
+    if problem is not None:
+        N = problem.N
+        chi = float("nan")
+    elif initial is None:
+        chi = V.open_interval("chi", chi, 0.0, 1.0)
+        N = V.integer("N", N, 1)
+    else:
+        if not isinstance(initial, ChainState):
+            raise V.SnappingInputError(f"initial={type(initial).__name__} must be a ChainState")
+        if N is not None and V.integer("N", N, 1) != initial.N:
+            raise V.SnappingInputError(f"N={N} does not match the initial state's N={initial.N}")
+        N = initial.N
+        chi = float("nan") if chi is None else V.open_interval("chi", chi, 0.0, 1.0)
+    if not isinstance(method, str) or method not in METHODS:
+        raise V.SnappingInputError(f"method={method!r} is not one of {METHODS}")
+    if not isinstance(chords, str) or chords not in ("arclength", "exact"):
+        raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")
+    return chi, N
+
+
+def run(
+    chi: float | None = None,
+    N: int | None = None,
+    *,
+    tol: float = 1e-8,
+    method: str = "euler-richardson",
+    dt0: float | None = None,
+    t_end: float | None = None,
+    stop_fraction: float = 0.5,
+    t_end_max: float = 10.0,
+    snapshot_times=(),
+    record_thin: float = 0.0,
+    max_link_error: float = 1e-2,
+    chords: str = "arclength",
+    initial: ChainState | None = None,
+    output=None,
+    progress: bool | None = False,
+    max_energy_drift: float | None = None,
+    dt_min: float = 1e-14,
+    max_rejections: int = 100,
+    checkpoint_every: float | None = CHECKPOINT_EVERY,
+    problem=None,
+) -> Run:
+    """Simulate the falling chain released from the paper's catenary, to the snap and a bit after.
+
+    The N-pendulum of the paper's appendix (eqs. (discretemo) and the tension
+    system) integrated with its Euler-Richardson scheme: half step, full step,
+    error estimate eq. (error), dt_new = 0.9 dt (tol/eps)^(1/2) (eq. (dtau)).
+
+    Step rejection: a step is accepted when eps <= tol; otherwise it is retried
+    from the same state with dt = 0.9 dt (tol/eps)^(1/2) (the same rule). The
+    half-step evaluation alone decides, so a rejected step costs one evaluation
+    and an accepted step two (the accelerations at the end of a step are those
+    at the start of the next). Initial step: ``dt0 = sqrt(tol)`` unless given
+    (eps ~ dt^2 max|a|/4 at rest, so this is accepted for max|a| ~ 1 and adapts
+    from there); if eps = 0 exactly the step grows by ``ZERO_ERROR_GROWTH``.
+
+    Stopping: with ``t_end`` the run ends at that time (the last step is clipped to
+    land on it). Otherwise at the snap: the run stops once the maximum speed over
+    the chain has fallen below ``stop_fraction`` of its running peak (the global
+    peak of v_max), or at ``t_end_max`` at the latest.
+
+    Recording: every accepted step (or, with ``record_thin > 0``, only steps where
+    v_max, a_max, sigma_max or kappa_max changed by more than that fraction since
+    the last recorded step; this keeps memory bounded and the record stays dense
+    where things change fast, near the snap). The three steps around the peak of
+    each of v_max, a_max, sigma_max, kappa_max are tracked densely regardless,
+    and give the snapping times (vertex of the parabola through them).
+    Snapshots of the full profiles: at t = 0, at the first step at or after each
+    time in ``snapshot_times``, whenever v_max first reaches 1, 1.5, 1.5^2, ...
+    (they pile up towards the snap), at the peak of v_max, when v_max falls to
+    0.9 and 0.7 of the peak, and at the end.
+
+    Parameters
+    ----------
+    chi : float or Problem
+        Initial end separation / length, in (0, 1); or a
+        :class:`snapping.simulate.problem.Problem` (any chain, start, held end, gravity).
+    N : int
+        Number of links, >= 1.
+    problem : Problem, optional
+        The problem to solve (the same as passing it as ``chi``): unequal links and
+        masses, a tip mass, any start shape and velocities, a moving held end, any
+        gravity. ``run(Problem.catenary(chi, N))`` is ``run(chi, N)``, bit for bit.
+        Methods ``dop853``/``fast`` take every problem; ``euler-richardson`` only the
+        paper's chain (N equal links and masses) with a fixed held end and g = 1.
+    tol : float
+        Stepper tolerance eps_tol (paper: 1e-8).
+    method : {"euler-richardson", "euler-richardson-fixed"}
+        The paper's adaptive scheme, or the same step with fixed dt = dt0.
+    dt0 : float, optional
+        Initial (fixed-mode: constant) time step.
+    t_end : float, optional
+        End time (> 0); default: stop automatically after the snap.
+    stop_fraction : float
+        Automatic stop when v_max < stop_fraction * peak, in (0, 1).
+    t_end_max : float
+        Hard end time of an automatic run.
+    snapshot_times : sequence of float
+        Extra snapshot times.
+    record_thin : float
+        Relative-change threshold of the thinned per-step record, in [0, 1).
+    max_link_error : float
+        The run fails when a link length is off from 1/N by more than this fraction
+        plus the initial chord error ``link_error_initial``.
+    chords : {"arclength", "exact"}
+        Initial node placement (see :func:`initial_state`).
+    initial : ChainState, optional
+        Start from this state instead of the catenary (``chi`` then optional).
+    output : path, optional
+        Write the netCDF4 file here (checked for writability before the run;
+        also written when the run fails or is interrupted).
+    progress : bool or None
+        tqdm progress bar on stderr (None: only on a terminal).
+    max_energy_drift : float, optional
+        The run fails when |E(t) - E(0)| exceeds this (default: no bound).
+    dt_min : float
+        The run fails when the adaptive time step falls below this floor.
+    max_rejections : int
+        The run fails after more than this many consecutive rejected steps.
+    checkpoint_every : float or None
+        With ``output``: save the full state of the run to ``output`` (status
+        'checkpoint', atomically) every this many seconds of wall time (0: at every
+        return of the compiled loop; None: only when stopped). A checkpointed or
+        interrupted file continues with :func:`resume` to the same Dataset, bit for bit.
+
+    Returns
+    -------
+    Run
+        ``.dataset`` (xarray.Dataset, schema in :mod:`snapping.schema`), ``.state``.
+
+    Raises
+    ------
+    SnappingInputError
+        Bad input, before anything runs; also a run whose record and snapshots
+        would not fit in the available memory (see :func:`memory_need`).
+    SimulationError
+        A numerical failure, as one of its subclasses: :class:`NonFiniteError`
+        (NaN/inf), :class:`StepSizeError` (dt below ``dt_min``), :class:`DriftError`
+        (link drift past ``max_link_error``), :class:`EnergyDriftError` (past
+        ``max_energy_drift``), :class:`RejectionError` (more than
+        ``max_rejections`` consecutive rejections). It carries ``t``, ``step`` and
+        the worst ``node``; what was computed is in ``exc.dataset`` (and in
+        ``output``), status 'failed', ``stop_reason`` and ``failure`` saying why.
+    RunInterrupted
+        SIGINT or SIGTERM arrived: the run stopped at a step boundary and was saved
+        (status 'interrupted') with its checkpoint; a ``KeyboardInterrupt``.
+
+    Examples
+    --------
+    >>> r = run(0.5, 8, t_end=0.05, chords="exact")
+    >>> ds = r.dataset
+    >>> ds.attrs["status"], int(ds.attrs["N"]), float(ds.t[-1])
+    ('completed', 8, 0.05)
+    >>> bool(ds.attrs["energy_drift"] < 1e-9), bool(ds.attrs["link_drift"] < 1e-9)
+    (True, True)
+    >>> snap = run(0.5, 50).dataset.attrs                 # to shortly after the snap
+    >>> round(snap["t_snap_v"], 3), snap["stop_reason"]
+    (1.144, 'snap detected: v_max fell below 0.5 of its peak')
+    """
+    chi, N, chords, initial, problem = _resolve_problem(chi, N, chords, initial, problem, method)
+    chi, N = _validate_start(chi, N, method, chords, initial, problem)
+    opts = RunOptions(tol=tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
+                      snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
+                      max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections)
+    output = None if output is None else check_writable(output)
+    checkpoint_every = check_checkpoint_every(checkpoint_every)
+    progress = check_progress(progress)
+    method_ = M.method(method)
+    opts = method_.complete(opts, method)
+    check_memory(N, opts, chi=chi, method=method)
+    inputs, eng = method_.setup(chi, N, method, opts, chords=chords, initial=initial, problem=problem)
+    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
+
+
+def check_inputs(chi=None, N=None, **options) -> None:
+    """Check the inputs of :func:`run` without running it (a sweep checks every run
+    before the first starts); raises :class:`SnappingInputError` like :func:`run`.
+
+    >>> check_inputs(0.3, 10, tol=-1.0)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: tol=-1.0 is out of range: must be > 0
+    """
+    import inspect
+
+    params = inspect.signature(run).parameters
+    unknown = sorted(k for k in options if k not in params or k in ("chi", "N"))
+    if unknown:
+        raise V.SnappingInputError(f"unknown keywords {unknown} of simulate.run (valid: "
+                                   f"{sorted(k for k in params if k not in ('chi', 'N'))})")
+    kw = {k: p.default for k, p in params.items() if k not in ("chi", "N")}
+    kw.update(options)
+    chi, N, chords, initial, problem = _resolve_problem(chi, N, kw["chords"], kw["initial"], kw["problem"],
+                                                        kw["method"])
+    chi, N = _validate_start(chi, N, kw["method"], chords, initial, problem)
+    opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])
+    if kw["output"] is not None:
+        check_writable(kw["output"])
+    check_checkpoint_every(kw["checkpoint_every"])
+    check_progress(kw["progress"])
+    check_memory(N, opts, chi=chi, method=kw["method"])
+
+
+# ---------------------------------------------------------------- the driver: signals, checkpoints, results
+def _checkpoint_dataset(eng, inputs: dict, results: dict) -> xr.Dataset:
+    ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs, results)
+    ds = ds.assign(eng.checkpoint_vars())
+    ds.attrs.update({
+        "checkpoint_version": CHECKPOINT_VERSION,
+        "checkpoint_wall_time": float(results["wall_time"]),
+        "checkpoint_link_error_initial": eng.link_error_initial,
+        "checkpoint_time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    })
+    return ds
+
+
+def _resume_command(path) -> str:
+    import shlex
+
+    return f"snapping simulate --resume {shlex.quote(str(path))}"
+
+
+def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
+    """Run ``eng`` to its end, with progress bar, signal handling and checkpoints; build and save the result.
+
+    ``eng`` is a method's engine (:data:`snapping.simulate.methods.METHODS`): each
+    provides ``t``, ``n_steps``,
+    ``loop(bar, poll)``, ``records()``, ``snapshots_now()``, ``checkpoint_vars()``,
+    ``results(...)``, ``worst_node(code)``, ``failure_message(code, node)``,
+    ``final_state()`` and ``link_error_initial``."""
+    t_end = inputs["t_end"] or None
+    N = eng.N
+    bar = None
+    if progress or progress is None:
+        from tqdm.auto import tqdm
+
+        desc = f"chain N={N}" if inputs["method"] in ("euler-richardson", "euler-richardson-fixed") else \
+            f"chain N={N} ({inputs['method']})"
+        bar = tqdm(total=t_end, initial=eng.t, file=sys.stderr, disable=None if progress is None else False,
+                   unit="t", desc=desc, dynamic_ncols=True,
+                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
+                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
+    got = {"signum": None, "last": time.monotonic()}
+    wall0 = time.perf_counter()
+
+    def on_signal(signum, frame):
+        got["signum"] = signum
+
+    def poll():
+        if _chunk_hook is not None:
+            r = _chunk_hook(eng)
+            if r:
+                got["signum"] = int(r)
+        if got["signum"] is not None:
+            return RET_SIGNAL
+        if output is not None and checkpoint_every is not None and time.monotonic() - got["last"] >= checkpoint_every:
+            wall = wall_before + time.perf_counter() - wall0
+            res = eng.results("checkpoint", f"running; checkpoint at t={eng.t:.9g}, step {eng.n_steps}; "
+                              f"if the run was killed, continue with: {_resume_command(output)}", wall)
+            save(_checkpoint_dataset(eng, inputs, res), output)
+            got["last"] = time.monotonic()
+        return None
+
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            try:
+                handlers[sig] = signal.signal(sig, on_signal)
+            except (ValueError, OSError):  # pragma: no cover - exotic embedding
+                pass
+    try:
+        status, reason, code = "completed", "", None
+        try:
+            code = eng.loop(bar, poll)
+        except KeyboardInterrupt:  # no handler of ours (e.g. one raised by another handler)
+            got["signum"] = signal.SIGINT
+            code = RET_SIGNAL
+        finally:
+            wall = wall_before + time.perf_counter() - wall0
+            if bar is not None:
+                bar.close()
+        failure, node = "", -1
+        if code == RET_SIGNAL:
+            status = "interrupted"
+            try:
+                name = signal.Signals(got["signum"]).name
+            except ValueError:
+                name = f"signal {got['signum']}"
+            reason = f"interrupted by {name} at t={eng.t:.9g}, step {eng.n_steps}"
+            if output is not None:
+                reason += f"; continue with: {_resume_command(output)}"
+            ds = _checkpoint_dataset(eng, inputs, eng.results(status, reason, wall))
+            path = save(ds, output) if output is not None else None
+            raise RunInterrupted(f"{reason}" + (f" (saved in {path})" if path else " (not saved: no output file)"),
+                                 int(got["signum"]), dataset=ds, path=path)
+        if code == K.RET_STOP:
+            reason = f"snap detected: v_max fell below {inputs['stop_fraction']:g} of its peak"
+        elif code == K.RET_END:
+            reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
+        else:
+            status = "failed"
+            node = eng.worst_node(code)
+            reason = eng.failure_message(code, node)
+            failure = FAILURES.get(code, SimulationError).kind
+        ds = build_dataset(eng.records(), eng.snapshots_now(), N, inputs,
+                           eng.results(status, reason, wall, failure, node))
+        final = eng.final_state() if status == "completed" else None
+        path = save(ds, output) if output is not None else None
+    finally:
+        for sig, h in handlers.items():
+            signal.signal(sig, h)
+    if status == "failed":
+        where = f"; what was computed is saved in {path}" if path else ""
+        cls = FAILURES.get(code, SimulationError)
+        raise cls(f"simulation failed: {reason}{where}", dataset=ds, path=path, t=eng.t,
+                  step=eng.n_steps, node=node)
+    return Run(ds, final, path)
+
+
+def rerun(ds: xr.Dataset, **overrides) -> Run:
+    """Run again from a run Dataset's attributes (``run(**inputs_from_attrs(ds))``).
+
+    Examples
+    --------
+    >>> r1 = run(0.5, 6, t_end=0.02)
+    >>> r2 = rerun(r1.dataset)
+    >>> bool((r1.dataset.v_max == r2.dataset.v_max).all())
+    True
+    """
+    kw = inputs_from_attrs(ds)
+    kw.update(overrides)
+    return run(**kw)
+
+
+def _open_checkpoint(path) -> xr.Dataset:
+    """Load a run file that :func:`resume` can continue, or raise SnappingInputError saying why not."""
+    from .. import schema
+
+    p = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+    if not p:
+        raise V.SnappingInputError(f"path={path!r} is not a file path")
+    ds = open_netcdf(p)
+    status = str(ds.attrs.get("status", ""))
+    if status not in schema.RESUMABLE_STATUS:
+        if status in ("completed", "failed"):
+            raise V.SnappingInputError(f"path={p!r} is a {status} run (status={status!r}): there is nothing to "
+                                       f"resume, only runs with status in {schema.RESUMABLE_STATUS} continue")
+        raise V.SnappingInputError(f"path={p!r} is not a snapping run checkpoint (status={status!r}; "
+                                   f"expected one of {schema.RESUMABLE_STATUS})")
+    ck_vars = M.method(str(ds.attrs.get("method", "euler-richardson"))).CHECKPOINT_VARS \
+        if str(ds.attrs.get("method", "")) in METHODS else schema.CHECKPOINT_VARS
+    missing = [k for k in (*ck_vars, schema.CHECKPOINT_KIND_VAR, *schema.STEP_VARS) if k not in ds.variables]
+    missing += [k for k in (*schema.CHECKPOINT_ATTRS, "chi", "N", "method", "tol") if k not in ds.attrs]
+    if missing:
+        raise V.SnappingInputError(f"path={p!r} is not a complete checkpoint: missing {missing[:5]}")
+    if int(ds.attrs["checkpoint_version"]) != CHECKPOINT_VERSION:
+        raise V.SnappingInputError(f"path={p!r}: checkpoint version {ds.attrs['checkpoint_version']} is not "
+                                   f"supported by this version (expects {CHECKPOINT_VERSION})")
+    return ds
+
+
+def is_resumable(path, **expected) -> bool:
+    """True if ``path`` is a checkpoint :func:`resume` can continue and, for each keyword
+    given (``chi``, ``N``, ``tol``, any input of :func:`run`), its input equals that value.
+
+    >>> is_resumable("no/such/run.nc")
+    False
+    """
+    try:
+        ds = _open_checkpoint(path)
+        kw = inputs_from_attrs(ds)
+    except (V.SnappingInputError, KeyError, ValueError, TypeError):
+        return False
+    for k, v in expected.items():
+        if v is None or k in ("output", "progress", "checkpoint_every"):
+            continue
+        have = kw.get(k)
+        if k == "method":  # files name the method it stands for
+            v = M.resolve(v)
+        if k == "snapshot_times":
+            if tuple(float(x) for x in np.atleast_1d(np.asarray(v, dtype=float))) != tuple(have or ()):
+                return False
+        elif isinstance(v, float) or isinstance(have, float):
+            try:
+                if float(v) != float(have):
+                    return False
+            except (TypeError, ValueError):
+                return False
+        elif v != have:
+            return False
+    return True
+
+
+def resume(path, *, output=None, progress: bool | None = False, checkpoint_every: float | None = CHECKPOINT_EVERY) -> Run:
+    """Continue an interrupted or checkpointed run file to its end.
+
+    The run continues from the complete state stored in the file (positions and
+    velocities of every node, t, dt, the stepper's counters, the record so far,
+    the snapshots and the peak trackers; :data:`snapping.schema.CHECKPOINT_VARS`),
+    and gives the same accepted steps and the same Dataset, bit for bit, as a run
+    that was never interrupted (``wall_time`` aside: it adds up the sessions).
+
+    Parameters
+    ----------
+    path : path
+        A run file with status 'checkpoint' or 'interrupted'.
+    output : path, optional
+        Where to write the run (default: ``path`` itself, replaced atomically).
+    progress, checkpoint_every
+        As for :func:`run`.
+
+    Returns
+    -------
+    Run
+
+    Raises
+    ------
+    SnappingInputError
+        Not a readable run checkpoint (a completed or failed run, another
+        program's file, a truncated file), or an unwritable ``output``.
+    SimulationError, RunInterrupted
+        As for :func:`run`.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> p = os.path.join(tempfile.mkdtemp(), "run.nc")
+    >>> resume(p)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: path='...run.nc' does not exist or is not a file
+    """
+    ds = _open_checkpoint(path)
+    out = check_writable(path if output is None else output)
+    checkpoint_every = check_checkpoint_every(checkpoint_every)
+    progress = check_progress(progress)
+    try:
+        kw = inputs_from_attrs(ds)
+        chi, N = _validate_start(kw["chi"], kw["N"], kw["method"], kw["chords"], kw.get("initial"),
+                                 kw.get("problem"))
+        opts = RunOptions.pick(kw)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the inputs stored in the checkpoint are not valid "
+                                   f"({type(exc).__name__}: {exc})") from None
+    check_memory(N, opts, chi=chi, method=kw["method"])
+    inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
+                                               initial=kw.get("initial"), problem=kw.get("problem"))
+    try:
+        eng.restore(ds)
+    except (KeyError, ValueError, TypeError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise V.SnappingInputError(f"path={os.fspath(path)!r}: {exc}") from None
+        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the checkpoint is damaged ({exc})") from None
+    return _drive(eng, inputs, output=out, progress=progress, checkpoint_every=checkpoint_every,
+                  wall_before=float(ds.attrs["checkpoint_wall_time"]))
+
+
+def integrate_fixed(state: ChainState, dt: float, n_steps: int) -> ChainState:
+    """Advance ``state`` by ``n_steps`` Euler-Richardson steps of fixed size ``dt``
+    (no error control; for measuring the order of accuracy).
+
+    >>> from snapping.simulate import initial_state
+    >>> s = integrate_fixed(initial_state(0.5, 4), 1e-3, 10)
+    >>> round(s.t, 12)
+    0.01
+    """
+    if not isinstance(state, ChainState):
+        raise V.SnappingInputError(f"state={type(state).__name__} is not a ChainState")
+    dt = V.positive("dt", dt)
+    n_steps = V.integer("n_steps", n_steps, 1)
+    r = run(initial=state, method="euler-richardson-fixed", dt0=dt, t_end=state.t + n_steps * dt,
+            max_link_error=0.5, progress=False)
+    return r.state
