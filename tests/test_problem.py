@@ -329,3 +329,50 @@ def test_tapered_chain_available_energy_against_quadrature():
     order = lambda e: math.log2(e[1] / e[2])  # noqa: E731
     assert 1.9 < order(errs["shared"]) < 2.1 and errs["shared"][-1] < 1e-6
     assert 0.9 < order(errs["paper"]) < 1.1
+
+
+def test_steps_land_on_the_held_ends_breakpoints():
+    """A pull from t = 0.1 to 0.4 (its acceleration jumps there): steps end exactly on both
+    times, the held end's velocity is the closed form, and before the pull the chain
+    falls with a fixed end (energy conserved to round-off)."""
+    p = Problem.catenary(0.5, 60, pin=PinMotion.pull((0.0, -2.0), duration=0.3, t0=0.1))
+    ds = run(p, t_end=0.6, **FAST).dataset
+    t = ds.t.values
+    assert 0.1 in t and 0.3 + 0.1 in t
+    bal = np.abs((ds.energy - ds.pin_work).values - float(ds.energy[0]))
+    assert bal[t <= 0.1].max() < 1e-13 and bal.max() < 1e-8
+    assert float(ds.pin_vy[-1]) == pytest.approx(-0.6, rel=1e-14)
+
+
+def test_checkpoint_written_before_breakpoints_existed_still_resumes(tmp_path):
+    """Checkpoints of the layout before the breakpoint entry (37 control entries; their runs
+    had no breakpoints) resume to the same run."""
+    import xarray as xr
+
+    from snapping.simulate import driver
+    import snapping.simulate.methods.dop853 as HO
+    from snapping.simulate import rk as R
+
+    calls = {"n": 0}
+
+    def hook(eng):
+        calls["n"] += 1
+        return 2 if calls["n"] == 3 else 0
+
+    out = tmp_path / "old.nc"
+    old = HO.NODE_EVALS_PER_CALL
+    driver._chunk_hook, HO.NODE_EVALS_PER_CALL = hook, 2000
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run(0.4, 40, output=str(out), **FAST)
+    finally:
+        driver._chunk_hook, HO.NODE_EVALS_PER_CALL = None, old
+    with xr.open_dataset(out) as f:
+        ds = f.load()
+    ctl = ds["checkpoint_ctl"].values
+    assert ctl.size == R.NQ and ctl[R.Q_TBRK] == np.inf
+    ds = ds.drop_vars("checkpoint_ctl").assign(checkpoint_ctl=(("checkpoint_ctl",), ctl[:R.NQ_BEFORE_BREAKS]))
+    ds.to_netcdf(tmp_path / "older.nc")
+    done = resume(str(tmp_path / "older.nc")).dataset
+    ref = run(0.4, 40, **FAST).dataset
+    assert np.array_equal(done.v_max.values, ref.v_max.values) and done.attrs["v_peak"] == ref.attrs["v_peak"]

@@ -451,6 +451,19 @@ def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
         general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, snode, tab)
 
 
+def breakpoints(mdl) -> list[float]:
+    """Times where the held end's acceleration jumps (the steppers land on them): the start
+    and end of a pull or a flick (a flick's acceleration is continuous, its third derivative
+    is not), the last sample of a table (constant velocity after it)."""
+    par, tab = mdl[0], mdl[-1]
+    kind = par[P_PIN]
+    if kind in (PIN_PULL, PIN_FLICK):
+        return [float(v) for v in (par[P_T0], par[P_T0] + par[P_T1]) if math.isfinite(v)]
+    if kind == PIN_TABLE:
+        return [float(tab[int(par[P_NKNOT]) - 1])]
+    return []
+
+
 def uniform_model(N: int):
     """The model tuple of the paper's chain (dispatches to the uniform kernels)."""
     return make_model(np.full(N, 1.0 / N), np.full(N, float(N)), uniform=True)

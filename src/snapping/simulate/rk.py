@@ -71,8 +71,12 @@ ERR_EXPONENT = -1.0 / 8.0
 (Q_T, Q_H, Q_SLOT, Q_NSTEPS, Q_NREJ, Q_NRHS, Q_NREC, Q_TOL, Q_THIN, Q_MAXLINK, Q_DTMIN,
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
- Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ) = range(37)
-NQ = 37
+ Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ,
+ Q_TBRK) = range(38)
+NQ = 38
+#: control entries of files written before Q_TBRK (the next breakpoint of the held end's
+#: motion) existed; their runs had none (inf)
+NQ_BEFORE_BREAKS = 37
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
@@ -209,11 +213,16 @@ def _changed(q, last, thin):
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def step_size(ctl):
-    """(h, last): the next step size, clipped to land on ``ctl[Q_TEND]``."""
+    """(h, last): the next step size, clipped to land on ``ctl[Q_TEND]``, or on the next
+    breakpoint of the held end's motion ``ctl[Q_TBRK]`` (where its acceleration jumps; a
+    step never straddles one)."""
     h = ctl[Q_H]
     rem = ctl[Q_TEND] - ctl[Q_T]
     if h >= rem * (1.0 - 1e-8):
         return rem, True
+    rb = ctl[Q_TBRK] - ctl[Q_T]
+    if h >= rb * (1.0 - 1e-8):
+        return rb, False
     return h, False
 
 
@@ -273,6 +282,10 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     HS[ns] = h
     DOK[ns] = 0.0
     t = ctl[Q_TEND] if last else t + h
+    brk = ctl[Q_TBRK]
+    at_brk = not last and brk < np.inf and abs(t - brk) <= 1e-13 * max(1.0, abs(brk))
+    if at_brk:  # (the step was clipped to land on it)
+        t = brk
     ctl[Q_T] = t
     ctl[Q_SLOT] = float(ns)
     dt = h * fac
@@ -340,7 +353,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         code = K.RET_STOP
     elif last:
         code = K.RET_END
-    elif t >= ctl[Q_TRET]:
+    elif t >= ctl[Q_TRET] or at_brk:
         code = K.RET_T_RETURN
     elif vmax >= ctl[Q_VUP]:
         code = K.RET_V_UP

@@ -151,7 +151,9 @@ class Engine(CheckpointMixin):
         c[R.Q_MAXENERGY] = np.inf if max_energy_drift is None else max_energy_drift
         c[R.Q_MAXREJ] = max_rejections
         c[R.Q_CONSREJ] = 0.0
+        c[R.Q_TBRK] = np.inf
         self.ctl = c
+        self.breaks = [b for b in G.breakpoints(self.mdl) if b > t0]
         pk = np.full((4, R.NPKR), np.nan)
         for qi, m in enumerate(_PEAK_MEAS):
             pk[qi, R.PK_SBEST] = self.meas[m]
@@ -260,6 +262,9 @@ class Engine(CheckpointMixin):
             self.requested.pop(0)
         c[R.Q_TRET] = self.requested[0] if self.requested else np.inf
         c[R.Q_VDOWN] = self.after_fracs[0] if self.after_fracs else 0.0
+        while self.breaks and self.breaks[0] <= self.t:
+            self.breaks.pop(0)
+        c[R.Q_TBRK] = self.breaks[0] if self.breaks else np.inf
 
     def start(self) -> None:
         """Targets of the first call into the compiled loop."""
@@ -430,7 +435,7 @@ class Engine(CheckpointMixin):
                           ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
                           ("checkpoint_meas0", self.meas0)):
             arr[...] = get(name, arr.shape)
-        self._restore_ctl(get, R.NQ)
+        self._restore_ctl(get, R.NQ, pad={R.NQ_BEFORE_BREAKS: np.inf})
         self._restore_scales(ds, get)
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
