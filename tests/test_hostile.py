@@ -307,6 +307,25 @@ def _cli_cases():
         add("simulate", "--chi", "nan", "--N", "10", "-o", f"{{{k}}}")
         add("simulate", "--chi", "0.3", "--N", "10", "--tol", "-1", "-o", f"{{{k}}}")
     add("simulate", "--resume", "{failed}", "-o", "{completed}")
+    # the general problem's options (#12): every one with bad values, and with -o never touching the file
+    fast = ("simulate", "--chi", "0.3", "--N", "10", "--method", "fast")
+    for flag, vals in (("--tip-mass", ("-1", "nan", "inf", "abc")),
+                       ("--taper", ("0", "-0.5", "nan", "0.5:0", "0.5:-1", "0.5:2:3", "a", "")),
+                       ("--lumping", ("nodes",)), ("--gravity", ("-1", "nan", "inf")),
+                       ("--pin-motion", ("wiggle", "pull", "pull:1", "pull:a,b", "pull:1,0,-1", "pull:nan,0",
+                                         "flick:1,0", "flick:1,0,0", "flick:1,0,-2", "flick:inf,0,1", "fixed:1"))):
+        for v in vals:
+            add(*fast, flag, v)
+    for v in ("0.4", "0.4,0.2,1", "-0.4,0.2", "nan,0", "0.9,0.9", "a,b", "0,0"):
+        add("simulate", "--supports", v, "--N", "10", "--method", "fast")
+    for k in ("missing", "empty", "garbage", "dir", "foreign", "completed"):  # (a run file: x, y are 2-D)
+        add("simulate", "--shape", f"{{{k}}}", "--N", "10", "--method", "fast")
+    add("simulate", "--chi", "0.3", "--supports", "0.4,0.1", "--N", "10", "--method", "fast")
+    add("simulate", "--chi", "0.3", "--N", "10", "--tip-mass", "0.5")  # euler-richardson refuses it
+    add("simulate", "--chi", "0.3", "--N", "10", "--gravity", "0.5", "--method", "euler-richardson")
+    for k in ("completed", "foreign"):
+        add(*fast, "--taper", "-1", "-o", f"{{{k}}}")
+        add(*fast, "--pin-motion", "flick:1", "-o", f"{{{k}}}")
     for v in ("abc", "nan", "2", "0.3,0.3", ""):
         add("sweep", "--chi", v, "--N", "10", "-o", "{root}/sw")
     for v in ("0", "abc", "-5"):

@@ -376,3 +376,29 @@ def test_checkpoint_written_before_breakpoints_existed_still_resumes(tmp_path):
     done = resume(str(tmp_path / "older.nc")).dataset
     ref = run(0.4, 40, **FAST).dataset
     assert np.array_equal(done.v_max.values, ref.v_max.values) and done.attrs["v_peak"] == ref.attrs["v_peak"]
+
+
+def test_cli_runs_the_general_problems(tmp_path, capsys):
+    import json
+
+    from snapping.cli import main
+
+    csv = tmp_path / "start.csv"
+    s = np.linspace(0.0, 1.0, 201)
+    csv.write_text("x,y\n" + "\n".join(f"{0.5 * math.sin(v)},{0.5 * (1 - math.cos(v))}" for v in 2.0 * s))
+    out = tmp_path / "shape.nc"
+    assert main(["simulate", "--shape", str(csv), "--N", "30", "--method", "fast", "--json", "-o", str(out)]) == 0
+    summ = json.loads(capsys.readouterr().out)
+    assert summ["start"] == "curve" and summ["status"] == "completed"
+    ds = load_run(str(out))
+    assert np.allclose(np.hypot(np.diff(ds.start_x), np.diff(ds.start_y)), 1 / 30, rtol=1e-12)
+    r = math.hypot(float(ds.start_x[0]), float(ds.start_y[0]) - 0.5)  # the nodes lie on the circle of radius 1/2
+    assert r == pytest.approx(0.5, abs=1e-6)  # (a cubic spline through 201 samples of the circle)
+    argv = ["simulate", "--supports", "0.4,0.2", "--N", "20", "--method", "fast", "--taper", "0.2:2", "--tip-mass",
+            "0.05", "--pin-motion", "flick:2,0,0.3", "--json"]
+    assert main(argv) == 0
+    summ = json.loads(capsys.readouterr().out)
+    assert (summ["start"], summ["pin_motion"], summ["tip_mass"]) == ("supports", "flick", 0.05)
+    p = Problem.supports(0.4, 0.2, links=Links.taper(20, 0.2, power=2.0, tip_mass=0.05),
+                         pin=PinMotion.flick((2.0, 0.0), 0.3))
+    assert summ["v_peak"] == run(p, **FAST).dataset.attrs["v_peak"]

@@ -326,7 +326,11 @@ class Problem:
         from . import shapes
 
         links = links if links is not None else Links.uniform(_links_count("N", N))
-        x, y = shapes.place_on_curve(curve, links.h)
+        try:
+            x, y = shapes.place_on_curve(curve, links.h)
+        except V.SnappingInputError as exc:
+            raise V.SnappingInputError(f"{name}: the chain ({links.N} links, length {links.length:.6g}) cannot be "
+                                       f"placed on it: {exc}") from None
         return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "curve", "name": str(name)})
 
     @classmethod
@@ -450,13 +454,16 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
     if not os.path.isfile(p):
         raise V.SnappingInputError(f"shape={p!r} does not exist or is not a file")
     if p.endswith((".nc", ".nc4", ".cdf")):
-        import xarray as xr
+        from .dataset import open_netcdf
 
-        try:
-            with xr.open_dataset(p) as ds:
-                x, y = (np.asarray(ds[k].values, dtype=float).ravel() for k in ("x", "y"))
-        except (OSError, KeyError, ValueError) as exc:
-            raise V.SnappingInputError(f"shape={p!r}: not a netCDF file with variables x and y ({exc})") from None
+        ds = open_netcdf(p)
+        if "x" not in ds.variables or "y" not in ds.variables:
+            raise V.SnappingInputError(f"shape={p!r}: a netCDF shape file needs variables x and y; it has "
+                                       f"{sorted(map(str, ds.variables))[:6]}")
+        if ds["x"].ndim != 1 or ds["y"].ndim != 1:
+            raise V.SnappingInputError(f"shape={p!r}: x and y must be 1-D (one point each along the curve); got "
+                                       f"dimensions {ds['x'].dims} and {ds['y'].dims}")
+        x, y = (np.asarray(ds[k].values, dtype=float) for k in ("x", "y"))
     else:
         try:
             a = np.genfromtxt(p, delimiter=",", dtype=float, comments="#")
@@ -512,8 +519,4 @@ def from_options(*, chi=None, N=None, chords: str = "arclength", supports=None, 
             raise V.SnappingInputError(f"supports={supports!r} must be two numbers DX,DY") from None
         return Problem.supports(dx, dy, links=links, pin=pin, gravity=gravity)
     x, y = read_shape(shape)
-    L = float(np.hypot(np.diff(x), np.diff(y)).sum())
-    if L < links.length * (1.0 - 1e-9):
-        raise V.SnappingInputError(f"shape={shape!r} is {L:.6g} long, shorter than the chain ({links.length:.6g}): "
-                                   f"give the start curve in units of the chain's length")
     return Problem.curve((x, y), links=links, pin=pin, gravity=gravity, name=str(shape))
