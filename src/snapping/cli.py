@@ -505,6 +505,66 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------- converge
+def _add_converge(sub) -> None:
+    p = sub.add_parser(
+        "converge",
+        help="the continuum limit of the snap: graded chains refined, peaks extrapolated with error bars",
+        formatter_class=_formatter,
+        description=(
+            "Refine chains whose links follow the fold (snapping.simulate.grading.fold_following) level\n"
+            "by level, every length scale times --ratio per level, run each to the snap (method fast),\n"
+            "and extrapolate the peaks of speed, acceleration, tension, curvature and the snapping\n"
+            "time to the string (Richardson, with the observed order and an error bar from the\n"
+            "spread of successive extrapolations). Nondimensional units (length, mass and g of the\n"
+            "chain)."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping converge --chi 0.25                      # 4 levels, ~10 s\n"
+            "  snapping converge --chi 0.1 --levels 5 --workers 2 -o conv01 --plot conv01.png\n"
+            "  snapping converge --chi 0.25 --levels 3 --first -1 --json\n"
+            "  snapping converge --chi 0.25 --lumping paper      # the paper's lumping: first order\n"
+            "\n"
+            "With -o DIR every level's run file is kept there and a rerun reuses the finished levels."
+        ),
+    )
+    p.add_argument("--chi", type=float, required=True, help="end separation / length, in (0, 1)")
+    p.add_argument("--levels", type=int, default=4, help="refinement levels (default 4; >= 4 for an error bar)")
+    p.add_argument("--ratio", type=float, default=0.5, help="length scales' factor per level (default 0.5)")
+    p.add_argument("--first", type=int, default=0,
+                   help="index of the coarsest level (default 0: fold links 4%% of its radius; -1: 8%%)")
+    p.add_argument("--lumping", default="shared", choices=["shared", "paper"], help="node masses (default shared)")
+    p.add_argument("--free-end", default=None, choices=["half", "whole"],
+                   help="mass of the free-end node: its share of the last link (shared's) or all of it")
+    p.add_argument("--tol", type=float, default=1e-8, help="tolerance of the fast method (default 1e-8)")
+    p.add_argument("--workers", type=int, default=1, help="levels run in parallel (default 1)")
+    p.add_argument("-o", "--output", default=None, metavar="DIR", help="keep the levels' run files here")
+    p.add_argument("--plot", default=None, metavar="PATH", help="draw the convergence figure (.png, .pdf, .svg)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.set_defaults(func=_cmd_converge)
+
+
+def _cmd_converge(args) -> int:
+    from . import continuum
+
+    if args.plot is not None:
+        from .simulate.dataset import check_writable
+
+        check_writable(args.plot)
+    res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
+                             free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
+                             progress=None if not args.json else False)
+    if args.plot is not None:
+        res.plot(args.plot)
+    if args.json:
+        ds = res.dataset
+        print_json({**res.summary(), "levels": {k: ds[k].values.tolist() for k in ds.data_vars}})
+    else:
+        print(res.table())
+    return 0
+
+
 # ----------------------------------------------------------------------- reproduce
 def _add_reproduce(sub) -> None:
     p = sub.add_parser(
@@ -561,7 +621,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"snapping {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
-    for add in (_add_ideal, _add_estimate, _add_simulate, _add_sweep, _add_fit, _add_reproduce):
+    for add in (_add_ideal, _add_estimate, _add_simulate, _add_sweep, _add_fit, _add_converge, _add_reproduce):
         add(sub)
     return parser
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from .estimates import Chain, PAPER_CHAIN
 
-__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "save"]
+__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "convergence_figure", "save"]
 
 
 def _plt():
@@ -147,4 +147,48 @@ def peak_speed_vs_N(table):
     ax.grid(alpha=0.3, which="both")
     ax.set_title("Snapping velocity against N")
     fig.tight_layout()
+    return fig
+
+
+def convergence_figure(ds, path=None, uniform=None):
+    """The continuum limit (:func:`snapping.continuum.converge`): (a) each peak over its
+    extrapolated limit against the resolution of the fold (``frac``), with the limit's
+    error band, and the paper's uniform chains beside them (``uniform``: run Datasets,
+    plotted at their equivalent ``frac = 1/(N a)``); (b) the distance to the limit on
+    log axes, whose slope is the order of convergence. Returns the Figure (and saves it
+    to ``path`` if given)."""
+    plt = _plt()
+    from . import estimates
+
+    quantities = (("v_peak", r"$v$"), ("a_peak", r"$a$"), ("sigma_peak", r"$\sigma$"))
+    colors = ("C0", "C1", "C2")
+    frac = np.asarray(ds.frac.values, dtype=float)
+    a_cat = estimates.catenary_parameter(float(ds.attrs["chi"]))
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    for (q, label), c in zip(quantities, colors):
+        lim, err = float(ds.attrs[q + "_limit"]), float(ds.attrs[q + "_error"])
+        vals = np.asarray(ds[q].values, dtype=float)
+        ax1.plot(frac, vals / lim, "o-", color=c, label=f"{label} graded (limit {lim:.6g} $\\pm$ {err:.1g})")
+        ax1.fill_between([frac.min() / 2, frac.max() * 2], 1 - err / lim, 1 + err / lim, color=c, alpha=0.15, lw=0)
+        if uniform:
+            fu = [1.0 / (int(u.attrs["N"]) * a_cat) for u in uniform]
+            ax1.plot(fu, [float(u.attrs[q]) / lim for u in uniform], "s--", color=c, mfc="none",
+                     label=f"{label} uniform N = " + ", ".join(str(int(u.attrs["N"])) for u in uniform))
+        dist = np.abs(vals - lim) / abs(lim)
+        ok = dist > 0
+        ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: order {float(ds.attrs[q + '_order']):.2f}")
+    ax1.set_xscale("log")
+    ax1.set_xlim(frac.min() / 1.5, max(frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or [])))
+                 * 1.5)
+    ax1.axhline(1.0, color="k", lw=0.6)
+    ax1.set_xlabel("link length on the fold / its radius of curvature")
+    ax1.set_ylabel("peak / extrapolated limit")
+    ax1.set_title(f"(a) $\\chi$ = {float(ds.attrs['chi']):g}: peaks against resolution")
+    ax1.legend(fontsize=7, loc="lower right")
+    ax2.set_xlabel("link length on the fold / its radius of curvature")
+    ax2.set_ylabel("|peak - limit| / limit")
+    ax2.set_title("(b) distance to the limit")
+    ax2.legend(fontsize=8)
+    if path is not None:
+        fig.savefig(path, dpi=130)
     return fig

@@ -44,6 +44,8 @@ from .pin import PIN_KINDS, PinMotion, parse_pin_motion
 __all__ = ["Links", "PinMotion", "Problem", "LUMPINGS", "PIN_KINDS"]
 
 LUMPINGS = ("shared", "paper")
+#: mass of the free-end node: its share of link 0, or all of it
+FREE_END_RULES = ("half", "whole")
 #: relative tolerance of a shape's link lengths against the chain's
 SHAPE_RTOL = 1e-6
 
@@ -158,11 +160,13 @@ class Links:
 
     @classmethod
     def from_density(cls, h, density=None, *, tip_mass: float = 0.0, lumping: str = "shared",
-                     kind: str = "density", params: dict | None = None) -> "Links":
+                     free_end: str | None = None, kind: str = "density", params: dict | None = None) -> "Links":
         """Links of lengths ``h`` (index 0 at the free end) with masses from a mass per length:
         ``density`` is None (1 everywhere), an array of link masses per length (one per
         link), or a function of the arclength from the held end (integrated over each link
         with Gauss-Legendre quadrature, 8 points: exact for polynomials of degree 15).
+        ``free_end``: the free-end node's mass rule, ``"half"`` (its share of link 0, the
+        ``lumping="shared"`` default) or ``"whole"`` (all of link 0, the paper's).
 
         >>> l = Links.from_density([0.5, 0.5], lambda s: 2 * s)   # heavier towards the tip
         >>> l.m.tolist()
@@ -187,7 +191,19 @@ class Links:
             mu = mu_p[::-1].copy()
         else:
             mu = h * _positive_array("density", density, N)
-        return cls._lumped(h, mu, tip_mass, lumping, kind, dict(params or {}))
+        return cls._lumped(h, mu, tip_mass, lumping, kind, dict(params or {}), free_end)
+
+    @classmethod
+    def graded(cls, h, *, lumping: str = "shared", free_end: str | None = None, tip_mass: float = 0.0,
+               params: dict | None = None) -> "Links":
+        """A chain of unit mass per length with links ``h`` (e.g. from
+        :mod:`snapping.simulate.grading`), masses lumped consistently by default.
+
+        >>> Links.graded([0.25, 0.75]).m.tolist(), Links.graded([0.25, 0.75], free_end="whole").m.tolist()
+        ([0.125, 0.5], [0.25, 0.5])
+        """
+        return cls.from_density(h, None, tip_mass=tip_mass, lumping=lumping, free_end=free_end, kind="graded",
+                                params=params)
 
     @classmethod
     def explicit(cls, h, m, *, tip_mass: float = 0.0) -> "Links":
@@ -205,9 +221,11 @@ class Links:
         return cls(h, m, tip, "explicit", {}, None)
 
     @classmethod
-    def _lumped(cls, h, mu, tip_mass, lumping, kind, params) -> "Links":
+    def _lumped(cls, h, mu, tip_mass, lumping, kind, params, free_end=None) -> "Links":
         if lumping not in LUMPINGS:
             raise V.SnappingInputError(f"lumping={lumping!r} is not one of {LUMPINGS}")
+        if free_end not in (None, *FREE_END_RULES):
+            raise V.SnappingInputError(f"free_end={free_end!r} is not one of {FREE_END_RULES}")
         tip = V.real("tip_mass", tip_mass)
         if tip < 0.0:
             raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must be >= 0 (a ratio to the chain's mass)")
@@ -216,6 +234,9 @@ class Links:
         else:
             m = 0.5 * mu
             m[1:] += 0.5 * mu[:-1]
+        if free_end is not None:
+            m[0] = (0.5 if free_end == "half" else 1.0) * mu[0]
+            params = {**params, "free_end": free_end}
         m[0] += tip
         return cls(h, m, tip, kind, {**params, "lumping": lumping}, np.asarray(mu, dtype=float))
 

@@ -1,0 +1,287 @@
+"""The continuum limit of the snap: graded chains refined level by level, extrapolated.
+
+:func:`converge` runs the chain released from the catenary of separation ``chi`` at a
+sequence of resolutions (the links of :func:`snapping.simulate.grading.fold_following`,
+every length scale of the grading -- ``frac``, ``h_min``, ``h_max`` -- multiplied by
+``ratio`` from one level to the next; masses lumped consistently), reads the peaks of
+speed, acceleration, tension and curvature and the snapping time at each, estimates the
+observed order of convergence and extrapolates (Richardson) to the string, with an
+error bar from the spread of successive extrapolations.
+
+Extrapolation (:func:`extrapolate`). With levels at resolutions ``h_k = h_0 r^k`` and a
+quantity ``q_k = q_inf + C h_k^p + ...``, three successive levels give the order
+``p = log(d_{k-1}/d_k)/log(1/r)`` (``d_k = q_k - q_{k-1}``) and the limit
+``q_inf = q_k + d_k/(r^-p - 1)``. The error bar is the difference between the last two
+such extrapolations (four levels or more), and never less than a tenth of the last
+correction; with three levels it is the last correction itself. Successive differences
+that change sign or do not shrink mean no asymptotic convergence: the verdict then says
+so and the error bar is the spread of the last levels.
+
+Example
+-------
+>>> import numpy as np
+>>> from snapping.continuum import extrapolate
+>>> h = 0.1 * 0.5 ** np.arange(5)
+>>> e = extrapolate(h, 3.0 + 2.0 * h**2 - h**3)
+>>> round(e["limit"], 6), round(e["order"], 2), e["converging"]
+(3.0, 2.05, True)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from . import _validate as V
+
+__all__ = ["converge", "extrapolate", "level_parameters", "Convergence", "QUANTITIES"]
+
+#: the peaks studied, and their names in a run's attributes
+QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v")
+#: the coarsest level's grading (fractions of the fold's radius, links at the free end, held arm)
+FRAC0, H_MIN0, H_MAX0 = 0.04, 4e-6, 4e-3
+
+
+def level_parameters(levels: int = 4, ratio: float = 0.5, *, frac0: float = FRAC0, h_min0: float = H_MIN0,
+                     h_max0: float = H_MAX0, first: int = 0) -> list[dict]:
+    """The grading parameters of each level: every length scale times ``ratio`` per level.
+
+    >>> [p["frac"] for p in level_parameters(3)]
+    [0.04, 0.02, 0.01]
+    """
+    levels = V.integer("levels", levels, 1)
+    ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
+    return [{"frac": frac0 * ratio**k, "h_min": h_min0 * ratio**k, "h_max": min(0.5, h_max0 * ratio**k)}
+            for k in range(first, first + levels)]
+
+
+def extrapolate(h, q) -> dict:
+    """Observed order, Richardson limit and error bar of ``q`` sampled at resolutions ``h``
+    (decreasing by a constant ratio). Returns ``limit``, ``error``, ``order``,
+    ``converging`` (bool) and ``digits`` (significant digits the error bar supports)."""
+    h = np.asarray(h, dtype=float)
+    q = np.asarray(q, dtype=float)
+    if h.size != q.size or h.size < 2:
+        raise V.SnappingInputError(f"extrapolate needs h and q of one length >= 2; got {h.size} and {q.size}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(h)) and np.all(h > 0)):
+        raise V.SnappingInputError("extrapolate needs finite q and positive resolutions h")
+    r = h[1:] / h[:-1]
+    if not np.allclose(r, r[0], rtol=1e-9) or not 0.0 < r[0] < 1.0:
+        raise V.SnappingInputError("extrapolate needs resolutions h decreasing by one constant ratio")
+    r = float(r[0])
+    d = np.diff(q)
+    out = {"limit": float(q[-1]), "error": float(abs(d[-1])), "order": float("nan"), "converging": False}
+    if q.size >= 3:
+        ests, orders = [], []
+        for k in range(2, q.size):
+            d1, d2 = d[k - 2], d[k - 1]
+            if d1 == 0.0 or d2 == 0.0 or np.sign(d1) != np.sign(d2) or abs(d2) >= abs(d1):
+                ests.append(None)
+                orders.append(float("nan"))
+                continue
+            p = math.log(abs(d1 / d2)) / math.log(1.0 / r)
+            orders.append(p)
+            ests.append(q[k] + d2 / (r ** -p - 1.0))
+        if ests[-1] is not None:
+            lim = float(ests[-1])
+            err = abs(lim - q[-1])  # with three levels: the correction itself
+            if len(ests) >= 2 and ests[-2] is not None:
+                err = max(abs(lim - float(ests[-2])), 0.1 * abs(lim - q[-1]))
+            out.update({"limit": lim, "error": float(err), "order": float(orders[-1]), "converging": True})
+        else:
+            out["error"] = float(np.ptp(q[-3:]))
+    scale = abs(out["limit"]) if out["limit"] != 0.0 else 1.0
+    out["digits"] = int(math.floor(-math.log10(out["error"] / scale))) if out["error"] > 0.0 else 16
+    return out
+
+
+@dataclass
+class Convergence:
+    """The result of :func:`converge`: ``dataset`` (dimension ``level``: links, grading,
+    peaks, cost; attributes: for each quantity its ``*_limit``, ``*_error``, ``*_order``
+    and a ``verdict``) and the run files of the levels (``paths``, when written)."""
+
+    dataset: xr.Dataset
+    paths: list
+
+    def summary(self) -> dict:
+        a = self.dataset.attrs
+        return {k: (v.item() if isinstance(v, np.generic) else v) for k, v in a.items()}
+
+    def table(self) -> str:
+        ds = self.dataset
+        lines = [f"continuum limit, chi = {ds.attrs['chi']:g} ({ds.attrs['lumping']} lumping, "
+                 f"free end {ds.attrs['free_end']}):",
+                 f"{'level':>5} {'links':>7} {'frac':>8} {'h_min':>8} " + " ".join(f"{q:>13}" for q in QUANTITIES)
+                 + f" {'wall s':>7}"]
+        for k in range(ds.sizes["level"]):
+            lines.append(f"{k:5d} {int(ds.n_links[k]):7d} {float(ds.frac[k]):8.3g} {float(ds.h_min[k]):8.2g} "
+                         + " ".join(f"{float(ds[q][k]):13.8g}" for q in QUANTITIES) + f" {float(ds.wall_time[k]):7.2f}")
+        lines.append(f"{'limit':>32} " + " ".join(f"{ds.attrs[q + '_limit']:13.8g}" for q in QUANTITIES))
+        lines.append(f"{'+-':>32} " + " ".join(f"{ds.attrs[q + '_error']:13.2g}" for q in QUANTITIES))
+        lines.append(f"{'order':>32} " + " ".join(f"{ds.attrs[q + '_order']:13.3g}" for q in QUANTITIES))
+        lines.append(f"verdict: {ds.attrs['verdict']}")
+        return "\n".join(lines)
+
+    def plot(self, path=None):
+        """Peaks against resolution (the fold fraction ``frac``) with the limit and its band."""
+        from .figures import convergence_figure
+
+        return convergence_figure(self.dataset, path)
+
+
+def _run_level(args):
+    """One level's run (in a worker process): the graded chain, its peaks and cost."""
+    chi, params, lumping, free_end, tol, path = args
+    from .simulate import Links, Problem, load_run, run
+    from .simulate import grading
+
+    h = grading.fold_following(chi, **params)
+    problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact")
+    if path is not None and os.path.isfile(path):
+        try:
+            ds = load_run(path)
+            if (ds.attrs.get("status") == "completed" and "link_length" in ds.variables
+                    and np.array_equal(ds.link_length.values, h) and float(ds.attrs["tol"]) == tol
+                    and np.array_equal(ds.node_mass.values[:-1], problem.links.m)):
+                return _level_row(ds, h), path  # resumed: this level is done
+        except V.SnappingInputError:
+            pass
+    ds = run(problem, method="fast", tol=tol, progress=False, output=path).dataset
+    return _level_row(ds, h), path
+
+
+def _level_row(ds, h) -> dict:
+    a = ds.attrs
+    row = {q: float(a[q]) for q in QUANTITIES}
+    row.update({"n_links": int(h.size), "wall_time": float(a["wall_time"]), "n_rhs": int(a["n_rhs"]),
+                "energy_drift": float(a["energy_drift"]), "link_drift": float(a["link_drift"])})
+    return row
+
+
+def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0, lumping: str = "shared",
+             free_end: str | None = None, tol: float = 1e-8, output=None, workers: int = 1,
+             progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
+             h_max0: float = H_MAX0) -> Convergence:
+    """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
+    peaks to the continuum (the string).
+
+    Parameters
+    ----------
+    chi : float
+        End separation of the catenary start, in (0, 1).
+    levels : int
+        Number of refinement levels (>= 3 for an order and a limit, >= 4 for an error bar
+        from two extrapolations).
+    ratio : float
+        Factor of every length scale of the grading from one level to the next, in (0, 1).
+    first : int
+        Index of the coarsest level (0: ``frac0, h_min0, h_max0``).
+    lumping, free_end
+        Mass lumping of the graded chains (:meth:`snapping.simulate.Links.graded`).
+    tol : float
+        Tolerance of the fast method (dop853) at every level.
+    output : path, optional
+        Directory for the levels' run files (``level{k}.nc``) and ``convergence.nc``; a
+        rerun reuses the levels already there (resumable).
+    workers : int
+        Levels run in parallel in this many processes.
+    progress : bool or None
+        One line per finished level on stderr.
+
+    Returns
+    -------
+    Convergence
+
+    Examples
+    --------
+    >>> c = converge(0.5, levels=3, first=-2)          # coarse and quick
+    >>> c.dataset.n_links.values.tolist(), round(c.dataset.attrs["v_peak_order"], 1)
+    ([123, 189, 324], 1.4)
+    """
+    import sys
+
+    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    workers = V.integer("workers", workers, 1)
+    params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0,
+                              first=V.integer("first", first, -20))
+    paths = [None] * len(params)
+    if output is not None:
+        out = V.file_path("output", output)
+        if os.path.exists(out) and not os.path.isdir(out):
+            raise V.SnappingInputError(f"output={out!r} exists and is not a directory")
+        os.makedirs(out, exist_ok=True)
+        paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
+    jobs = [(chi, p, lumping, free_end, tol, path) for p, path in zip(params, paths)]
+    # check every level's chain before any runs (bad input raises here, nothing written)
+    from .simulate import Links, grading
+    from .simulate.options import RunOptions
+
+    RunOptions(tol=tol)
+    for p in params:
+        Links.graded(grading.fold_following(chi, **p), lumping=lumping, free_end=free_end)
+    t0 = time.perf_counter()
+    rows = [None] * len(jobs)
+    if workers == 1 or len(jobs) == 1:
+        for k, job in enumerate(jobs):
+            rows[k], _ = _run_level(job)
+            if progress:
+                print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} ({rows[k]['n_links']} links) done in "
+                      f"{rows[k]['wall_time']:.1f} s", file=sys.stderr, flush=True)
+    else:
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
+            futs = {pool.submit(_run_level, job): k for k, job in enumerate(jobs)}
+            for f in as_completed(futs):
+                k = futs[f]
+                rows[k], _ = f.result()
+                if progress:
+                    print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} done", file=sys.stderr, flush=True)
+    ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
+    if output is not None:
+        from .simulate import save
+
+        save(ds, os.path.join(out, "convergence.nc"))
+    return Convergence(ds, [p for p in paths if p is not None])
+
+
+def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Dataset:
+    lev = "level"
+    data = {
+        "n_links": (lev, np.array([r["n_links"] for r in rows]), {"long_name": "number of links", "units": "1"}),
+        "frac": (lev, np.array([p["frac"] for p in params]),
+                 {"long_name": "link length along the fold's path / its radius of curvature", "units": "1"}),
+        "h_min": (lev, np.array([p["h_min"] for p in params]), {"long_name": "link length at the free end", "units": "1"}),
+        "h_max": (lev, np.array([p["h_max"] for p in params]), {"long_name": "largest link length", "units": "1"}),
+        "wall_time": (lev, np.array([r["wall_time"] for r in rows]), {"long_name": "wall time of the run", "units": "s"}),
+        "n_rhs": (lev, np.array([r["n_rhs"] for r in rows]), {"long_name": "right-hand-side evaluations", "units": "1"}),
+        "energy_drift": (lev, np.array([r["energy_drift"] for r in rows]), {"long_name": "max |E(t) - E(0)|", "units": "1"}),
+        "link_drift": (lev, np.array([r["link_drift"] for r in rows]), {"long_name": "max relative link error", "units": "1"}),
+    }
+    from . import schema
+
+    for q in QUANTITIES:
+        data[q] = (lev, np.array([r[q] for r in rows]), {"long_name": schema.RESULT_ATTRS[q], "units": "1"})
+    attrs = {"title": "snapping: continuum limit of the snap (graded chains, Richardson extrapolation)",
+             "chi": chi, "lumping": lumping, "free_end": free_end or ("half" if lumping == "shared" else "whole"),
+             "grading": "fold", "ratio": ratio, "tol": tol, "wall_time_total": wall}
+    verdicts = []
+    for q in QUANTITIES:
+        e = extrapolate(data["frac"][1], data[q][1]) if len(rows) >= 2 else \
+            {"limit": float(data[q][1][-1]), "error": float("nan"), "order": float("nan"), "converging": False,
+             "digits": 0}
+        attrs[f"{q}_limit"] = e["limit"]
+        attrs[f"{q}_error"] = e["error"]
+        attrs[f"{q}_order"] = e["order"]
+        attrs[f"{q}_digits"] = e["digits"]
+        if q != "t_snap_v":
+            verdicts.append(f"{q}: converged to {e['digits']} significant digits (order {e['order']:.2f})"
+                            if e["converging"] else f"{q}: not converging over these levels")
+    attrs["verdict"] = "; ".join(verdicts)
+    return xr.Dataset(data, attrs=attrs)
