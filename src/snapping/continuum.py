@@ -24,7 +24,7 @@ Example
 >>> h = 0.1 * 0.5 ** np.arange(5)
 >>> e = extrapolate(h, 3.0 + 2.0 * h**2 - h**3)
 >>> round(e["limit"], 6), round(e["order"], 2), e["converging"]
-(3.0, 2.05, True)
+(3.0, 1.99, True)
 """
 
 from __future__ import annotations
