@@ -9,7 +9,8 @@ from snapping import SnappingInputError, ideal
 from snapping.reproduce import PLANS, Plan, expected_seconds, reproduce
 
 TINY = Plan(name="tiny", shapes_chi=(0.5, 0.25), shapes_N=40, speed_chi=(0.25,), speed_N=(20, 40),
-            scaling_chi=(0.25, 0.4), scaling_N=40, tol_chi=0.25, tol_N=40, tols=(1e-7, 1e-8))
+            scaling_chi=(0.25, 0.4), scaling_N=40, tol_chi=0.25, tol_N=40, tols=(1e-7, 1e-8),
+            continuum_chi=(0.25,), continuum_levels=3, continuum_first=-3)
 
 
 @pytest.fixture(scope="module")
@@ -29,6 +30,19 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     for name in ("fig1_shapes", "fig1e_pin_force", "fig2_profiles", "fig2d_peak_speed_vs_N", "fig3_maxima",
                  "fig3_local_slopes", "fig4_delta"):
         assert (tmp_path / "figures" / f"{name}.pdf").is_file(), name
+    # the continuum-limit section: the study's extrapolated peaks and the uniform chain against them
+    assert "## The continuum limit" in text and (tmp_path / "figures" / "fig5_continuum.png").stat().st_size > 5000
+    from snapping.simulate import load_run
+    from xarray import open_dataset
+
+    with open_dataset(tmp_path / "continuum" / "chi0.25" / "convergence.nc") as conv:
+        v_lim = conv.attrs["v_peak_limit"]
+    row = next(l for l in text.splitlines() if l.startswith("| 0.25 | 3 ("))
+    assert f"{v_lim:.6g} ±" in row
+    from snapping.reproduce import _path
+
+    u = load_run(_path(tmp_path, 0.25, 40, 1e-8))  # the paper's chain at the plan's largest N, tol
+    assert f"{float(u.attrs['v_peak']) / v_lim - 1:+.2%}" in row
     # every claim row has four cells and a verdict
     rows = [l for l in text.splitlines() if l.startswith("| ") and not l.startswith("| claim") and "seconds" not in l]
     assert len(rows) >= 15

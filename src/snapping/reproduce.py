@@ -47,6 +47,10 @@ class Plan:
     tol_N: int = 5000
     tols: tuple = (1e-7, 1e-8, 1e-9)
     tol: float = 1e-8
+    #: the continuum limit (snapping.continuum.converge): chi, levels, index of the coarsest level
+    continuum_chi: tuple = (0.05, 0.1, 0.15, 0.25, 0.4)
+    continuum_levels: int = 5
+    continuum_first: int = -1
 
     def grids(self) -> list[sweep.Grid]:
         """The sweeps, with the default tolerance first and one grid per other tolerance."""
@@ -81,6 +85,9 @@ PLANS = {
         scaling_chi=(0.1, 0.15, 0.2, 0.25, 0.3, 0.4),
         scaling_N=400,
         tol_N=400,
+        continuum_chi=(0.25,),
+        continuum_levels=4,
+        continuum_first=-1,
     ),
     "full": Plan(name="full"),
 }
@@ -435,6 +442,11 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                  "; ".join(cells), "N = 5000: v changes at the 9th digit, a and sigma at the 6th",
                  tolerance_verdict(digits_coarse, plan.tol_N) if digits_coarse else "needs two tolerances"))
 
+    # ---------------------------------------------------------------- the continuum limit
+    t1 = time.perf_counter()
+    continuum_lines = _continuum(plan, out, figdir, log)
+    timings["continuum limit"] = time.perf_counter() - t1
+
     # ---------------------------------------------------------------- REPORT.md
     timings["total"] = time.perf_counter() - t0
     report = out / "REPORT.md"
@@ -443,6 +455,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
              f"Paper's chain for SI: {PAPER_CHAIN.length:g} m, {PAPER_CHAIN.mass:g} kg.", "",
              "| claim | measured here | paper | verdict |", "|---|---|---|---|"]
     lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
+    lines += [""] + continuum_lines + [""]
     lines += ["", "## Fit report per run (Fig. 3 as numbers)", ""]
     for res in results:
         lines += [f"### chi = {res.chi:g}, N = {res.N}: t*_chi = {res.snap.t_star:.6f} ± {res.snap.t_star_err:.1e}", "", "```"]
@@ -457,10 +470,35 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                       ("fig2d_peak_speed_vs_N", "Fig. 2(d): peak speed against N with the N^(1/2) line"),
                       ("fig3_maxima", "Fig. 3: maxima against t*_chi - t with the folded-string scalings"),
                       ("fig3_local_slopes", "local log-log slopes and fit windows"),
-                      ("fig4_delta", "Fig. 4: the scales delta and the predicted against computed peaks")):
+                      ("fig4_delta", "Fig. 4: the scales delta and the predicted against computed peaks"),
+                      ("fig5_continuum", "the continuum limit: peaks against resolution, graded and uniform chains")):
         lines += [f"**{cap}**", "", f"![{name}](figures/{name}.png)", ""]
     lines += ["## Wall time", "", "| part | seconds |", "|---|---|"]
     lines += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
     report.write_text("\n".join(lines) + "\n")
     log(f"wrote {report} and {len(list(figdir.glob('*.png')))} figures in {figdir} ({timings['total']:.0f} s)")
     return report
+
+
+def _continuum(plan: Plan, out: Path, figdir: Path, log) -> list[str]:
+    """Run the continuum-limit studies of the plan (resumable, in ``out/continuum``), draw
+    their figure for the smallest chi and return the report's section."""
+    from . import continuum, figures
+    from .simulate import load_run
+
+    studies, uniform, finest = {}, {}, {}
+    for chi in plan.continuum_chi:
+        d = out / "continuum" / f"chi{chi:g}"
+        studies[chi] = continuum.converge(chi, levels=plan.continuum_levels, first=plan.continuum_first, output=d)
+        finest[chi] = load_run(studies[chi].paths[-1])
+        Ns = [N for c, N, t in plan.points() if c == chi and t == plan.tol]
+        if Ns:
+            uniform[chi] = _load(out, chi, max(Ns), plan.tol)
+        log(f"continuum limit chi = {chi:g}: v = {studies[chi].dataset.attrs['v_peak_limit']:.6g} "
+            f"± {studies[chi].dataset.attrs['v_peak_error']:.1g}")
+    chi0 = min(plan.continuum_chi)
+    runs_u = sorted((_load(out, c, N, t) for c, N, t in plan.points() if c == chi0 and t == plan.tol),
+                    key=lambda ds: int(ds.attrs["N"]))
+    fig = figures.convergence_figure(studies[chi0].dataset, uniform=runs_u or None)
+    figures.save(fig, figdir / "fig5_continuum")
+    return continuum.report_section(studies, uniform, finest)
