@@ -292,12 +292,14 @@ def _limit(ds, q) -> tuple[float, float]:
     return float(ds.attrs[q + "_limit"]), float(ds.attrs[q + "_error"])
 
 
-def report_section(studies: dict, uniform: dict, finest: dict) -> list[str]:
+def report_section(studies: dict, uniform: dict, finest: dict, fits: dict | None = None) -> list[str]:
     """Markdown lines of the report's "continuum limit" section.
 
     ``studies``: chi -> :class:`Convergence`; ``uniform``: chi -> the paper's run (its
     largest N) to compare with; ``finest``: chi -> the finest level's run Dataset (for
-    delta_kappa_m). Every verdict is computed from the numbers in its row."""
+    delta_kappa_m); ``fits``: chi -> :func:`snapping.scaling.fit_run` of that run (Fig. 3's
+    exponents refitted on the converged chain). Every verdict is computed from the numbers
+    in its row."""
     from . import estimates
 
     lines = ["## The continuum limit", "",
@@ -360,4 +362,16 @@ def report_section(studies: dict, uniform: dict, finest: dict) -> list[str]:
         best = min(worst, key=worst.get)
         lines.append(f"| {chi:g} | {cells[0]} | {cells[1]} | {cells[2]} | {best} (worst factor "
                      f"{math.exp(worst[best]):.2f}) |")
+    if fits:
+        from . import scaling
+
+        lines += ["", "Fig. 3's exponents refitted on the finest level of each study (does the late curvature "
+                  "exponent -1/6 survive refinement?):", "",
+                  "| chi (links) | quantity | exponent (t* = t*_chi) | reference | window t*-t | verdict |",
+                  "|---|---|---|---|---|---|"]
+        for chi in sorted(fits):
+            for row in scaling.report_rows(fits[chi]):
+                if row[0] in ("v_max", "sigma_max", "kappa_max"):
+                    lines.append(f"| {chi:g} ({int(studies[chi].dataset.n_links[-1])}) | {row[0]} | {row[1]} | "
+                                 f"{row[2]} | {row[4]} | {row[7]} |")
     return lines

@@ -501,4 +501,12 @@ def _continuum(plan: Plan, out: Path, figdir: Path, log) -> list[str]:
                     key=lambda ds: int(ds.attrs["N"]))
     fig = figures.convergence_figure(studies[chi0].dataset, uniform=runs_u or None)
     figures.save(fig, figdir / "fig5_continuum")
-    return continuum.report_section(studies, uniform, finest)
+    from . import scaling
+
+    fits = {}
+    for chi, ds in finest.items():
+        try:
+            fits[chi] = scaling.fit_run(ds)
+        except V.SnappingInputError as exc:  # e.g. too coarse a study to fit
+            log(f"continuum limit chi = {chi:g}: no exponent fit on the finest level ({exc})")
+    return continuum.report_section(studies, uniform, finest, fits)

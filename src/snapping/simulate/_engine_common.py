@@ -73,9 +73,9 @@ class CheckpointMixin:
 
     def _restore_ctl(self, get, nctl: int, pad: dict | None = None) -> None:
         """Restore the control vector (``nctl`` entries) from a checkpoint; ``pad`` maps
-        the length of an older layout to the value its missing last entry takes."""
+        the length of an older layout to the values its missing last entries take."""
         ctl = get("checkpoint_ctl", None)
-        if pad and ctl.ndim == 1 and ctl.size in pad and ctl.size == nctl - 1:
+        if pad and ctl.ndim == 1 and ctl.size in pad and ctl.size + len(pad[ctl.size]) == nctl:
             ctl = np.append(ctl, pad[ctl.size])
         if ctl.shape != (nctl,):
             raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {nctl}")

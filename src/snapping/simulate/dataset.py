@@ -357,7 +357,8 @@ def problem_from_dataset(ds: xr.Dataset):
         else:
             pin = PinMotion.from_table(ds["pin_table_t"].values, ds["pin_table_x"].values, ds["pin_table_y"].values)
         st = dict(desc["start"])
-        p = Problem._make(links, *(ds[f"start_{k}"].values for k in ("x", "y", "vx", "vy")), pin,
+        vel = (ds["start_vx"].values, ds["start_vy"].values) if st.get("velocities") else (None, None)
+        p = Problem._make(links, ds["start_x"].values, ds["start_y"].values, *vel, pin,
                           float(desc["gravity"]), st, chi=st.get("chi"), chords=st.get("chords"))
     except (KeyError, TypeError, ValueError, json.JSONDecodeError) as exc:
         if isinstance(exc, V.SnappingInputError):

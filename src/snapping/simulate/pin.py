@@ -25,6 +25,10 @@ from . import general as G
 __all__ = ["PinMotion", "parse_pin_motion", "PIN_KINDS"]
 
 PIN_KINDS = ("fixed", "pull", "flick", "table")
+#: most samples of a motion given as a function
+MAX_SAMPLES = 1_000_000
+#: shortest duration or period of a preset (nondimensional time)
+MIN_DURATION = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +63,8 @@ class PinMotion:
             raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
         d = math.inf if isinstance(duration, (int, float)) and duration == math.inf else \
             V.positive("duration", duration)
+        if d < MIN_DURATION:
+            raise V.SnappingInputError(f"duration={d!r} is out of range: must be >= {MIN_DURATION:g}")
         return cls("pull", (ax, ay), t0, d)
 
     @classmethod
@@ -71,6 +77,8 @@ class PinMotion:
         """
         ax, ay = cls._vector("accel", accel)
         T = V.positive("period", period)
+        if T < MIN_DURATION:
+            raise V.SnappingInputError(f"period={T!r} is out of range: must be >= {MIN_DURATION:g}")
         t0 = V.real("t0", t0)
         if t0 < 0.0:
             raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
@@ -91,8 +99,14 @@ class PinMotion:
             raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y))")
         t_max = V.positive("t_max", t_max)
         n = V.integer("samples", samples, 4)
+        if n > MAX_SAMPLES:
+            raise V.SnappingInputError(f"samples={n} is out of range: at most {MAX_SAMPLES}")
         t = np.linspace(0.0, t_max, n)
-        xy = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
+        try:
+            xy = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
+        except Exception as exc:  # noqa: BLE001 - the user's function failed
+            raise V.SnappingInputError(f"r(t) failed or did not return two numbers (x, y) "
+                                       f"({type(exc).__name__}: {str(exc)[:120]})") from None
         if xy.ndim != 2 or xy.shape[1] != 2:
             raise V.SnappingInputError(f"r(t) must return two numbers (x, y); got shape {xy.shape[1:]}")
         return cls.from_table(t, xy[:, 0], xy[:, 1])
@@ -185,7 +199,7 @@ def parse_pin_motion(spec: str | None) -> PinMotion:
     kind, _, rest = str(spec).partition(":")
     kind = kind.strip()
     try:
-        vals = [float(v) for v in rest.split(",") if v.strip()]
+        vals = [float(v) for v in rest.split(",")] if rest.strip() else []
     except ValueError:
         raise V.SnappingInputError(f"pin_motion={spec!r}: the parameters after {kind + ':'!r} must be numbers") \
             from None

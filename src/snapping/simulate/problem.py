@@ -51,7 +51,10 @@ SHAPE_RTOL = 1e-6
 
 
 def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
-    a = np.asarray(V.float_array(name, a), dtype=float).ravel().copy()
+    a = np.asarray(V.float_array(name, a), dtype=float)
+    if a.ndim > 1:
+        raise V.SnappingInputError(f"{name} must be one-dimensional (one value per link or node); got shape {a.shape}")
+    a = a.ravel().copy()
     if a.size == 0 or (n is not None and a.size != n):
         want = f"{n}" if n is not None else ">= 1"
         raise V.SnappingInputError(f"{name} has {a.size} entries; expected {want}")
@@ -61,6 +64,19 @@ def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
                                    f"and > 0")
     return a
 
+
+def _call(name: str, fn, args) -> np.ndarray:
+    """A user function's values at ``args`` as floats, or SnappingInputError naming it."""
+    try:
+        return np.asarray([np.asarray(fn(float(v)), dtype=float) for v in args], dtype=float)
+    except Exception as exc:  # noqa: BLE001 - any failure of the user's function
+        raise V.SnappingInputError(f"{name}({float(args[0])!r}) ... failed or did not return numbers "
+                                   f"({type(exc).__name__}: {str(exc)[:120]})") from None
+
+
+#: node masses are kept within this factor of the unit (the tension solve's leading minors are
+#: rescaled every general.BLOCK rows: they stay far from overflow for masses in [1/M, M])
+MASS_RANGE = 1e15
 
 #: bytes a chain needs per link, about (its arrays, the start, a run's state and stages)
 BYTES_PER_LINK = 1000
@@ -76,6 +92,12 @@ def _links_count(name: str, N) -> int:
         raise V.SnappingInputError(f"{name}={N} links would need about {N * BYTES_PER_LINK / 2**30:.3g} GiB of "
                                    f"memory, but only {avail / 2**30:.3g} GiB is available")
     return N
+
+
+def _check_links(links) -> None:
+    if not isinstance(links, Links):
+        raise V.SnappingInputError(f"links={links!r} is not a snapping.simulate.Links (use Links.uniform, "
+                                   f"Links.taper, Links.graded, Links.explicit, ...)")
 
 
 # ---------------------------------------------------------------------------------- the chain
@@ -143,7 +165,11 @@ class Links:
         """
         N = _links_count("N", N)
         ratio = V.positive("ratio", ratio)
+        if not 1e-6 <= ratio <= 1e6:
+            raise V.SnappingInputError(f"ratio={ratio!r} is out of range: must lie in [1e-06, 1e+06]")
         power = V.positive("power", power)
+        if not 1e-3 <= power <= 100.0:
+            raise V.SnappingInputError(f"power={power!r} is out of range: must lie in [0.001, 100]")
         h = np.full(N, 1.0 / N) if h is None else _positive_array("h", h, N)
         L = float(h.sum())
         c = 1.0 - ratio ** (1.0 / power)
@@ -183,7 +209,7 @@ class Links:
             for k in range(N):
                 a, b = edges[k], edges[k + 1]
                 s = 0.5 * (a + b) + 0.5 * (b - a) * xg
-                vals = np.asarray([density(float(v)) for v in s], dtype=float)
+                vals = _call("density", density, s)
                 if not np.all(np.isfinite(vals) & (vals > 0.0)):
                     raise V.SnappingInputError(f"density(s) must be finite and > 0 on the chain; got {vals.min()!r} "
                                                f"on link {N - 1 - k} (s in [{a:.6g}, {b:.6g}])")
@@ -293,7 +319,8 @@ class Problem:
 
         if links is None:
             links = Links.uniform(_links_count("N", N))
-        elif N is not None and V.integer("N", N, 1) != links.N:
+        _check_links(links)
+        if N is not None and V.integer("N", N, 1) != links.N:
             raise V.SnappingInputError(f"N={N!r} disagrees with the chain's {links.N} links")
         chi = V.open_interval("chi", chi, 0.0, 1.0)
         if links.is_paper:
@@ -332,6 +359,7 @@ class Problem:
         from . import shapes
 
         links = links if links is not None else Links.uniform(_links_count("N", N))
+        _check_links(links)
         dx = V.positive("dx", dx)
         dy = V.real("dy", dy)
         curve = shapes.catenary_between(dx, dy, links.length)
@@ -347,11 +375,15 @@ class Problem:
         from . import shapes
 
         links = links if links is not None else Links.uniform(_links_count("N", N))
+        _check_links(links)
         try:
             x, y = shapes.place_on_curve(curve, links.h)
         except V.SnappingInputError as exc:
             raise V.SnappingInputError(f"{name}: the chain ({links.N} links, length {links.length:.6g}) cannot be "
                                        f"placed on it: {exc}") from None
+        except Exception as exc:  # noqa: BLE001 - the user's curve function failed
+            raise V.SnappingInputError(f"{name}: the curve function failed or did not return (x, y) "
+                                       f"({type(exc).__name__}: {str(exc)[:120]})") from None
         return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "curve", "name": str(name)})
 
     @classmethod
@@ -366,6 +398,7 @@ class Problem:
         if x.size != y.size or x.size < 2:
             raise V.SnappingInputError(f"shape x and y must have the same length N + 1 >= 2; got {x.size}, {y.size}")
         links = links if links is not None else Links.uniform(x.size - 1)
+        _check_links(links)
         if x.size != links.N + 1:
             raise V.SnappingInputError(f"shape has {x.size} nodes but the chain has {links.N} links "
                                        f"({links.N + 1} nodes)")
@@ -381,14 +414,18 @@ class Problem:
     def _make(cls, links, x, y, vx, vy, pin, gravity, start, chi=None, chords=None) -> "Problem":
         from . import shapes
 
-        if not isinstance(links, Links):
-            raise V.SnappingInputError(f"links={type(links).__name__} is not a Links")
+        _check_links(links)
+        if not (np.all(links.m >= 1.0 / MASS_RANGE) and np.all(links.m <= MASS_RANGE)):
+            j = int(np.argmax((links.m < 1.0 / MASS_RANGE) | (links.m > MASS_RANGE)))
+            raise V.SnappingInputError(f"m[{j}]={float(links.m[j])!r} is out of range: node masses must lie in "
+                                       f"[{1.0 / MASS_RANGE:g}, {MASS_RANGE:g}] (units of the chain's mass)")
         pin = PinMotion() if pin is None else pin
         if not isinstance(pin, PinMotion):
             raise V.SnappingInputError(f"pin={type(pin).__name__} is not a PinMotion")
         g = V.real("gravity", gravity)
         if g < 0.0:
             raise V.SnappingInputError(f"gravity={g!r} is out of range: must be >= 0 (along +e2, y downward)")
+        g = abs(g)  # (-0.0 is 0)
         x = np.array(x, dtype=float)
         y = np.array(y, dtype=float)
         N = links.N
@@ -486,12 +523,17 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
                                        f"dimensions {ds['x'].dims} and {ds['y'].dims}")
         x, y = (np.asarray(ds[k].values, dtype=float) for k in ("x", "y"))
     else:
+        import warnings
+
         try:
-            a = np.genfromtxt(p, delimiter=",", dtype=float, comments="#")
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # (an empty file warns; it is refused below)
+                a = np.genfromtxt(p, delimiter=",", dtype=float, comments="#")
         except (OSError, ValueError) as exc:
-            raise V.SnappingInputError(f"shape={p!r}: cannot read it as CSV ({exc})") from None
+            first = (str(exc).strip().splitlines() or [""])[-1][:160]
+            raise V.SnappingInputError(f"shape={p!r}: cannot read it as CSV of two columns x, y ({first})") from None
         a = np.atleast_2d(a)
-        if a.ndim != 2 or a.shape[1] < 2:
+        if a.ndim != 2 or a.shape[1] < 2 or a.shape[0] == 0:
             raise V.SnappingInputError(f"shape={p!r}: expected two comma-separated columns x, y")
         a = a[~np.all(np.isnan(a[:, :2]), axis=1)]  # a header line reads as NaN
         x, y = a[:, 0], a[:, 1]

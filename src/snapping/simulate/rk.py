@@ -72,11 +72,12 @@ ERR_EXPONENT = -1.0 / 8.0
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
  Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ,
- Q_TBRK) = range(38)
-NQ = 38
+ Q_TBRK, Q_LASTBRK) = range(39)
+NQ = 39
 #: control entries of files written before Q_TBRK (the next breakpoint of the held end's
-#: motion) existed; their runs had none (inf)
+#: motion) and Q_LASTBRK (the last one reached) existed, and the values their runs had
 NQ_BEFORE_BREAKS = 37
+CTL_PAD = {NQ_BEFORE_BREAKS: (np.inf, np.nan)}
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
@@ -284,8 +285,9 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     t = ctl[Q_TEND] if last else t + h
     brk = ctl[Q_TBRK]
     at_brk = not last and brk < np.inf and abs(t - brk) <= 1e-13 * max(1.0, abs(brk))
-    if at_brk:  # (the step was clipped to land on it)
+    if at_brk:  # (the step was clipped to land on it; the next starts with the right limit there)
         t = brk
+        ctl[Q_LASTBRK] = brk
     ctl[Q_T] = t
     ctl[Q_SLOT] = float(ns)
     dt = h * fac
@@ -409,7 +411,14 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
         ycur = Y1[sl]
         for i in range(n):
             y0[i] = ycur[i]
-            KK[ns, 0, i] = KK[sl, NS, i]
+        if ctl[Q_T] == ctl[Q_LASTBRK]:
+            # a step from a breakpoint of the held end's motion (its acceleration jumps):
+            # the first stage is the derivative just after it, not the last step's end (FSAL)
+            G.model_rhs(N, np.nextafter(ctl[Q_T], np.inf), y0, KK[ns, 0], c, s, S, cp, dp, sig, mdl)
+            ctl[Q_NRHS] += 1.0
+        else:
+            for i in range(n):
+                KK[ns, 0, i] = KK[sl, NS, i]
         err = rk_step(N, ctl[Q_T], h, y0, Y1[ns], KK[ns], ytmp, c, s, S, cp, dp, sig, tol, mdl)
         code = after_attempt(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas,
                              mdl)

@@ -98,6 +98,10 @@ class Engine(CheckpointMixin):
         self.HS = np.zeros(2)
         self.DOK = np.zeros(2)
         self.ytmp = np.zeros(n)
+        self.breaks = [b for b in G.breakpoints(self.mdl) if b > t0]
+        # at a breakpoint of the held end's motion (e.g. a pull from t = 0) the run starts
+        # with the right limit of the derivative there
+        t_eval = float(np.nextafter(t0, np.inf)) if t0 in G.breakpoints(self.mdl) else t0
         self.w = AG.Work(N)
         self.rw = AG.Work(N)  # scratch of peak searches and snapshots
         self.Z = np.zeros((K.NROWS, N + 1))
@@ -111,14 +115,14 @@ class Engine(CheckpointMixin):
         # initial state: slot 0 holds it as the end of a zero-length step
         self.Y1[0] = y0
         w = self.w
-        G.model_rhs(N, t0, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
+        G.model_rhs(N, t_eval, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.TS[0] = t0
         self.HS[0] = 0.0
-        G.model_measure(N, t0, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas, self.mdl)
+        G.model_measure(N, t_eval, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas, self.mdl)
         self.meas0 = self.meas.copy()
         self.link_error_initial = float(self.meas[K.M_LINKERR])
         if dt0 is None:
-            dt0 = self._initial_step(y0, self.KK[0, R.NS].copy(), t0)
+            dt0 = self._initial_step(y0, self.KK[0, R.NS].copy(), t_eval)
         self.dt0 = dt0
         K._write_record(self.rec, 0, t0, 0.0, 0.0, self.meas)
         self.rec[0, K.NREC:] = self.meas[K.NMEAS:]
@@ -152,8 +156,8 @@ class Engine(CheckpointMixin):
         c[R.Q_MAXREJ] = max_rejections
         c[R.Q_CONSREJ] = 0.0
         c[R.Q_TBRK] = np.inf
+        c[R.Q_LASTBRK] = np.nan
         self.ctl = c
-        self.breaks = [b for b in G.breakpoints(self.mdl) if b > t0]
         pk = np.full((4, R.NPKR), np.nan)
         for qi, m in enumerate(_PEAK_MEAS):
             pk[qi, R.PK_SBEST] = self.meas[m]
@@ -435,7 +439,7 @@ class Engine(CheckpointMixin):
                           ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
                           ("checkpoint_meas0", self.meas0)):
             arr[...] = get(name, arr.shape)
-        self._restore_ctl(get, R.NQ, pad={R.NQ_BEFORE_BREAKS: np.inf})
+        self._restore_ctl(get, R.NQ, pad=R.CTL_PAD)
         self._restore_scales(ds, get)
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
