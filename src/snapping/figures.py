@@ -150,11 +150,12 @@ def peak_speed_vs_N(table):
     return fig
 
 
-def convergence_figure(ds, path=None, uniform=None):
+def convergence_figure(ds, path=None, uniform=None, other=None):
     """The continuum limit (:func:`snapping.continuum.converge`): (a) each peak over its
     extrapolated limit against the resolution of the fold (``frac``), with the limit's
     error band, and the paper's uniform chains beside them (``uniform``: run Datasets,
-    plotted at their equivalent ``frac = 1/(N a)``); (b) the distance to the limit on
+    plotted at their equivalent ``frac = 1/(N a)``), and ``other`` (a second study, e.g.
+    the paper's lumping) dotted against the same limit; (b) the distance to the limit on
     log axes, whose slope is the order of convergence. Returns the Figure (and saves it
     to ``path`` if given)."""
     plt = _plt()
@@ -177,13 +178,21 @@ def convergence_figure(ds, path=None, uniform=None):
         dist = np.abs(vals - lim) / abs(lim)
         ok = dist > 0
         ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: order {float(ds.attrs[q + '_order']):.2f}")
+        if other is not None:
+            fo, vo = np.asarray(other.frac.values, dtype=float), np.asarray(other[q].values, dtype=float)
+            lump = other.attrs.get("lumping", "other")
+            ax1.plot(fo, vo / lim, "^:", color=c, label=f"{label} graded, {lump} lumping")
+            do = np.abs(vo - lim) / abs(lim)
+            ax2.loglog(fo[do > 0], do[do > 0], "^:", color=c,
+                       label=f"{label}, {lump} lumping: order {float(other.attrs[q + '_order']):.2f}")
     ax1.set_xscale("log")
     ax1.set_xlim(frac.min() / 1.5, max(frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or [])))
                  * 1.5)
     ax1.axhline(1.0, color="k", lw=0.6)
     ax1.set_xlabel("link length on the fold / its radius of curvature")
     ax1.set_ylabel("peak / extrapolated limit")
-    ax1.set_title(f"(a) $\\chi$ = {float(ds.attrs['chi']):g}: peaks against resolution")
+    ax1.set_title(f"(a) $\\chi$ = {float(ds.attrs['chi']):g}: peaks against resolution "
+                  f"({ds.attrs.get('lumping', '')} lumping)")
     ax1.legend(fontsize=7, loc="lower right")
     ax2.set_xlabel("link length on the fold / its radius of curvature")
     ax2.set_ylabel("|peak - limit| / limit")

@@ -496,10 +496,12 @@ def _continuum(plan: Plan, out: Path, figdir: Path, log) -> list[str]:
             uniform[chi] = _load(out, chi, max(Ns), plan.tol)
         log(f"continuum limit chi = {chi:g}: v = {studies[chi].dataset.attrs['v_peak_limit']:.6g} "
             f"± {studies[chi].dataset.attrs['v_peak_error']:.1g}")
-    chi0 = min(plan.continuum_chi)
+    chi0 = 0.25 if 0.25 in plan.continuum_chi else min(plan.continuum_chi)
     runs_u = sorted((_load(out, c, N, t) for c, N, t in plan.points() if c == chi0 and t == plan.tol),
                     key=lambda ds: int(ds.attrs["N"]))
-    fig = figures.convergence_figure(studies[chi0].dataset, uniform=runs_u or None)
+    paper = continuum.converge(chi0, levels=plan.continuum_levels, first=plan.continuum_first, lumping="paper",
+                               output=out / "continuum" / f"chi{chi0:g}_paper_lumping")
+    fig = figures.convergence_figure(studies[chi0].dataset, uniform=runs_u or None, other=paper.dataset)
     figures.save(fig, figdir / "fig5_continuum")
     from . import scaling
 
