@@ -537,7 +537,7 @@ def _add_converge(sub) -> None:
     p.add_argument("--lumping", default="shared", choices=["shared", "paper"], help="node masses (default shared)")
     p.add_argument("--free-end", default=None, choices=["half", "whole"],
                    help="mass of the free-end node: its share of the last link (shared's) or all of it")
-    p.add_argument("--tol", type=float, default=1e-8, help="tolerance of the fast method (default 1e-8)")
+    p.add_argument("--tol", type=float, default=1e-7, help="tolerance of the fast method (default 1e-7)")
     p.add_argument("--workers", type=int, default=1, help="levels run in parallel (default 1)")
     p.add_argument("-o", "--output", default=None, metavar="DIR", help="keep the levels' run files here")
     p.add_argument("--plot", default=None, metavar="PATH", help="draw the convergence figure (.png, .pdf, .svg)")

@@ -165,7 +165,7 @@ def _level_row(ds, h) -> dict:
 
 
 def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0, lumping: str = "shared",
-             free_end: str | None = None, tol: float = 1e-8, output=None, workers: int = 1,
+             free_end: str | None = None, tol: float = 1e-7, output=None, workers: int = 1,
              progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
              h_max0: float = H_MAX0) -> Convergence:
     """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
@@ -185,7 +185,10 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     lumping, free_end
         Mass lumping of the graded chains (:meth:`snapping.simulate.Links.graded`).
     tol : float
-        Tolerance of the fast method (dop853) at every level.
+        Tolerance of the fast method (dop853) at every level. The default 1e-7 is the
+        cheapest measured: on the fold-following chains the peaks at tol 1e-6, 1e-7 and
+        1e-8 agree to 3e-8 (chi = 0.1, 7328 links) and 1e-10 (chi = 0.25, 4835 links),
+        with 38 379 evaluations at 1e-7 against 54 104 at 1e-8 and 45 522 at 1e-6.
     output : path, optional
         Directory for the levels' run files (``level{k}.nc``) and ``convergence.nc``; a
         rerun reuses the levels already there (resumable).
