@@ -148,13 +148,9 @@ def _cmd_estimate(args) -> int:
 
 
 # ------------------------------------------------------------------------ simulate
-def _problem_title(summary, args) -> str:
-    parts = []
-    for k in ("start", "tip_mass", "pin_motion", "gravity"):
-        if k in summary:
-            parts.append(f"{k}={summary[k]}")
+def _problem_title(summary) -> str:
+    parts = [f"{k}={summary[k]}" for k in ("start", "tip_mass", "pin_motion", "gravity") if k in summary]
     return ", ".join(parts) or "general problem"
-
 
 
 def _add_simulate(sub) -> None:
@@ -299,7 +295,7 @@ def _cmd_simulate(args) -> int:
         print_table(
             [(k, f"{v:.10g}" if k in precise and isinstance(v, float) else v, units.get(k)) for k, v in summary.items()],
             title=f"snapping simulate: chi={args.chi:g}, N={args.N}" if problem is None else
-            f"snapping simulate: N={args.N}, {_problem_title(summary, args)}",
+            f"snapping simulate: N={args.N}, {_problem_title(summary)}",
         )
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)

@@ -325,7 +325,7 @@ def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before
     if progress or progress is None:
         from tqdm.auto import tqdm
 
-        desc = f"chain N={N}" if inputs["method"] in ("euler-richardson", "euler-richardson-fixed") else \
+        desc = f"chain N={N}" if M.method(inputs["method"]) is M.euler_richardson else \
             f"chain N={N} ({inputs['method']})"
         bar = tqdm(total=t_end, initial=eng.t, file=sys.stderr, disable=None if progress is None else False,
                    unit="t", desc=desc, dynamic_ncols=True,

@@ -1,8 +1,10 @@
 """Runs with the exactly inextensible, high-order method (``method="dop853"``, alias ``"fast"``).
 
-The chain in link angles (:mod:`snapping.simulate.angles`: every link has length 1/N to
-round-off) integrated with the compiled Dormand-Prince 8(5,3) pair and its dense
-output (:mod:`snapping.simulate.rk`). Same inputs, same run Dataset (the names of
+The chain in link angles (:mod:`snapping.simulate.angles` for the paper's chain,
+:mod:`snapping.simulate.general` for any :class:`snapping.simulate.problem.Problem`:
+every link keeps its length to round-off) integrated with the compiled Dormand-Prince
+8(5,3) pair and its dense output (:mod:`snapping.simulate.rk`), landing on the
+breakpoints of a held end's prescribed motion. Same inputs, same run Dataset (the names of
 :mod:`snapping.schema`), same stop rules and automatic snapshots as the paper's
 Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
 
@@ -448,7 +450,8 @@ class Engine(CheckpointMixin):
 def _failure_message(code: int, eng: Engine, node: int = -1) -> str:
     t = eng.t
     c = eng.ctl
-    where = f" (step {int(c[R.Q_NSTEPS])}, worst node {node}: s={(eng.N - node) / eng.N:.6g})" if node >= 0 else ""
+    snode = eng.mdl[-2]  # arclength of each node from the held end (any links)
+    where = f" (step {int(c[R.Q_NSTEPS])}, worst node {node}: s={snode[node]:.6g})" if node >= 0 else ""
     if code == K.RET_FAIL_NAN:
         return f"non-finite values (NaN/inf) in the state at t={t:.9g}{where}"
     if code == K.RET_FAIL_DT:
