@@ -35,11 +35,10 @@ the state, as a last component ``W``, so that the energy balance ``E(t) - W(t) =
 is a conservation law the stepper can be checked against (``W = 0`` for a fixed pin).
 
 Layout: the state is ``y = [theta (N), theta' (N), W]`` (length 2N + 1); the model is a
-tuple ``mdl = (par, h, invm, wlo, whi, snode, tab)`` of float64 arrays built by
+tuple ``mdl = (par, h, invm, invh, snode, tab)`` of float64 arrays built by
 :meth:`snapping.simulate.problem.Problem.model`: scalar parameters (indices ``P_*``),
-link lengths, inverse node masses, the couplings ``1/(m_j h_j)`` and ``1/(m_{j+1} h_j)``
-of the angular accelerations, the arclength of each node from the held end, and the
-pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
+link lengths, inverse node masses, inverse link lengths, the arclength of each node
+from the held end, and the pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
 :func:`model_rhs` and :func:`model_measure` call the uniform kernels of
 :mod:`snapping.simulate.angles` unchanged (bit for bit the runs of before).
 
@@ -114,7 +113,7 @@ class Work:
 
 def make_model(h, invm, *, g: float = 1.0, pin=(PIN_FIXED, 0.0, 0.0, 0.0, math.inf), table=None,
                uniform: bool = False):
-    """The model tuple ``(par, h, invm, wlo, whi, snode, tab)`` of the compiled kernels (no checks:
+    """The model tuple ``(par, h, invm, invh, snode, tab)`` of the compiled kernels (no checks:
     :class:`snapping.simulate.problem.Problem` validates and calls this).
 
     ``pin = (kind, ax, ay, t0, T)`` for the presets; ``table = (t, cx, cy)`` with ``cx``,
@@ -139,10 +138,7 @@ def make_model(h, invm, *, g: float = 1.0, pin=(PIN_FIXED, 0.0, 0.0, 0.0, math.i
     else:
         tab = np.zeros(1)
     par[P_EOFF] = g * float(np.sum(snode[:N] / invm))
-    wlo = invm / h  # 1/(m_j h_j) and 1/(m_{j+1} h_j): the couplings of theta_j'' to T_{j-1}, T_{j+1}
-    whi = np.zeros(N)
-    whi[:N - 1] = invm[1:] / h[:N - 1]
-    return par, h, invm, wlo, whi, snode, tab
+    return par, h, invm, 1.0 / h, snode, tab
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -213,10 +209,11 @@ def pin_kinematics(t, par, tab):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode, tab):
+def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab):
     """Derivative ``f = [theta', theta'', W']`` of the state ``y`` (length 2N + 1) at time t.
 
-    Leaves cos/sin of the angles in ``c``/``s``, ``S_j`` in ``S`` and the tensions in ``sig``.
+    Leaves cos/sin of the angles in ``c``/``s``, ``S_j/m_{j+1}`` in ``S`` (both terms of
+    ``h_k theta_k''`` are such a product times a tension) and the tensions in ``sig``.
     Pass 0: trigonometry; pass 1: coefficients and the forward elimination with Thomas's
     pivots as ratios of leading minors, ``p_j = b_j p_{j-1} - e_{j-1}^2 p_{j-2}`` and
     ``q_j = r_j p_{j-1} - e_{j-1} q_{j-1}`` (no division in the recurrence, so that the
@@ -254,8 +251,8 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode,
             cn = c[j + 1]
             sn = s[j + 1]
             C = cn * cj + sn * sj
-            S[j] = sn * cj - cn * sj
             imn = invm[j + 1]
+            S[j] = (sn * cj - cn * sj) * imn
             w = y[N + j]
             r = -h[j] * (w * w)
             p = -(im + imn) * pm - (eprev * eprev) * pmm
@@ -286,21 +283,21 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode,
     j = N - 2  # (link j + 1 = N - 1 is the held link)
     Tj = dp[j] - cp[j] * Tn
     sig[j] = Tj
-    f[N + jl] = (ey * c[jl] - ex * s[jl]) / h[jl] - S[j] * Tj * wlo[jl]
+    f[N + jl] = ((ey * c[jl] - ex * s[jl]) - S[j] * Tj) * invh[jl]
     Tnn = Tn  # T_{j+2}
     Tn = Tj
     for j in range(N - 3, -1, -1):
         Tj = dp[j] - cp[j] * Tn
         sig[j] = Tj
         k = j + 1
-        f[N + k] = S[k] * Tnn * whi[k] - S[j] * Tj * wlo[k]
+        f[N + k] = (S[k] * Tnn - S[j] * Tj) * invh[k]
         Tnn = Tn
         Tn = Tj
-    f[N] = S[0] * Tnn * whi[0]
+    f[N] = S[0] * Tnn * invh[0]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, wlo, whi, snode, tab):
+def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, invh, snode, tab):
     """Fill the (7, N + 1) position-form state Z (x, y, vx, vy, ax, ay, tension) from the
     state y with its c, s, sig (as left by :func:`general_rhs`); column N is the held end."""
     g = par[P_G]
@@ -339,7 +336,7 @@ def general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, wlo, whi, snode, tab):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, snode, tab):
+def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab):
     """The per-step diagnostics of :func:`snapping.simulate.kernels.measure` for a general
     chain (``meas`` of length :data:`NMEAS_G`): maxima of speed, acceleration, tension and
     curvature (turning angle over the mean of the two adjacent link lengths) with the
@@ -348,7 +345,7 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, 
     ``sum m_j (|v_j|^2/2 - g y_j) + g sum m_j s_j`` (zero hanging at rest from the origin),
     link errors ``| |t_j| - 1 |``, the length, and the held end's position, velocity and
     work done on the chain (``y[2N]``). ``rinv0`` is unused (links are exact)."""
-    general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, wlo, whi, snode, tab)
+    general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, invh, snode, tab)
     g = par[P_G]
     vmax2 = -1.0
     iv = 0
@@ -433,22 +430,22 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, 
 def model_rhs(N, t, y, f, c, s, S, cp, dp, sig, mdl):
     """The derivative of y at t: the paper's uniform kernel (:func:`angles.angle_rhs`, state
     of length 2N) when ``mdl`` is the uniform model, else :func:`general_rhs`."""
-    par, h, invm, wlo, whi, snode, tab = mdl
+    par, h, invm, invh, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)
     else:
-        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, wlo, whi, snode, tab)
+        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
 def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
     """The per-step diagnostics of y at t (:func:`angles.measure_angles` for the uniform
     model, else :func:`general_measure`)."""
-    par, h, invm, wlo, whi, snode, tab = mdl
+    par, h, invm, invh, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.measure_angles(N, y, c, s, sig, Z, rinv0, meas)
     else:
-        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, wlo, whi, snode, tab)
+        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab)
 
 
 def breakpoints(mdl) -> list[float]:
@@ -477,7 +474,7 @@ def state_dim(mdl) -> int:
 
 def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
     """``[theta', theta'', W']`` by a dense solve of the rows above (numpy, O(N^3); for tests)."""
-    par, h, invm, wlo, whi, snode, tab = mdl
+    par, h, invm, invh, snode, tab = mdl
     N = h.size
     th, om = y[:N], y[N:2 * N]
     _, _, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)
