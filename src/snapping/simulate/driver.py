@@ -70,7 +70,7 @@ def _resolve_problem(chi, N, chords, initial, problem, method):
         raise V.SnappingInputError(f"N={N!r} disagrees with the problem's {problem.N} links")
     if problem.is_paper:
         return problem.chi, problem.N, problem.chords, None, None
-    if method in ("euler-richardson", "euler-richardson-fixed"):
+    if method in M.euler_richardson.NAMES:
         why = []
         if not problem.links.is_paper:
             why.append("links or masses other than N equal links and masses 1/N" if problem.links.tip_mass == 0
