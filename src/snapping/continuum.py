@@ -374,7 +374,8 @@ def report_section(studies: dict, uniform: dict, finest: dict, fits: dict | None
                   "|---|---|---|---|---|---|"]
         for chi in sorted(fits):
             for row in scaling.report_rows(fits[chi]):
-                if row[0] in ("v_max", "sigma_max", "kappa_max"):
-                    lines.append(f"| {chi:g} ({int(studies[chi].dataset.n_links[-1])}) | {row[0]} | {row[1]} | "
-                                 f"{row[2]} | {row[4]} | {row[7]} |")
+                cells = [str(c).strip() for c in row]  # (the report's rows are padded for text)
+                if cells[0] in ("v_max", "sigma_max", "kappa_max"):
+                    lines.append(f"| {chi:g} ({int(studies[chi].dataset.n_links[-1])}) | {cells[0]} | {cells[1]} | "
+                                 f"{cells[2]} | {cells[4]} | {cells[7]} |")
     return lines
