@@ -545,9 +545,13 @@ def _cmd_converge(args) -> int:
     from . import continuum
 
     if args.plot is not None:
+        from ._validate import SnappingInputError
         from .simulate.dataset import check_writable
 
-        check_writable(args.plot)
+        try:
+            check_writable(args.plot)
+        except SnappingInputError as exc:
+            raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
                              free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
                              progress=None if not args.json else False)
