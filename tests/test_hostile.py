@@ -323,6 +323,17 @@ def _cli_cases():
     add("simulate", "--chi", "0.3", "--supports", "0.4,0.1", "--N", "10", "--method", "fast")
     add("simulate", "--chi", "0.3", "--N", "10", "--tip-mass", "0.5")  # euler-richardson refuses it
     add("simulate", "--chi", "0.3", "--N", "10", "--gravity", "0.5", "--method", "euler-richardson")
+    for v in ("nan", "0", "1", "-0.2", "abc"):
+        add("converge", "--chi", v)
+    for flag, vals in (("--levels", ("0", "-1", "x")), ("--ratio", ("0", "1", "2", "nan")), ("--workers", ("0",)),
+                       ("--tol", ("0", "-1")), ("--lumping", ("nodes",)), ("--free-end", ("none",)),
+                       ("--first", ("x",))):
+        for v in vals:
+            add("converge", "--chi", "0.3", flag, v)
+    for k in ("no_parent", "under_file", "proc", "dir"):
+        add("converge", "--chi", "0.3", "--plot", f"{{{k}}}")
+    add("converge", "--chi", "0.3", "-o", "{completed}")  # a file, not a directory
+    add("converge")
     for k in ("completed", "foreign"):
         add(*fast, "--taper", "-1", "-o", f"{{{k}}}")
         add(*fast, "--pin-motion", "flick:1", "-o", f"{{{k}}}")
