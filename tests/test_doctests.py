@@ -5,7 +5,7 @@ import importlib
 
 import pytest
 
-MODULES = ["snapping.schema", "snapping.estimates", "snapping.ideal", "snapping._validate"]
+MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", "snapping.ideal", "snapping._validate"]
 
 
 @pytest.mark.parametrize("name", MODULES)

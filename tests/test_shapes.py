@@ -17,6 +17,7 @@ import pytest
 from scipy.integrate import quad
 
 from snapping import estimates as E
+from snapping import shape_estimates as SE
 from snapping._validate import SnappingInputError
 from snapping.simulate.chain import curvature_profile, initial_state
 from snapping.simulate.shapes import catenary_between, check_curve, place_on_curve
@@ -389,13 +390,13 @@ def test_available_energy_shape_closed_forms():
     for N in (1, 2, 7, 64):
         s = (N - np.arange(N + 1)) / N
         m = lumped(np.full(N, 1.0 / N), 1.0)
-        assert abs(E.available_energy_shape(s, np.zeros(N + 1), m) - 0.5) < 1e-15
-        assert abs(E.available_energy_shape(np.zeros(N + 1), s, m)) < 1e-15
+        assert abs(SE.available_energy_shape(s, np.zeros(N + 1), m) - 0.5) < 1e-15
+        assert abs(SE.available_energy_shape(np.zeros(N + 1), s, m)) < 1e-15
     x, y, _ = level_catenary_nodes(0.3, 20)
     m = lumped(np.full(20, 1 / 20), 1.0)
-    P = E.available_energy_shape(x, y, m)
-    assert abs(E.available_energy_shape(x + 0.3, y - 0.7, m) - P) < 1e-15
-    assert abs(E.available_energy_shape(x, y, m, g=9.81) - 9.81 * P) < 1e-14
+    P = SE.available_energy_shape(x, y, m)
+    assert abs(SE.available_energy_shape(x + 0.3, y - 0.7, m) - P) < 1e-15
+    assert abs(SE.available_energy_shape(x, y, m, g=9.81) - 9.81 * P) < 1e-14
 
 
 @pytest.mark.parametrize("chi", [0.25, 0.5])
@@ -416,7 +417,7 @@ def test_available_energy_uniform_catenary_second_order(chi):
     errs = []
     for N in Ns:
         x, y, _ = level_catenary_nodes(chi, N)
-        errs.append(E.available_energy_shape(x, y, lumped(np.full(N, 1.0 / N), 1.0)) - P)
+        errs.append(SE.available_energy_shape(x, y, lumped(np.full(N, 1.0 / N), 1.0)) - P)
     np.testing.assert_allclose(orders(errs), 2.0, atol=0.01)
     assert abs(errs[-1] * Ns[-1] ** 2 / C - 1) < 1e-3
 
@@ -429,7 +430,7 @@ def test_available_energy_exact_chords_second_order():
     errs = []
     for N in (32, 64, 128, 256):
         x, y = place_on_curve(cat, np.full(N, 1.0 / N))
-        errs.append(E.available_energy_shape(x, y, lumped(np.full(N, 1.0 / N), 1.0)) - P)
+        errs.append(SE.available_energy_shape(x, y, lumped(np.full(N, 1.0 / N), 1.0)) - P)
     np.testing.assert_allclose(orders(errs), 2.0, atol=0.05)
 
 
@@ -447,7 +448,7 @@ def test_available_energy_tapered_chain_second_order():
         h = np.full(N, 1.0 / N)
         m = lumped(h, lam(0.5 * (s[:-1] + s[1:])))
         assert abs(m.sum() - m[-1] - (1.0 - lam(0.5 / N) / (2 * N))) < 1e-14   # all but the pin's share
-        errs.append(E.available_energy_shape(x, y, m) - exact)
+        errs.append(SE.available_energy_shape(x, y, m) - exact)
     np.testing.assert_allclose(orders(errs), 2.0, atol=0.05)
 
 
@@ -461,7 +462,7 @@ def test_kappa_m0_shape_catenary_closed_form_and_order(chi):
     errs = []
     for N in Ns:
         x, y, _ = level_catenary_nodes(chi, N)
-        k = E.kappa_m0_shape(x, y)
+        k = SE.kappa_m0_shape(x, y)
         h = 1.0 / N
         Dx, Dy = a * math.asinh(h / a), h * h / (math.sqrt(a * a + h * h) + a)
         assert abs(k - 2 * math.atan(Dy / Dx) / math.hypot(Dx, Dy)) < 1e-15 * N * N   # rounding ~ eps/h^2
@@ -478,26 +479,26 @@ def test_kappa_m0_shape_circle_unequal_links():
     x, y = place_on_curve(circle(R), h)
     q = np.arcsin(h / (2 * R))
     expected = np.max((q[:-1] + q[1:]) / (0.5 * (h[:-1] + h[1:])))
-    assert abs(E.kappa_m0_shape(x, y) - expected) < 1e-12
+    assert abs(SE.kappa_m0_shape(x, y) - expected) < 1e-12
 
 
 def test_kappa_m0_shape_equal_links_matches_paper_curvature():
     """For equal links 1/N it is the maximum of the paper's |N (theta_{k+1} - theta_k)|."""
     st = initial_state(0.3, 60, chords="exact")
-    assert abs(E.kappa_m0_shape(st.x, st.y) - np.nanmax(np.abs(curvature_profile(st.x, st.y)))) < 1e-9
-    assert E.kappa_m0_shape([1.0, 0.0], [0.0, 0.0]) == 0.0                   # one link, no joint
-    assert E.kappa_m0_shape([0.0, 0.0, 0.0], [2.0, 1.0, 0.0]) == 0.0         # straight
+    assert abs(SE.kappa_m0_shape(st.x, st.y) - np.nanmax(np.abs(curvature_profile(st.x, st.y)))) < 1e-9
+    assert SE.kappa_m0_shape([1.0, 0.0], [0.0, 0.0]) == 0.0                   # one link, no joint
+    assert SE.kappa_m0_shape([0.0, 0.0, 0.0], [2.0, 1.0, 0.0]) == 0.0         # straight
 
 
 def test_shape_estimates_errors():
     x, y = [1.0, 0.5, 0.0], [0.0, 0.0, 0.0]
     with pytest.raises(SnappingInputError, match="^m must hold one mass per node"):
-        E.available_energy_shape(x, y, [0.5, 0.5])
+        SE.available_energy_shape(x, y, [0.5, 0.5])
     with pytest.raises(SnappingInputError, match=r"^m\[1\]=-0\.5"):
-        E.available_energy_shape(x, y, [0.25, -0.5, 0.25])
+        SE.available_energy_shape(x, y, [0.25, -0.5, 0.25])
     with pytest.raises(SnappingInputError, match=r"^g=0\.0"):
-        E.available_energy_shape(x, y, [0.25, 0.5, 0.25], g=0.0)
-    for f in (lambda a, b: E.available_energy_shape(a, b, [1.0, 1.0]), E.kappa_m0_shape):
+        SE.available_energy_shape(x, y, [0.25, 0.5, 0.25], g=0.0)
+    for f in (lambda a, b: SE.available_energy_shape(a, b, [1.0, 1.0]), SE.kappa_m0_shape):
         with pytest.raises(SnappingInputError, match="^x and y"):
             f([0.0, 1.0], [0.0])
         with pytest.raises(SnappingInputError, match="^nodes 0 and 1 coincide"):

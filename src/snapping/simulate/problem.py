@@ -479,7 +479,7 @@ class Problem:
 
     def estimate(self) -> dict:
         """The paper's estimates from this start shape and these masses
-        (:func:`snapping.estimates.shape_estimate`): P, kappa_m(0), the delta scales and
+        (:func:`snapping.shape_estimates.shape_estimate`): P, kappa_m(0), the delta scales and
         the whirling-rod peaks.
 
         >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared")).estimate()
@@ -488,9 +488,9 @@ class Problem:
         >>> round(Problem.catenary(0.25, 2000).estimate()["P"], 5)   # the paper's lumping: O(1/N) off
         0.2543
         """
-        from .. import estimates
+        from ..shape_estimates import shape_estimate
 
-        return estimates.shape_estimate(self.x, self.y, np.concatenate([self.links.m, [0.0]]), self.gravity)
+        return shape_estimate(self.x, self.y, np.concatenate([self.links.m, [0.0]]), self.gravity)
 
     def describe(self) -> dict:
         """JSON-friendly description (recorded in the run file)."""
