@@ -75,7 +75,7 @@ def test_dop853_resume_after_interrupt_at_every_boundary_is_bit_for_bit(tmp_path
     for k in sorted({1, 2, *range(3, len(n_ret), max(1, len(n_ret) // 8)), len(n_ret) - 1}):
         monkeypatch.setattr(stepper, "_chunk_hook", _StopAt(k))
         with pytest.raises(RunInterrupted) as info:
-            run(**CASE, output=path, checkpoint_every=None)
+            run(**CASE, output=path, checkpoint_every=None, overwrite=True)
         assert info.value.exit_status == 130 and info.value.path == str(path)
         monkeypatch.setattr(stepper, "_chunk_hook", None)
         ck = load_run(path)

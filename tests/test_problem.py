@@ -87,7 +87,7 @@ def test_paper_problem_is_the_paper_run_bit_for_bit():
             va, vb = a[k].values, b[k].values
             assert np.array_equal(va, vb, equal_nan=va.dtype.kind == "f"), k
         for k, v in a.attrs.items():
-            if k != "wall_time":
+            if k not in ("wall_time", "integrity_sha256"):  # the digest covers the wall time
                 assert np.array_equal(np.asarray(v), np.asarray(b.attrs[k])), k
     c = run(Problem.catenary(0.4, 30, chords="exact"), method="fast").dataset
     d = run(0.4, 30, method="fast", chords="exact").dataset
@@ -234,7 +234,7 @@ def test_general_run_file_reproduces_and_resumes(tmp_path):
     assert np.array_equal(ds.link_length.values, p.links.h) and np.array_equal(ds.node_mass.values[:-1], p.links.m)
     again = rerun(ds).dataset
     for k, v in r.dataset.attrs.items():  # (n_rhs: a rerun is given dt0, so it skips the first-step probe)
-        if k not in ("wall_time", "n_rhs"):
+        if k not in ("wall_time", "n_rhs", "integrity_sha256"):
             assert np.array_equal(np.asarray(again.attrs[k]), np.asarray(v), equal_nan=isinstance(v, float)), k
     assert np.array_equal(again.v_max.values, r.dataset.v_max.values)
     assert np.array_equal(again.pin_work.values, r.dataset.pin_work.values)
@@ -359,13 +359,13 @@ def test_steps_land_on_the_held_ends_breakpoints():
     assert float(ds.pin_vy[-1]) == pytest.approx(-0.6, rel=1e-14)
 
 
-def test_checkpoint_written_before_breakpoints_existed_still_resumes(tmp_path):
-    """Checkpoints of the layout before the breakpoint entry (37 control entries; their runs
-    had no breakpoints) resume to the same run."""
+def test_checkpoint_of_an_older_layout_is_refused_clearly(tmp_path):
+    """Checkpoints of layout version 1 (37 control entries, no integrity digest) are
+    refused with a message that names the version, not resumed wrongly or half-read."""
     import xarray as xr
 
+    from snapping import schema
     from snapping.simulate import driver
-    import snapping.simulate.methods.dop853 as HO
     from snapping.simulate import rk as R
 
     calls = {"n": 0}
@@ -374,21 +374,24 @@ def test_checkpoint_written_before_breakpoints_existed_still_resumes(tmp_path):
         calls["n"] += 1
         return 2 if calls["n"] == 3 else 0
 
-    out = tmp_path / "old.nc"
-    old = HO.NODE_EVALS_PER_CALL
-    driver._chunk_hook, HO.NODE_EVALS_PER_CALL = hook, 2000
+    out = tmp_path / "new.nc"
+    driver._chunk_hook = hook
     try:
         with pytest.raises(KeyboardInterrupt):
             run(0.4, 40, output=str(out), **FAST)
     finally:
-        driver._chunk_hook, HO.NODE_EVALS_PER_CALL = None, old
+        driver._chunk_hook = None
     with xr.open_dataset(out) as f:
         ds = f.load()
     ctl = ds["checkpoint_ctl"].values
-    assert ctl.size == R.NQ and ctl[R.Q_TBRK] == np.inf
-    ds = ds.drop_vars("checkpoint_ctl").assign(checkpoint_ctl=(("checkpoint_ctl",), ctl[:R.NQ_BEFORE_BREAKS]))
-    ds.to_netcdf(tmp_path / "older.nc")
-    done = resume(str(tmp_path / "older.nc")).dataset
+    assert ctl.size == R.NQ and ctl[R.Q_TBRK] == np.inf and ds.attrs["checkpoint_version"] == 2
+    old = ds.drop_vars("checkpoint_ctl").assign(checkpoint_ctl=(("checkpoint_ctl",), ctl[:37]))
+    old.attrs["checkpoint_version"] = 1
+    del old.attrs[schema.DIGEST_ATTR]
+    old.to_netcdf(tmp_path / "older.nc")
+    with pytest.raises(SnappingInputError, match="checkpoint version 1 .* start the run again"):
+        resume(str(tmp_path / "older.nc"))
+    done = resume(str(out)).dataset  # the current layout resumes to the uninterrupted run
     ref = run(0.4, 40, **FAST).dataset
     assert np.array_equal(done.v_max.values, ref.v_max.values) and done.attrs["v_peak"] == ref.attrs["v_peak"]
 

@@ -16,6 +16,7 @@ import math
 import sys
 
 EXIT_BAD_INPUT = 2
+EXIT_FAILED = 1  # a numerical failure or an I/O fault (e.g. a full disk)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -191,7 +192,14 @@ def _add_simulate(sub) -> None:
             "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
-            "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit."
+            "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
+            "\n"
+            "Output files: -o must be a new path or, with --overwrite, an existing regular file (a\n"
+            "device, FIFO or directory is never replaced; a symbolic link is written through, to its\n"
+            "target); its directory and free space are checked before the run, and the file is locked\n"
+            "while the run writes it (a second writer is refused, naming the PID). --resume checks\n"
+            "the checkpoint's integrity digest, and refuses options that contradict the stored run.\n"
+            "Exit status: 0 done, 1 numerical failure or I/O fault (e.g. a full disk), 2 bad input."
         ),
     )
     p.add_argument("--chi", type=float, default=None, help="end separation / length, in (0, 1)")
@@ -223,7 +231,8 @@ def _add_simulate(sub) -> None:
     p.add_argument("--pin-motion", default=None, metavar="SPEC",
                    help="held end: fixed (default), pull:AX,AY[,DURATION[,T0]] or flick:AX,AY,PERIOD[,T0]")
     p.add_argument("--gravity", type=float, default=1.0, help="gravity along +y in units of g (default 1; 0: none)")
-    p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file")
+    p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file (a new path, or --overwrite)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
                    help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
     p.add_argument("--checkpoint-every", type=float, default=300.0, metavar="SECONDS",
@@ -263,8 +272,15 @@ def _cmd_simulate(args) -> int:
                                pin_motion=args.pin_motion, gravity=args.gravity)
     try:
         if args.resume is not None:
-            result = simulate.resume(args.resume, output=args.output, progress=progress,
-                                     checkpoint_every=args.checkpoint_every)
+            expect = _resume_expect(args, times)
+            try:
+                result = simulate.resume(args.resume, output=args.output, progress=progress,
+                                         checkpoint_every=args.checkpoint_every, overwrite=args.overwrite,
+                                         expect=expect)
+            except simulate.driver.ResumeMismatch as exc:
+                opt = "--" + exc.key.replace("_", "-")
+                raise simulate.driver.ResumeMismatch(exc.key, _given_text(args, exc.key), exc.stored, exc.path,
+                                                     option=opt) from None
             args.output = result.path
             args.chi, args.N = float(result.dataset.attrs["chi"]), int(result.dataset.attrs["N"])
             if str(result.dataset.attrs.get("initial")) == "problem":
@@ -275,7 +291,7 @@ def _cmd_simulate(args) -> int:
                 stop_fraction=args.stop_fraction, snapshot_times=times, record_thin=args.record_thin,
                 chords=args.chords if problem is None else "arclength", output=args.output, progress=progress, max_link_error=args.max_link_error,
                 max_energy_drift=args.max_energy_drift, dt_min=args.dt_min, max_rejections=args.max_rejections,
-                checkpoint_every=args.checkpoint_every,
+                checkpoint_every=args.checkpoint_every, overwrite=args.overwrite,
             )
         summary, failed = result.summary(), None
     except simulate.RunInterrupted as exc:
@@ -304,6 +320,34 @@ def _cmd_simulate(args) -> int:
 
 
 # ----------------------------------------------------------------------------- fit
+#: simulate options that define the run (with --resume: checked against the checkpoint)
+_RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "snapshot_times", "record_thin",
+                "chords", "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
+#: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
+_PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity")
+
+
+def _given_text(args, key: str) -> str:
+    return str(getattr(args, key))
+
+
+def _resume_expect(args, times) -> dict:
+    """The run inputs given on the command line with --resume (explicitly typed), to be
+    checked against the checkpoint; a problem option is refused outright."""
+    from ._validate import SnappingInputError
+
+    given = getattr(args, "_explicit", set())
+    for key in _PROBLEM_OPTIONS:
+        if key in given:
+            opt = "--" + key.replace("_", "-")
+            raise SnappingInputError(f"{opt} {getattr(args, key)} cannot be given with --resume: the checkpoint "
+                                     f"{args.resume!r} holds its problem (a resumed run continues the stored run)")
+    expect = {k: getattr(args, k) for k in _RUN_OPTIONS if k in given}
+    if "snapshot_times" in expect:
+        expect["snapshot_times"] = times
+    return expect
+
+
 def _add_fit(sub) -> None:
     p = sub.add_parser(
         "fit",
@@ -329,6 +373,7 @@ def _add_fit(sub) -> None:
     p.add_argument("files", nargs="+", metavar="RUN.nc", help="run files or a sweep file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="PATH", default=None, help="write the figures (.png, .pdf or .svg)")
+    p.add_argument("--overwrite", action="store_true", help="replace existing --plot files (default: refuse them)")
     p.add_argument("--tol", type=float, default=1e-3, help="flatness tolerance of the local slope (default 1e-3)")
     p.add_argument("--min-width", type=float, default=1.0, help="smallest fit window in decades (default 1)")
     p.add_argument(
@@ -358,7 +403,9 @@ def _cmd_fit(args) -> int:
 
         if Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
             raise SnappingInputError(f"--plot={args.plot!r}: the figure suffix must be .png, .pdf or .svg")
-        check_writable(args.plot)
+        out = Path(args.plot)
+        for path in (out, out.with_name(f"{out.stem}_slopes{out.suffix}"), out.with_name(f"{out.stem}_delta{out.suffix}")):
+            check_writable(path, name="--plot", overwrite=args.overwrite)
     runs, names = [], []
     for f in args.files:
         ds = scaling.load_run(f)
@@ -537,6 +584,7 @@ def _add_converge(sub) -> None:
     p.add_argument("--workers", type=int, default=1, help="levels run in parallel (default 1)")
     p.add_argument("-o", "--output", default=None, metavar="DIR", help="keep the levels' run files here")
     p.add_argument("--plot", default=None, metavar="PATH", help="draw the convergence figure (.png, .pdf, .svg)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file (default: refuse it)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.set_defaults(func=_cmd_converge)
 
@@ -549,7 +597,7 @@ def _cmd_converge(args) -> int:
         from .simulate.dataset import check_writable
 
         try:
-            check_writable(args.plot)
+            check_writable(args.plot, name="plot", overwrite=args.overwrite)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
@@ -632,6 +680,7 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return EXIT_BAD_INPUT
+    args._explicit = _explicit_dests(argv)
     try:
         return int(args.func(args) or 0)
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
@@ -640,9 +689,26 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"snapping {args.command}: interrupted", file=sys.stderr)
         return 130
-    except OSError as exc:  # an unwritable or vanished path found while working: one line, exit 2
-        print(f"snapping {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except OSError as exc:  # an I/O fault while working (a full disk, a vanished path): one line, exit 1
+        what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
+        print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+def _explicit_dests(argv) -> set[str]:
+    """The options typed on the command line ``argv`` (not defaulted), as argparse dests."""
+    parser = build_parser()
+
+    def suppress(p):
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for sp in action.choices.values():
+                    suppress(sp)
+            elif action.dest != "help":
+                action.default = argparse.SUPPRESS
+
+    suppress(parser)
+    return set(vars(parser.parse_args(argv)))
 
 
 if __name__ == "__main__":  # pragma: no cover

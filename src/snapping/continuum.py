@@ -152,7 +152,7 @@ def _run_level(args):
                 return _level_row(ds, h), path  # resumed: this level is done
         except V.SnappingInputError:
             pass
-    ds = run(problem, method="fast", tol=tol, progress=False, output=path).dataset
+    ds = run(problem, method="fast", tol=tol, progress=False, output=path, overwrite=True).dataset  # own files
     return _level_row(ds, h), path
 
 
@@ -250,7 +250,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     if output is not None:
         from .simulate import save
 
-        save(ds, os.path.join(out, "convergence.nc"))
+        save(ds, os.path.join(out, "convergence.nc"), overwrite=True)  # the directory's own summary
     return Convergence(ds, [p for p in paths if p is not None])
 
 

@@ -30,11 +30,15 @@ def save(fig, path_stem) -> list[Path]:
     stem = Path(path_stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
     out = []
-    for ext in (".png", ".pdf"):
-        p = stem.with_suffix(ext)
-        fig.savefig(p, dpi=150, bbox_inches="tight")
-        out.append(p)
-    _plt().close(fig)
+    from ._files import save_figure
+
+    try:
+        for ext in (".png", ".pdf"):
+            p = stem.with_suffix(ext)
+            save_figure(fig, p, dpi=150, bbox_inches="tight")
+            out.append(p)
+    finally:
+        _plt().close(fig)
     return out
 
 
@@ -199,5 +203,7 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
     ax2.set_title("(b) distance to the limit")
     ax2.legend(fontsize=8)
     if path is not None:
-        fig.savefig(path, dpi=130)
+        from ._files import save_figure
+
+        save_figure(fig, path, dpi=130)
     return fig

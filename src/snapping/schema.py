@@ -256,3 +256,9 @@ CHECKPOINT_ATTRS: dict[str, str] = {
     "checkpoint_link_error_initial": "relative error of the initial chords (exact, for the failure bound)",
     "checkpoint_time": "ISO time at which the checkpoint was written",
 }
+
+#: Global attribute of every run file the simulator writes: the SHA-256 digest of its
+#: content (every attribute but itself, every variable's name, dimensions, dtype and
+#: values; :func:`snapping.simulate.dataset.content_digest`). A checkpoint whose digest
+#: does not match (an edited ``chi``, a damaged state) is not resumed.
+DIGEST_ATTR = "integrity_sha256"

@@ -41,29 +41,19 @@ if TYPE_CHECKING:  # annotations only
 __all__ = ["Grid", "run_sweep", "combine", "atomic_to_netcdf", "is_complete_run"]
 
 
-def atomic_to_netcdf(ds, path) -> Path:
-    """Write ``ds`` to ``path`` as netCDF4 atomically: a temporary file in the same
-    directory, flushed and renamed over ``path``. A reader never sees a half-written file.
+def atomic_to_netcdf(ds, path, *, overwrite: bool = True) -> Path:
+    """Write ``ds`` to ``path`` as netCDF4 atomically (:func:`snapping.simulate.save`: a
+    temporary file in the same directory, flushed and renamed over ``path``, under the
+    file's lock), creating the directory. A reader never sees a half-written file.
     """
-    from .simulate.dataset import check_writable
+    from .simulate.dataset import save
 
     path = Path(V.file_path("path", path))
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise V.SnappingInputError(f"path={str(path)!r}: directory cannot be created ({exc.strerror or exc})") from None
-    check_writable(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        from .simulate.dataset import save
-
-        save(ds, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return Path(save(ds, path, overwrite=overwrite))
 
 
 def is_complete_run(path) -> bool:
@@ -152,7 +142,7 @@ def _run_one(params: dict, path: str) -> str:
     if simulate.is_resumable(path, **params):
         simulate.resume(path, **{k: params[k] for k in ("checkpoint_every",) if k in params})
     else:
-        simulate.run(**params, output=path)
+        simulate.run(**params, output=path, overwrite=True)  # the sweep owns its run files
     return path
 
 
@@ -211,7 +201,8 @@ def _run_task(task: list) -> list[str]:
     opts = {k: v for k, v in params[0].items() if k not in ("chi", "N")}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # failed members are reported below
-        dss = run_ensemble([p["chi"] for p in params], params[0]["N"], outputs=[path for _, path in task], **opts)
+        dss = run_ensemble([p["chi"] for p in params], params[0]["N"], outputs=[path for _, path in task],
+                           overwrite=True, **opts)
     bad = [f"chi={p['chi']:g}: {ds.attrs['stop_reason']}" for p, ds in zip(params, dss)
            if ds.attrs["status"] != "completed"]
     if bad:

@@ -34,9 +34,13 @@ def _save(fig, path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise V.SnappingInputError(f"path={str(path)!r}: the figure suffix must be .png, .pdf or .svg")
+    from .._files import save_figure
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150, bbox_inches="tight")
-    _plt().close(fig)
+    try:
+        save_figure(fig, path, dpi=150, bbox_inches="tight")
+    finally:
+        _plt().close(fig)
     return path
 
 

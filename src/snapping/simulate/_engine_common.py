@@ -71,12 +71,9 @@ class CheckpointMixin:
                                            {"long_name": "kinds of the snapshots so far"})
         return out
 
-    def _restore_ctl(self, get, nctl: int, pad: dict | None = None) -> None:
-        """Restore the control vector (``nctl`` entries) from a checkpoint; ``pad`` maps
-        the length of an older layout to the values its missing last entries take."""
+    def _restore_ctl(self, get, nctl: int) -> None:
+        """Restore the control vector (``nctl`` entries) from a checkpoint."""
         ctl = get("checkpoint_ctl", None)
-        if pad and ctl.ndim == 1 and ctl.size in pad and ctl.size + len(pad[ctl.size]) == nctl:
-            ctl = np.append(ctl, pad[ctl.size])
         if ctl.shape != (nctl,):
             raise V.SnappingInputError(f"checkpoint_ctl has {ctl.size} entries, this version needs {nctl}")
         self.ctl[...] = ctl

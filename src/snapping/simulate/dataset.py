@@ -42,9 +42,9 @@ class Run:
         """The detected results and inputs as a plain dict (also the CLI's --json)."""
         return summary(self.dataset)
 
-    def save(self, path) -> str:
-        """Write the dataset as netCDF4."""
-        self.path = save(self.dataset, path)
+    def save(self, path, *, overwrite: bool = False) -> str:
+        """Write the dataset as netCDF4 (atomically; an existing file only with ``overwrite=True``)."""
+        self.path = save(self.dataset, path, overwrite=overwrite)
         return self.path
 
 
@@ -166,62 +166,92 @@ def _add_problem(problem, data_vars: dict, coords: dict, attrs: dict) -> None:
     attrs["start"] = str(problem.start.get("kind", ""))
 
 
-def check_writable(path) -> str:
-    """Raise :class:`SnappingInputError` unless ``path`` can be written (checked before a run)."""
-    import tempfile
+def check_writable(path, *, overwrite: bool = False, name: str = "output", need_bytes: float = 0.0) -> str:
+    """The path to write for output ``path`` (a symbolic link's target), checked before a run; raises
+    :class:`SnappingInputError` when it cannot be written, is not a regular file or a new path,
+    already exists (unless ``overwrite``), or its filesystem lacks ``need_bytes`` of space
+    (the rules: :mod:`snapping._files`)."""
+    from .. import _files
 
-    p = V.file_path("output", path)
-    if os.path.isdir(p):
-        raise V.SnappingInputError(f"output={p!r} is a directory, not a writable file path")
-    parent = os.path.dirname(os.path.abspath(p))
-    if not os.path.isdir(parent):
-        raise V.SnappingInputError(f"output={p!r}: directory {parent!r} does not exist")
-    if not os.access(parent, os.W_OK) or (os.path.exists(p) and not os.access(p, os.W_OK)):
-        raise V.SnappingInputError(f"output={p!r} is not writable")
-    try:  # the file is written next to itself and renamed: the directory must take a new file
-        fd, probe = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".probe", dir=parent)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise V.SnappingInputError(f"output={p!r} is not writable ({exc.strerror or exc})") from None
-    return p
+    return _files.check_output(path, name=name, overwrite=overwrite, need_bytes=need_bytes)
 
 
-def save(ds: xr.Dataset, path) -> str:
-    """Write a run Dataset as netCDF4, atomically; returns the path.
+def save(ds: xr.Dataset, path, *, overwrite: bool = False) -> str:
+    """Write a run Dataset as netCDF4, atomically; returns the path written.
 
     The file is written to a temporary file in the same directory, flushed to
-    disk and renamed over ``path`` (``os.replace``): a reader, or a run killed
-    while saving, never sees a half-written file, and an existing file is only
-    replaced by a complete one.
+    disk and renamed over ``path`` (``os.replace``), under the output's exclusive
+    lock: a reader, or a run killed while saving, never sees a half-written file.
+    An existing file is refused unless ``overwrite=True``, and then only replaced by
+    a complete one; a symbolic link is written through; a full disk raises
+    :class:`snapping._files.OutputWriteError` saying so (the rules: :mod:`snapping._files`).
     """
-    import tempfile
+    from .. import _files
 
     if not isinstance(ds, xr.Dataset):
         raise V.SnappingInputError(f"ds={type(ds).__name__} is not an xarray.Dataset")
-    p = check_writable(path)
     encoding = {name: {"zlib": True, "complevel": 1} for name in ds.data_vars if ds[name].dtype.kind not in "OUS"}
-    d = os.path.dirname(os.path.abspath(p))
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
-    os.close(fd)
-    try:
-        ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4", encoding=encoding)
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        if os.path.exists(p):  # keep the permissions of the file it replaces
-            os.chmod(tmp, os.stat(p).st_mode & 0o7777)
+    return _files.write_atomic(path, lambda tmp: ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4",
+                                                              encoding=encoding),
+                               overwrite=overwrite, dataset=ds)
+
+
+def _canonical(value) -> bytes:
+    """Bytes of an attribute value that survive a netCDF round trip unchanged (numbers as
+    float64 lists, strings as text)."""
+    if isinstance(value, (str, bytes)):
+        return b"s" + (value.encode() if isinstance(value, str) else value)
+    a = np.asarray(value)
+    if a.dtype.kind in "biuf":
+        return b"n" + np.ascontiguousarray(a.astype(np.float64).ravel()).tobytes()
+    return b"r" + repr(a.ravel().tolist()).encode()
+
+
+def content_digest(ds: xr.Dataset) -> str:
+    """SHA-256 (hex) of a run Dataset's content: every attribute except
+    ``schema.DIGEST_ATTR``, and every variable's name, dimensions, dtype and values. The same
+    before writing and after reading back the netCDF file; any edit changes it.
+
+    >>> import numpy as np, xarray as xr
+    >>> ds = xr.Dataset({"a": ("x", np.arange(3.0))}, attrs={"chi": 0.25})
+    >>> d = content_digest(ds)
+    >>> ds.attrs["chi"] = 0.5
+    >>> content_digest(ds) == d
+    False
+    """
+    import hashlib
+
+    h = hashlib.sha256()
+    for k in sorted(ds.attrs):
+        if k != schema.DIGEST_ATTR:
+            h.update(b"\0attr\0" + k.encode() + b"\0" + _canonical(ds.attrs[k]))
+    for name in sorted(map(str, ds.variables)):
+        var = ds.variables[name]
+        a = np.asarray(var.values)
+        h.update(b"\0var\0" + name.encode() + b"\0" + repr(tuple(var.dims)).encode() + repr(a.shape).encode())
+        if a.dtype.kind in "OUS":
+            h.update(repr(a.ravel().tolist()).encode())
         else:
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, p)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-    return p
+            h.update(a.dtype.str.encode() + np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def seal(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` with its integrity digest (``schema.DIGEST_ATTR``) set, in place; returned."""
+    ds.attrs[schema.DIGEST_ATTR] = content_digest(ds)
+    return ds
+
+
+def verify_digest(ds: xr.Dataset, what: str) -> None:
+    """Raise :class:`SnappingInputError` (naming ``what``) unless ``ds`` carries its own
+    content digest: an edited or corrupted run file is not trusted."""
+    stored = ds.attrs.get(schema.DIGEST_ATTR)
+    if not isinstance(stored, str) or not stored:
+        raise V.SnappingInputError(f"{what} has no integrity digest (attribute {schema.DIGEST_ATTR!r}): it was "
+                                   f"written by another program or an older snapping, or edited; it is not resumed")
+    if content_digest(ds) != stored:
+        raise V.SnappingInputError(f"{what} fails its integrity check: its inputs or state were changed after it "
+                                   f"was written (edited or corrupted); it is not resumed, start the run again")
 
 
 def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
@@ -237,8 +267,9 @@ def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
 def open_netcdf(p: str) -> xr.Dataset:
     """The netCDF file at path ``p`` loaded into memory (the file is closed), or
     SnappingInputError saying why it cannot be read."""
-    if not os.path.isfile(p):
-        raise V.SnappingInputError(f"path={p!r} does not exist or is not a file")
+    from .. import _files
+
+    p = _files.check_input(p)
     try:
         with xr.open_dataset(p, engine="netcdf4") as f:
             return f.load()

@@ -22,23 +22,25 @@ import time
 import numpy as np
 import xarray as xr
 
+from .. import _files
 from .. import _validate as V
 from . import kernels as K
 from . import methods as M
 from .chain import ChainState
-from .dataset import Run, build_dataset, check_writable, inputs_from_attrs, open_netcdf, save
+from .dataset import Run, build_dataset, check_writable, inputs_from_attrs, open_netcdf, save, seal, verify_digest
 from .errors import FAILURES, RET_SIGNAL, RunInterrupted, SimulationError
 from .options import RunOptions, check_checkpoint_every, check_memory, check_progress
 
-__all__ = ["run", "rerun", "resume", "is_resumable", "check_inputs", "integrate_fixed", "METHODS",
+__all__ = ["run", "rerun", "resume", "ResumeMismatch", "is_resumable", "check_inputs", "integrate_fixed", "METHODS",
            "CHECKPOINT_EVERY"]
 
 #: the method names :func:`run` takes (the table: :data:`snapping.simulate.methods.METHODS`)
 METHODS = M.NAMES
 #: default wall-clock seconds between checkpoints of a run with an output file
 CHECKPOINT_EVERY = 300.0
-#: layout version of the checkpoint variables (schema.CHECKPOINT_VARS)
-CHECKPOINT_VERSION = 1
+#: layout version of the checkpoint variables (schema.CHECKPOINT_VARS); 2: the control array
+#: has the held end's breakpoints (39 entries) and the file carries its integrity digest
+CHECKPOINT_VERSION = 2
 #: test hook: called with the engine after every return of the compiled loop; may
 #: return a signal number to act as if that signal had arrived
 _chunk_hook = None
@@ -130,6 +132,7 @@ def run(
     max_rejections: int = 100,
     checkpoint_every: float | None = CHECKPOINT_EVERY,
     problem=None,
+    overwrite: bool = False,
 ) -> Run:
     """Simulate the falling chain released from the paper's catenary, to the snap and a bit after.
 
@@ -198,8 +201,12 @@ def run(
     initial : ChainState, optional
         Start from this state instead of the catenary (``chi`` then optional).
     output : path, optional
-        Write the netCDF4 file here (checked for writability before the run;
-        also written when the run fails or is interrupted).
+        Write the netCDF4 file here (the whole path checked before the run: a new
+        path or, with ``overwrite``, an existing regular file; its directory, and
+        room on its filesystem; locked against other writers while the run lasts;
+        also written when the run fails or is interrupted; rules: :mod:`snapping._files`).
+    overwrite : bool
+        Replace ``output`` if it exists (default: refuse an existing file).
     progress : bool or None
         tqdm progress bar on stderr (None: only on a terminal).
     max_energy_drift : float, optional
@@ -253,14 +260,16 @@ def run(
     opts = RunOptions(tol=tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections)
-    output = None if output is None else check_writable(output)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     progress = check_progress(progress)
     method_ = M.method(method)
     opts = method_.complete(opts, method)
-    check_memory(N, opts, chi=chi, method=method)
+    need = check_memory(N, opts, chi=chi, method=method)
+    if output is not None:
+        output = check_writable(output, overwrite=overwrite, need_bytes=need["file_bytes"])
     inputs, eng = method_.setup(chi, N, method, opts, chords=chords, initial=initial, problem=problem)
-    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every, wall_before=0.0)
+    return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every,
+                  wall_before=0.0, overwrite=overwrite)
 
 
 def check_inputs(chi=None, N=None, **options) -> None:
@@ -285,11 +294,11 @@ def check_inputs(chi=None, N=None, **options) -> None:
                                                         kw["method"])
     chi, N = _validate_start(chi, N, kw["method"], chords, initial, problem)
     opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])
-    if kw["output"] is not None:
-        check_writable(kw["output"])
     check_checkpoint_every(kw["checkpoint_every"])
     check_progress(kw["progress"])
-    check_memory(N, opts, chi=chi, method=kw["method"])
+    need = check_memory(N, opts, chi=chi, method=kw["method"])
+    if kw["output"] is not None:
+        check_writable(kw["output"], overwrite=kw["overwrite"], need_bytes=need["file_bytes"])
 
 
 # ---------------------------------------------------------------- the driver: signals, checkpoints, results
@@ -302,7 +311,7 @@ def _checkpoint_dataset(eng, inputs: dict, results: dict) -> xr.Dataset:
         "checkpoint_link_error_initial": eng.link_error_initial,
         "checkpoint_time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
     })
-    return ds
+    return seal(ds)
 
 
 def _resume_command(path) -> str:
@@ -311,8 +320,24 @@ def _resume_command(path) -> str:
     return f"snapping simulate --resume {shlex.quote(str(path))}"
 
 
-def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
+def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float, overwrite: bool) -> Run:
     """Run ``eng`` to its end, with progress bar, signal handling and checkpoints; build and save the result.
+
+    With an ``output``, its lock is held from before the first step to after the last
+    save, and the path is checked again under the lock (another process may have
+    created it since the first check); every save of the run replaces its own file.
+    """
+    if output is None:
+        return _drive_locked(eng, inputs, output=None, progress=progress, checkpoint_every=checkpoint_every,
+                             wall_before=wall_before)
+    with _files.locked(output):
+        check_writable(output, overwrite=overwrite)
+        return _drive_locked(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every,
+                             wall_before=wall_before)
+
+
+def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
+    """:func:`_drive` once the output (if any) is locked and checked.
 
     ``eng`` is a method's engine (:data:`snapping.simulate.methods.METHODS`): each
     provides ``t``, ``n_steps``,
@@ -348,7 +373,7 @@ def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before
             wall = wall_before + time.perf_counter() - wall0
             res = eng.results("checkpoint", f"running; checkpoint at t={eng.t:.9g}, step {eng.n_steps}; "
                               f"if the run was killed, continue with: {_resume_command(output)}", wall)
-            save(_checkpoint_dataset(eng, inputs, res), output)
+            save(_checkpoint_dataset(eng, inputs, res), output, overwrite=True)
             got["last"] = time.monotonic()
         return None
 
@@ -381,7 +406,7 @@ def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before
             if output is not None:
                 reason += f"; continue with: {_resume_command(output)}"
             ds = _checkpoint_dataset(eng, inputs, eng.results(status, reason, wall))
-            path = save(ds, output) if output is not None else None
+            path = save(ds, output, overwrite=True) if output is not None else None
             raise RunInterrupted(f"{reason}" + (f" (saved in {path})" if path else " (not saved: no output file)"),
                                  int(got["signum"]), dataset=ds, path=path)
         if code == K.RET_STOP:
@@ -393,10 +418,10 @@ def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before
             node = eng.worst_node(code)
             reason = eng.failure_message(code, node)
             failure = FAILURES.get(code, SimulationError).kind
-        ds = build_dataset(eng.records(), eng.snapshots_now(), N, inputs,
-                           eng.results(status, reason, wall, failure, node))
+        ds = seal(build_dataset(eng.records(), eng.snapshots_now(), N, inputs,
+                                   eng.results(status, reason, wall, failure, node)))
         final = eng.final_state() if status == "completed" else None
-        path = save(ds, output) if output is not None else None
+        path = save(ds, output, overwrite=True) if output is not None else None
     finally:
         for sig, h in handlers.items():
             signal.signal(sig, h)
@@ -445,9 +470,47 @@ def _open_checkpoint(path) -> xr.Dataset:
     if missing:
         raise V.SnappingInputError(f"path={p!r} is not a complete checkpoint: missing {missing[:5]}")
     if int(ds.attrs["checkpoint_version"]) != CHECKPOINT_VERSION:
-        raise V.SnappingInputError(f"path={p!r}: checkpoint version {ds.attrs['checkpoint_version']} is not "
-                                   f"supported by this version (expects {CHECKPOINT_VERSION})")
+        raise V.SnappingInputError(f"path={p!r}: checkpoint version {ds.attrs['checkpoint_version']} (written by "
+                                   f"another version of snapping) is not supported by this version (expects "
+                                   f"{CHECKPOINT_VERSION}): start the run again")
+    verify_digest(ds, f"path={p!r}")
     return ds
+
+
+class ResumeMismatch(V.SnappingInputError):
+    """An input given to :func:`resume` (``expect``) that differs from the checkpoint's run."""
+
+    def __init__(self, key: str, given, stored, path: str, *, option: str | None = None):
+        self.key, self.given, self.stored, self.path = key, given, stored, path
+        name = option or key
+        shown = f"{option} {given}" if option else f"{key}={given!r}"
+        super().__init__(f"{shown} contradicts the checkpoint {path!r}, whose run has {key}={stored!r}: "
+                         f"a resumed run continues the stored run; drop {name}, or start a new run")
+
+
+def _mismatch(kw: dict, expected: dict) -> str | None:
+    """The first key of ``expected`` whose value differs from the run inputs ``kw`` (None: all agree)."""
+    for k, v in expected.items():
+        if v is None or k in ("output", "progress", "checkpoint_every", "overwrite"):
+            continue
+        have = kw.get(k)
+        if k == "method":  # files name the method it stands for
+            v = M.resolve(v) if v in METHODS else v
+        if k == "snapshot_times":
+            try:
+                if tuple(float(x) for x in np.atleast_1d(np.asarray(v, dtype=float))) != tuple(have or ()):
+                    return k
+            except (TypeError, ValueError):
+                return k
+        elif isinstance(v, float) or isinstance(have, float):
+            try:
+                if float(v) != float(have):
+                    return k
+            except (TypeError, ValueError):
+                return k
+        elif v != have:
+            return k
+    return None
 
 
 def is_resumable(path, **expected) -> bool:
@@ -462,27 +525,11 @@ def is_resumable(path, **expected) -> bool:
         kw = inputs_from_attrs(ds)
     except (V.SnappingInputError, KeyError, ValueError, TypeError):
         return False
-    for k, v in expected.items():
-        if v is None or k in ("output", "progress", "checkpoint_every"):
-            continue
-        have = kw.get(k)
-        if k == "method":  # files name the method it stands for
-            v = M.resolve(v)
-        if k == "snapshot_times":
-            if tuple(float(x) for x in np.atleast_1d(np.asarray(v, dtype=float))) != tuple(have or ()):
-                return False
-        elif isinstance(v, float) or isinstance(have, float):
-            try:
-                if float(v) != float(have):
-                    return False
-            except (TypeError, ValueError):
-                return False
-        elif v != have:
-            return False
-    return True
+    return _mismatch(kw, expected) is None
 
 
-def resume(path, *, output=None, progress: bool | None = False, checkpoint_every: float | None = CHECKPOINT_EVERY) -> Run:
+def resume(path, *, output=None, progress: bool | None = False, checkpoint_every: float | None = CHECKPOINT_EVERY,
+           overwrite: bool = False, expect: dict | None = None) -> Run:
     """Continue an interrupted or checkpointed run file to its end.
 
     The run continues from the complete state stored in the file (positions and
@@ -490,6 +537,11 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
     the snapshots and the peak trackers; :data:`snapping.schema.CHECKPOINT_VARS`),
     and gives the same accepted steps and the same Dataset, bit for bit, as a run
     that was never interrupted (``wall_time`` aside: it adds up the sessions).
+
+    The checkpoint's integrity digest (``schema.DIGEST_ATTR``, over every input
+    and the whole state) is checked first: a file whose inputs (say its ``chi``) or
+    state were edited, or that is corrupted, is refused. The file is locked while
+    the run continues: a second writer is refused, naming this process.
 
     Parameters
     ----------
@@ -499,6 +551,12 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
         Where to write the run (default: ``path`` itself, replaced atomically).
     progress, checkpoint_every
         As for :func:`run`.
+    overwrite : bool
+        Replace ``output`` if it exists and is not ``path`` (default: refuse).
+    expect : dict, optional
+        Inputs of :func:`run` (``chi``, ``N``, ``method``, ``tol``, ...) the caller expects
+        the checkpoint to have: one that differs is refused by name (a resumed run
+        continues the stored run; it cannot change its inputs).
 
     Returns
     -------
@@ -508,7 +566,8 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
     ------
     SnappingInputError
         Not a readable run checkpoint (a completed or failed run, another
-        program's file, a truncated file), or an unwritable ``output``.
+        program's file, a truncated, edited or corrupted file), an unwritable or
+        existing ``output``, or a file that another process is writing.
     SimulationError, RunInterrupted
         As for :func:`run`.
 
@@ -519,31 +578,38 @@ def resume(path, *, output=None, progress: bool | None = False, checkpoint_every
     >>> resume(p)
     Traceback (most recent call last):
     ...
-    snapping._validate.SnappingInputError: path='...run.nc' does not exist or is not a file
+    snapping._validate.SnappingInputError: path='...run.nc' does not exist
     """
-    ds = _open_checkpoint(path)
-    out = check_writable(path if output is None else output)
+    p = _files.check_input(path)
+    own = output is None or os.path.realpath(os.fspath(output)) == os.path.realpath(p)
+    out = check_writable(p if own else output, overwrite=True if own else overwrite)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     progress = check_progress(progress)
-    try:
-        kw = inputs_from_attrs(ds)
-        chi, N = _validate_start(kw["chi"], kw["N"], kw["method"], kw["chords"], kw.get("initial"),
-                                 kw.get("problem"))
-        opts = RunOptions.pick(kw)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the inputs stored in the checkpoint are not valid "
-                                   f"({type(exc).__name__}: {exc})") from None
-    check_memory(N, opts, chi=chi, method=kw["method"])
-    inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
-                                               initial=kw.get("initial"), problem=kw.get("problem"))
-    try:
-        eng.restore(ds)
-    except (KeyError, ValueError, TypeError) as exc:
-        if isinstance(exc, V.SnappingInputError):
-            raise V.SnappingInputError(f"path={os.fspath(path)!r}: {exc}") from None
-        raise V.SnappingInputError(f"path={os.fspath(path)!r}: the checkpoint is damaged ({exc})") from None
-    return _drive(eng, inputs, output=out, progress=progress, checkpoint_every=checkpoint_every,
-                  wall_before=float(ds.attrs["checkpoint_wall_time"]))
+    with _files.locked(p, name="path"):  # nobody else writes the checkpoint while we read and continue it
+        ds = _open_checkpoint(p)
+        try:
+            kw = inputs_from_attrs(ds)
+            chi, N = _validate_start(kw["chi"], kw["N"], kw["method"], kw["chords"], kw.get("initial"),
+                                     kw.get("problem"))
+            opts = RunOptions.pick(kw)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise V.SnappingInputError(f"path={p!r}: the inputs stored in the checkpoint are not valid "
+                                       f"({type(exc).__name__}: {exc})") from None
+        bad = _mismatch(kw, dict(expect or {}))
+        if bad is not None:
+            raise ResumeMismatch(bad, expect[bad], kw.get(bad), p)
+        need = check_memory(N, opts, chi=chi, method=kw["method"])
+        out = check_writable(out, overwrite=True if own else overwrite, need_bytes=need["file_bytes"])
+        inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
+                                                   initial=kw.get("initial"), problem=kw.get("problem"))
+        try:
+            eng.restore(ds)
+        except (KeyError, ValueError, TypeError) as exc:
+            if isinstance(exc, V.SnappingInputError):
+                raise V.SnappingInputError(f"path={p!r}: {exc}") from None
+            raise V.SnappingInputError(f"path={p!r}: the checkpoint is damaged ({exc})") from None
+        return _drive(eng, inputs, output=out, progress=progress, checkpoint_every=checkpoint_every,
+                      wall_before=float(ds.attrs["checkpoint_wall_time"]), overwrite=True if own else overwrite)
 
 
 def integrate_fixed(state: ChainState, dt: float, n_steps: int) -> ChainState:

@@ -35,6 +35,7 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import warnings
@@ -42,6 +43,7 @@ import warnings
 import numpy as np
 from numba import njit
 
+from .. import _files
 from .. import _validate as V
 from . import angles as AG
 from . import kernels as K
@@ -416,7 +418,7 @@ class _Lanes:
 def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end: float | None = None,
                  stop_fraction: float = 0.5, t_end_max: float = 10.0, snapshot_times=(), record_thin: float = 0.0,
                  max_link_error: float = 1e-2, chords: str = "arclength", outputs=None, progress: bool = False,
-                 dt_min: float = 1e-14):
+                 dt_min: float = 1e-14, overwrite: bool = False):
     """Run several chains of N links (one per ``chis`` value) together, one vectorised
     kernel advancing all of them, each with its own adaptive DOP853 step.
 
@@ -437,7 +439,10 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     method : {"fast", "dop853"}
         The angle-form method (the only one with an ensemble kernel).
     outputs : sequence of paths, optional
-        Write member i's Dataset to ``outputs[i]``.
+        Write member i's Dataset to ``outputs[i]`` (distinct new paths, checked before the
+        run and locked while it lasts; rules: :mod:`snapping._files`).
+    overwrite : bool
+        Replace outputs that exist (default: refuse them).
     progress : bool
         Show a progress bar of finished members.
 
@@ -475,7 +480,18 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       dt_min=dt_min)
     if outputs is not None:
-        outputs = [check_writable(o) for o in outputs]
+        outputs = [check_writable(o, name=f"outputs[{i}]", overwrite=overwrite) for i, o in enumerate(outputs)]
+        same = [o for o in set(outputs) if outputs.count(o) > 1]
+        if same:
+            raise V.SnappingInputError(f"outputs names {same[0]!r} more than once: give each member its own file")
+    with contextlib.ExitStack() as held:  # every output locked against other writers while the ensemble runs
+        for o in outputs or ():
+            held.enter_context(_files.locked(o))
+        return _run_members(chis, N, method, opts, chords, outputs, progress)
+
+
+def _run_members(chis, N, method, opts, chords, outputs, progress):
+    """:func:`run_ensemble` once its inputs are checked and its outputs locked."""
     method = DOP.resolve_method(method)
     DOP._warm_up()
     _warm_up()
@@ -541,7 +557,7 @@ def _warm_up() -> None:
 def _finish(eng, inputs: dict, code, wall: float, output, opts):
     """The run Dataset of a finished member (saved to ``output`` if given), as a Run; a
     numerical failure gives status 'failed' (no exception: the ensemble goes on)."""
-    from .dataset import Run, build_dataset, save
+    from .dataset import Run, build_dataset, save, seal
     from .errors import FAILURES, SimulationError
 
     status, reason, failure, node = "completed", "", "", -1
@@ -558,5 +574,5 @@ def _finish(eng, inputs: dict, code, wall: float, output, opts):
             failure = FAILURES.get(code, SimulationError).kind
     ds = build_dataset(eng.records(), eng.snapshots_now(), eng.N, inputs,
                        eng.results(status, reason, wall, failure, node))
-    path = save(ds, output) if output is not None else None
+    path = save(seal(ds), output, overwrite=True) if output is not None else None
     return Run(ds, eng.final_state(), path)

@@ -210,14 +210,16 @@ def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: 
             "state_bytes": state_bytes}
 
 
-def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "euler-richardson") -> None:
-    """Raise SnappingInputError when the run's record and snapshots would not fit in memory."""
+def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "euler-richardson") -> dict:
+    """Raise SnappingInputError when the run's record and snapshots would not fit in memory;
+    else return the estimate (:func:`memory_need`, with ``file_bytes``: the run file's size)."""
     dt0 = math.sqrt(opts.tol) if opts.dt0 is None else opts.dt0
     need = memory_need(N, chi=chi, tol=opts.tol, method=method, dt0=dt0, t_end=opts.t_end,
                        t_end_max=opts.t_end_max, snapshot_times=opts.snapshot_times, record_thin=opts.record_thin)
+    need["file_bytes"] = need["record_bytes"] / 3 + need["snapshot_bytes"]
     avail = _available_memory()
     if avail is None or need["bytes"] <= MEMORY_MARGIN * avail:
-        return
+        return need
     gib = 2.0 ** 30
     raise V.SnappingInputError(
         f"the run would need about {need['bytes'] / gib:.3g} GiB of memory (record: ~{need['records']:.3g} steps "

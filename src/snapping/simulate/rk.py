@@ -74,10 +74,6 @@ ERR_EXPONENT = -1.0 / 8.0
  Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ,
  Q_TBRK, Q_LASTBRK) = range(39)
 NQ = 39
-#: control entries of files written before Q_TBRK (the next breakpoint of the held end's
-#: motion) and Q_LASTBRK (the last one reached) existed, and the values their runs had
-NQ_BEFORE_BREAKS = 37
-CTL_PAD = {NQ_BEFORE_BREAKS: (np.inf, np.nan)}
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)

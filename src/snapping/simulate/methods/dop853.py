@@ -441,7 +441,7 @@ class Engine(CheckpointMixin):
                           ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
                           ("checkpoint_meas0", self.meas0)):
             arr[...] = get(name, arr.shape)
-        self._restore_ctl(get, R.NQ, pad=R.CTL_PAD)
+        self._restore_ctl(get, R.NQ)
         self._restore_scales(ds, get)
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
