@@ -53,7 +53,7 @@ import threading
 
 from . import _validate as V
 
-__all__ = ["check_output", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
+__all__ = ["check_output", "check_output_dir", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
            "OutputBusyError", "lock_path", "describe_kind"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
@@ -181,6 +181,29 @@ def check_input(path, *, name: str = "path") -> str:
     return p
 
 
+def check_output_dir(path, *, name: str = "output") -> str:
+    """Output directory ``path`` (made, with its parents, if missing) that takes new files;
+    else :class:`SnappingInputError` saying why (a file, device or FIFO in the way, a
+    read-only filesystem, no permission)."""
+    p = V.file_path(name, path)
+    try:
+        st = os.stat(p)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:
+        raise V.SnappingInputError(f"{name}={p!r} cannot be examined ({exc.strerror or exc})") from None
+    if st is not None and not stat.S_ISDIR(st.st_mode):
+        raise V.SnappingInputError(f"{name}={p!r} exists and is {describe_kind(st.st_mode)}, not a directory")
+    try:
+        os.makedirs(p, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", suffix=".probe", dir=p)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise V.SnappingInputError(f"{name}={p!r}: the directory cannot be written ({exc.strerror or exc})") from None
+    return p
+
+
 # ------------------------------------------------------------------------------- locks
 def lock_path(path: str) -> str:
     """The lock file of output ``path``: ``.NAME.lock`` in the same directory."""
@@ -230,8 +253,9 @@ def _acquire(path: str, name: str) -> int:
         if not same:  # we locked a lock file its holder had just removed: try again
             os.close(fd)
             continue
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        with contextlib.suppress(OSError):  # (a full disk: the lock holds, only its PID is not shown)
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         return fd
     raise V.SnappingInputError(f"{name}={path!r}: its lock file {lp!r} keeps changing")  # pragma: no cover
 

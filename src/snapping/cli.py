@@ -17,6 +17,7 @@ import sys
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 1  # a numerical failure or an I/O fault (e.g. a full disk)
+PLOT_BYTES = 2e6  # free space a figure file needs (checked before the work)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -398,14 +399,14 @@ def _cmd_fit(args) -> int:
         except ValueError:
             raise SnappingInputError(f"--window={w!r} must look like NAME=LO,HI (e.g. v_max=1e-4,1e-2)") from None
         windows[key.strip()] = (lo, hi)
-    if args.plot:  # before the (slow) fits
+    if args.plot is not None:  # before the (slow) fits
         from .simulate.dataset import check_writable
 
         if Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
             raise SnappingInputError(f"--plot={args.plot!r}: the figure suffix must be .png, .pdf or .svg")
         out = Path(args.plot)
         for path in (out, out.with_name(f"{out.stem}_slopes{out.suffix}"), out.with_name(f"{out.stem}_delta{out.suffix}")):
-            check_writable(path, name="--plot", overwrite=args.overwrite)
+            check_writable(path, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
     runs, names = [], []
     for f in args.files:
         ds = scaling.load_run(f)
@@ -443,7 +444,7 @@ def _cmd_fit(args) -> int:
         print(f"\n  curvature amplification max kappa_max / kappa_max(0) = {res.kappa_amplification:.4g}")
     else:
         print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
-    if args.plot:
+    if args.plot is not None:
         out = Path(args.plot)
         paths = [
             scaling.plot_maxima(runs, results, out),
@@ -597,7 +598,7 @@ def _cmd_converge(args) -> int:
         from .simulate.dataset import check_writable
 
         try:
-            check_writable(args.plot, name="plot", overwrite=args.overwrite)
+            check_writable(args.plot, name="plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,

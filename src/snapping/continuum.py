@@ -215,10 +215,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
                               first=V.integer("first", first, -20))
     paths = [None] * len(params)
     if output is not None:
-        out = V.file_path("output", output)
-        if os.path.exists(out) and not os.path.isdir(out):
-            raise V.SnappingInputError(f"output={out!r} exists and is not a directory")
-        os.makedirs(out, exist_ok=True)
+        from ._files import check_output_dir
+
+        out = check_output_dir(output, name="output")
         paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
     jobs = [(chi, p, lumping, free_end, tol, path) for p, path in zip(params, paths)]
     # check every level's chain before any runs (bad input raises here, nothing written)

@@ -475,7 +475,10 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
         lines += [f"**{cap}**", "", f"![{name}](figures/{name}.png)", ""]
     lines += ["## Wall time", "", "| part | seconds |", "|---|---|"]
     lines += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
-    report.write_text("\n".join(lines) + "\n")
+    from ._files import write_atomic
+
+    text = "\n".join(lines) + "\n"
+    write_atomic(report, lambda tmp: Path(tmp).write_text(text), name="report")  # the directory's own file
     log(f"wrote {report} and {len(list(figdir.glob('*.png')))} figures in {figdir} ({timings['total']:.0f} s)")
     return report
 

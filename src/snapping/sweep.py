@@ -24,7 +24,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -211,14 +210,9 @@ def _run_task(task: list) -> list[str]:
 
 
 def _check_out_dir(out_dir) -> Path:
-    out = Path(V.file_path("out_dir", out_dir))
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=out, prefix=".write-test-"):
-            pass
-    except OSError as exc:
-        raise V.SnappingInputError(f"output directory {str(out)!r} cannot be written: {exc.strerror}") from None
-    return out
+    from ._files import check_output_dir
+
+    return Path(check_output_dir(out_dir, name="out_dir"))
 
 
 def _client_for(scheduler):

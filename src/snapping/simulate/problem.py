@@ -506,11 +506,9 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
     """Points (x, y) of a start curve from a CSV file (two columns x, y; a header line is
     skipped) or a netCDF file (variables ``x`` and ``y``), listed from the held end; the
     curve is translated so that its first point (the held end) is at the origin."""
-    import os
+    from .._files import check_input
 
-    p = V.file_path("shape", path)
-    if not os.path.isfile(p):
-        raise V.SnappingInputError(f"shape={p!r} does not exist or is not a file")
+    p = check_input(path, name="shape")
     if p.endswith((".nc", ".nc4", ".cdf")):
         from .dataset import open_netcdf
 
