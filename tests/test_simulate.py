@@ -375,3 +375,80 @@ def test_fast_tension_solve_matches_textbook_thomas():
         for a, b in zip(fast, ref):
             # condition number ~ N^2; seen <= 1.2e-10 (hanging, moving)
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-15 * N * N, err_msg=name)
+
+
+# ---------------------------------------------------------------- the absolute energy
+def _mp_catenary(chi, dps=30):
+    """(a, y(s)) of the unit catenary in mpmath, from its definition 1 = 2 a sinh(chi/2a),
+    y(s) = sqrt(a^2 + 1/4) - sqrt(a^2 + (s - 1/2)^2), x(s) = a asinh((s - 1/2)/a) + chi/2."""
+    mp = mpmath.mp.clone()
+    mp.dps = dps
+    chi = mp.mpf(chi)
+    # in b = chi/2a: sinh(b)/b = 1/chi (monotone); start from the large-b root b ~ log(2b/chi)
+    b = mp.findroot(lambda b: mp.sinh(b) / b - 1 / chi, mp.log(2 / chi) + mp.log(mp.log(2 / chi)))
+    a = chi / (2 * b)
+    xy = lambda s: (a * mp.asinh((s - mp.mpf(1) / 2) / a) + chi / 2,  # noqa: E731
+                    mp.sqrt(a**2 + mp.mpf(1) / 4) - mp.sqrt(a**2 + (s - mp.mpf(1) / 2) ** 2))
+    return mp, a, xy
+
+
+def test_initial_energy_is_the_catenarys_potential_energy_arclength_chords():
+    """The recorded energy at t = 0 (Euler-Richardson, the paper's arclength nodes) is the
+    discrete chain's potential energy relative to hanging at rest, computed here in mpmath
+    from the catenary's closed form: E0 = sum_i m (-y_i) + sum_i m s_i with m = 1/N,
+    s_i = (N - i)/N. A constant offset of 1e-6 in the measured energy fails it. And it
+    tends to the available energy P(chi) of snapping.estimates: E0 = 1/2 + 1/(2N) - T_N[y]
+    with T_N the trapezoid sum of int y ds (y = 0 at both ends), and Euler-Maclaurin gives
+    T_N = int y ds - (h^2/12)(y'(0) - y'(1)) + ..., so (h = 1/N)
+    E0 = P + h/2 + (h^2/12)(y'(0) - y'(1)) + O(h^4), the remainder ~ exp(-2 pi a N) for
+    y analytic within a of the real axis (tiny at N = 200: a N ~ 7.7)."""
+    from snapping import estimates
+
+    chi, N = 0.25, 200
+    ds = run(chi, N, t_end=1e-4).dataset
+    assert float(ds["t"][0]) == 0.0
+    mp, a, xy = _mp_catenary(chi)
+    E0 = mp.fsum(-xy(mp.mpf(N - i) / N)[1] / N for i in range(N)) + mp.mpf(N + 1) / (2 * N)
+    assert float(ds["energy"][0]) == pytest.approx(float(E0), rel=0, abs=1e-13)
+    assert ds.attrs["energy_initial"] == pytest.approx(float(E0), rel=0, abs=1e-13)
+    # the same from the recorded node coordinates of the initial snapshot
+    snap = ds.isel(snapshot=0)
+    assert str(snap["snapshot_kind"].values) == "initial"
+    assert -float(snap["y"][:N].sum()) / N + (N + 1) / (2 * N) == pytest.approx(float(E0), abs=1e-13)
+    # Euler-Maclaurin: y'(0) - y'(1) = 1/sqrt(a^2 + 1/4)
+    h = mp.mpf(1) / N
+    em = estimates.available_energy(chi) + float(h / 2 + h**2 / (12 * mp.sqrt(a**2 + mp.mpf(1) / 4)))
+    assert float(E0) == pytest.approx(em, abs=1e-11)
+
+
+def test_initial_energy_exact_chords_and_a_general_chain():
+    """The same for the angle-form DOP853 run (exact chords 1/N, nodes walked from the pin
+    on the catenary: recomputed in mpmath here) and for a tapered chain (general kernel):
+    E0 = sum_j m_j (|v_j|^2/2 - y_j) + sum_j m_j s_j from the Problem's nodes and masses."""
+    from snapping.simulate.problem import Links, Problem
+
+    chi, N = 0.25, 20
+    ds = run(chi, N, t_end=1e-4, method="dop853", chords="exact").dataset
+    mp, a, xy = _mp_catenary(chi)
+    h = mp.mpf(1) / N
+    s, nodes = mp.mpf(0), [(mp.mpf(0), mp.mpf(0))]
+    for _ in range(N):
+        x0, y0 = nodes[-1]
+        s = mp.findroot(lambda u: mp.hypot(xy(u)[0] - x0, xy(u)[1] - y0) - h, s + h)
+        nodes.append(xy(s))
+    E0 = mp.fsum(-yv / N for _, yv in nodes[1:]) + mp.mpf(N + 1) / (2 * N)
+    assert float(ds["energy"][0]) == pytest.approx(float(E0), rel=0, abs=1e-13)
+    assert ds.attrs["energy_initial"] == pytest.approx(float(E0), rel=0, abs=1e-13)
+    # a tapered chain (equal links 1/N, masses falling to half at the free end) on the
+    # exact-chord catenary nodes, spinning rigidly about the held end (v = w e3 x r)
+    links = Links.taper(N, 0.5)
+    st = initial_state(chi, N, chords="exact")
+    w = 0.4
+    q = Problem.nodes(st.x, st.y, links=links, vx=-w * st.y, vy=w * st.x)
+    assert not q.is_paper
+    dq = run(problem=q, t_end=1e-4, method="dop853").dataset
+    m, hl = links.m, links.h
+    s_node = np.cumsum(hl[::-1])[::-1]  # arclength of node j from the held end
+    v2 = w * w * (q.x[:N] ** 2 + q.y[:N] ** 2)
+    E_ref = math.fsum(m * (v2 / 2 - q.y[:N])) + math.fsum(m * s_node)
+    assert float(dq["energy"][0]) == pytest.approx(E_ref, rel=0, abs=1e-13)
