@@ -121,6 +121,12 @@ def test_initial_tension_and_chords():
     r = run(0.25, N, t_end=1e-3)
     kappa0 = r.dataset.attrs["kappa_max_0"]
     assert r.dataset.attrs["link_error_initial"] == pytest.approx(kappa0**2 / (24 * N**2), rel=0.05)
+    # exactly: the largest chord deficit 1 - N |r(s_k) - r(s_k+1)| of the closed-form catenary
+    # (mpmath; at the links beside the bottom, where kappa is largest)
+    mp, _, xy = _mp_catenary(0.25)
+    nodes = [xy(mp.mpf(k) / N) for k in range(N + 1)]
+    deficit = max(abs(1 - N * mp.hypot(x1 - x0, y1 - y0)) for (x0, y0), (x1, y1) in zip(nodes, nodes[1:]))
+    assert r.dataset.attrs["link_error_initial"] == pytest.approx(float(deficit), rel=1e-9, abs=0)
     exact = initial_state(0.25, N, chords="exact")
     np.testing.assert_allclose(exact.link_lengths(), 1.0 / N, rtol=1e-12)
 
