@@ -12,4 +12,5 @@ MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", 
 def test_docstring_examples(name):
     module = importlib.import_module(name)
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    assert result.failed == 0
+    # a module without examples would pass by construction: require that some ran
+    assert result.failed == 0 and result.attempted > 0, result

@@ -3,6 +3,7 @@
 import json
 import math
 
+import mpmath
 import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
@@ -29,9 +30,11 @@ def test_catenary_parameter_limits():
     chi = 1 - 1e-8
     assert E.catenary_parameter(chi) == pytest.approx(math.sqrt(chi**3 / (24 * (1 - chi))), rel=1e-6)
     # chi -> 0: the folded string; a -> 0 with chi = 2a asinh(1/2a) ~ 2a log(1/a)
+    # (exactly chi = 2a asinh(1/2a) = 2a [log(1/a) + log((1 + sqrt(1 + 4a^2))/2)], the last
+    # term ~ a^2 ~ 1e-27 here: the relative gap is set by the root finding alone)
     chi = 1e-12
     a = E.catenary_parameter(chi)
-    assert chi == pytest.approx(2 * a * math.log(1 / a), rel=0.05)
+    assert chi == pytest.approx(2 * a * math.log(1 / a), rel=1e-12)
 
 
 @pytest.mark.parametrize("chi", [0.01, 0.1, 0.25, 0.5, 0.9])
@@ -94,6 +97,37 @@ def test_delta_crude_is_where_the_two_paper_lines_meet():
         assert T == pytest.approx((math.pi / k0) ** 2, rel=1e-12)
         assert E.delta_crude(chi) == pytest.approx(front(T), rel=1e-12)
         assert E.delta_crude(chi) < E.delta_kappa0(chi)
+
+
+def _mp_catenary_parameter(chi):
+    """a > 0 with 1 = 2 a sinh(chi/2a) (the paper, after Lockwood), in mpmath at 40 digits,
+    by bisection in log a: 2 a sinh(chi/2a) falls from inf (a -> 0) to chi (a -> inf)."""
+    with mpmath.workdps(40):
+        chi = mpmath.mpf(chi)
+        f = lambda a: 2 * a * mpmath.sinh(chi / (2 * a)) - 1  # noqa: E731
+        lo, hi = mpmath.log(chi / (2 * (5 - mpmath.log(chi)))), mpmath.log(10**7)
+        assert f(mpmath.exp(lo)) > 0 > f(mpmath.exp(hi))
+        for _ in range(170):  # bracket width < 40 / 2^170 ~ 3e-50 in log a
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if f(mpmath.exp(mid)) > 0 else (lo, mid)
+        return mpmath.exp((lo + hi) / 2)
+
+
+@pytest.mark.parametrize("chi", [1e-9, 1e-4, 0.01, 0.1, 0.25, 0.5, 0.9, 0.999])
+def test_scales_against_mpmath(chi):
+    """delta_kappa0 = (pi/2)/kappa_m(0) and delta_c = (1/2)(pi/kappa_m(0))^(4/3), with
+    kappa_m(0) = 1/a (paper, section "Amplification estimates" and eq. deltacrude), and
+    P = 1/2 - int_0^1 y ds, all from an independent 40-digit solve for a (and quadrature)."""
+    with mpmath.workdps(40):
+        a = _mp_catenary_parameter(chi)
+        dk0 = mpmath.pi / 2 * a
+        dc = (mpmath.pi * a) ** (mpmath.mpf(4) / 3) / 2
+        y = lambda s: mpmath.sqrt(a**2 + mpmath.mpf(1) / 4) - mpmath.sqrt(a**2 + (s - mpmath.mpf(1) / 2) ** 2)  # noqa: E731
+        P = mpmath.mpf(1) / 2 - mpmath.quad(y, [0, mpmath.mpf(1) / 2, 1])
+    assert E.catenary_parameter(chi) == pytest.approx(float(a), rel=1e-13, abs=0)
+    assert E.delta_kappa0(chi) == pytest.approx(float(dk0), rel=1e-13, abs=0)
+    assert E.delta_crude(chi) == pytest.approx(float(dc), rel=1e-13, abs=0)
+    assert E.available_energy(chi) == pytest.approx(float(P), rel=1e-13, abs=0)
 
 
 def test_whirling_rod_is_a_rigid_rotating_rod():

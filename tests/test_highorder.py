@@ -318,4 +318,5 @@ def test_docstring_examples(name):
 
     module = importlib.import_module(f"snapping.simulate.{name}")
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    assert result.failed == 0
+    # a module without examples would pass by construction: require that some ran
+    assert result.failed == 0 and result.attempted > 0, result

@@ -121,6 +121,12 @@ def test_initial_tension_and_chords():
     r = run(0.25, N, t_end=1e-3)
     kappa0 = r.dataset.attrs["kappa_max_0"]
     assert r.dataset.attrs["link_error_initial"] == pytest.approx(kappa0**2 / (24 * N**2), rel=0.05)
+    # exactly: the largest chord deficit 1 - N |r(s_k) - r(s_k+1)| of the closed-form catenary
+    # (mpmath; at the links beside the bottom, where kappa is largest)
+    mp, _, xy = _mp_catenary(0.25)
+    nodes = [xy(mp.mpf(k) / N) for k in range(N + 1)]
+    deficit = max(abs(1 - N * mp.hypot(x1 - x0, y1 - y0)) for (x0, y0), (x1, y1) in zip(nodes, nodes[1:]))
+    assert r.dataset.attrs["link_error_initial"] == pytest.approx(float(deficit), rel=1e-9, abs=0)
     exact = initial_state(0.25, N, chords="exact")
     np.testing.assert_allclose(exact.link_lengths(), 1.0 / N, rtol=1e-12)
 
@@ -297,17 +303,158 @@ def test_simulate_docstring_examples(name):
     assert result.failed == 0 and result.attempted > 0
 
 
-def test_fast_tension_solve_matches_textbook_thomas():
+def _chain_from_link_angles(theta, omega):
+    """Node positions and velocities (index 0 free end, index N the pin at the origin) of
+    links of length 1/N at angles ``theta`` turning at rates ``omega``: d_j = (cos, sin)/N,
+    d_j' = omega_j (-sin, cos)/N, so |d_j| = 1/N and d_j.d_j' = 0 hold exactly."""
+    N = theta.size
+    parts = (np.cos(theta), np.sin(theta), -omega * np.sin(theta), omega * np.cos(theta))
+    return [np.append(-np.cumsum(p[::-1] / N)[::-1], 0.0) for p in parts]
+
+
+def _tension_test_states(N):
+    """Order-1 states: the catenary start (exact chords), a bent and a hanging chain;
+    each at rest (gravity alone drives it) and with link rates ~1 (speeds ~0.5)."""
+    s = (N - np.arange(N) - 0.5) / N  # arclength of the link midpoints from the pin
+    cat = initial_state(0.25, N, chords="exact")
+    shapes = {"catenary": np.arctan2(np.diff(cat.y), np.diff(cat.x)),
+              "bent": -np.pi / 2 + 1.2 * np.sin(np.pi * s), "hanging": np.full(N, -np.pi / 2)}
+    for name, th in shapes.items():
+        for rates in ("rest", "moving"):
+            om = np.zeros(N) if rates == "rest" else 0.8 * np.cos(3 * s) + 0.3
+            yield f"{name}/{rates}", _chain_from_link_angles(th, om)
+
+
+def _kernel_solve(kernel, N, x, y, vx, vy):
     from snapping.simulate import kernels as K
 
-    for st in (initial_state(0.25, 3000), hanging_state(3000)):
-        rng = np.random.default_rng(3)
-        st.vx[:-1] = 0.3 * rng.standard_normal(st.N)
-        st.vy[:-1] = 0.3 * rng.standard_normal(st.N)
-        Z1 = st.as_array()
-        Z2 = Z1.copy()
-        w = np.zeros((4, st.N))
-        K.rhs_thomas(st.N, Z2, w[0], w[1], w[2], w[3])
-        for row in (K.RAX, K.RAY, K.RSIG):
-            scale = np.abs(Z2[row]).max()
-            assert np.abs(Z1[row] - Z2[row]).max() <= 1e-10 * scale
+    Z = np.zeros((K.NROWS, N + 1))
+    Z[K.RX], Z[K.RY], Z[K.RVX], Z[K.RVY] = x, y, vx, vy
+    w = np.zeros((4, N))
+    kernel(N, Z, w[0], w[1], w[2], w[3])
+    return Z[K.RAX, :N], Z[K.RAY, :N], Z[K.RSIG, :N]
+
+
+def test_tension_solves_match_dense_kkt_reference():
+    """Both tension solvers of kernels.py (rhs and the textbook rhs_thomas) against the
+    independent dense KKT solve of tests/reference_chain.py (m = h = 1/N, g = 1, T = sigma),
+    on order-1 states. Tensions and accelerations are O(1) here, so the tolerance
+    (1e-14 N^2: the system's condition number ~ N^2; seen <= 3.6e-10 at N = 300) is far
+    below what a 1e-6 relative change of gravity in either solver moves them (~1e-6)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import reference_chain as RC
+    from snapping.simulate import kernels as K
+
+    N = 300
+    h = np.full(N, 1.0 / N)
+    tol = 1e-14 * N * N
+    for name, (x, y, vx, vy) in _tension_test_states(N):
+        speed = np.hypot(vx, vy).max()
+        assert speed < 1.0
+        ax, ay, T = RC.dense_accelerations(x, y, vx, vy, h, h, 1.0)
+        assert 0.3 < np.abs(T).max() < 2.0, name  # order-1 tensions
+        for kernel in (K.rhs, K.rhs_thomas):
+            kax, kay, ksig = _kernel_solve(kernel, N, x, y, vx, vy)
+            for got, ref in ((ksig, T), (kax, ax), (kay, ay)):
+                np.testing.assert_allclose(got, ref, rtol=0, atol=tol, err_msg=f"{kernel.__name__} {name}")
+    # the hanging chain at rest, in closed form: T_j = (j + 1)/N, no acceleration
+    x, y, vx, vy = _chain_from_link_angles(np.full(N, -np.pi / 2), np.zeros(N))
+    for kernel in (K.rhs, K.rhs_thomas):
+        kax, kay, ksig = _kernel_solve(kernel, N, x, y, vx, vy)
+        np.testing.assert_allclose(ksig, np.arange(1, N + 1) / N, rtol=0, atol=tol)
+        assert np.abs(kax).max() < tol and np.abs(kay).max() < tol
+
+
+def test_fast_tension_solve_matches_textbook_thomas():
+    """rhs against rhs_thomas at N = 3000 on the same order-1 states (the old version of
+    this test used independent random node velocities, sigma ~ 4e5, under which a 1e-6
+    error in the gravity term passed)."""
+    from snapping.simulate import kernels as K
+
+    N = 3000
+    for name, (x, y, vx, vy) in _tension_test_states(N):
+        fast = _kernel_solve(K.rhs, N, x, y, vx, vy)
+        ref = _kernel_solve(K.rhs_thomas, N, x, y, vx, vy)
+        for a, b in zip(fast, ref):
+            # condition number ~ N^2; seen <= 1.2e-10 (hanging, moving)
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-15 * N * N, err_msg=name)
+
+
+# ---------------------------------------------------------------- the absolute energy
+def _mp_catenary(chi, dps=30):
+    """(a, y(s)) of the unit catenary in mpmath, from its definition 1 = 2 a sinh(chi/2a),
+    y(s) = sqrt(a^2 + 1/4) - sqrt(a^2 + (s - 1/2)^2), x(s) = a asinh((s - 1/2)/a) + chi/2."""
+    mp = mpmath.mp.clone()
+    mp.dps = dps
+    chi = mp.mpf(chi)
+    # in b = chi/2a: sinh(b)/b = 1/chi (monotone); start from the large-b root b ~ log(2b/chi)
+    b = mp.findroot(lambda b: mp.sinh(b) / b - 1 / chi, mp.log(2 / chi) + mp.log(mp.log(2 / chi)))
+    a = chi / (2 * b)
+    xy = lambda s: (a * mp.asinh((s - mp.mpf(1) / 2) / a) + chi / 2,  # noqa: E731
+                    mp.sqrt(a**2 + mp.mpf(1) / 4) - mp.sqrt(a**2 + (s - mp.mpf(1) / 2) ** 2))
+    return mp, a, xy
+
+
+def test_initial_energy_is_the_catenarys_potential_energy_arclength_chords():
+    """The recorded energy at t = 0 (Euler-Richardson, the paper's arclength nodes) is the
+    discrete chain's potential energy relative to hanging at rest, computed here in mpmath
+    from the catenary's closed form: E0 = sum_i m (-y_i) + sum_i m s_i with m = 1/N,
+    s_i = (N - i)/N. A constant offset of 1e-6 in the measured energy fails it. And it
+    tends to the available energy P(chi) of snapping.estimates: E0 = 1/2 + 1/(2N) - T_N[y]
+    with T_N the trapezoid sum of int y ds (y = 0 at both ends), and Euler-Maclaurin gives
+    T_N = int y ds - (h^2/12)(y'(0) - y'(1)) + ..., so (h = 1/N)
+    E0 = P + h/2 + (h^2/12)(y'(0) - y'(1)) + O(h^4), the remainder ~ exp(-2 pi a N) for
+    y analytic within a of the real axis (tiny at N = 200: a N ~ 7.7)."""
+    from snapping import estimates
+
+    chi, N = 0.25, 200
+    ds = run(chi, N, t_end=1e-4).dataset
+    assert float(ds["t"][0]) == 0.0
+    mp, a, xy = _mp_catenary(chi)
+    E0 = mp.fsum(-xy(mp.mpf(N - i) / N)[1] / N for i in range(N)) + mp.mpf(N + 1) / (2 * N)
+    assert float(ds["energy"][0]) == pytest.approx(float(E0), rel=0, abs=1e-13)
+    assert ds.attrs["energy_initial"] == pytest.approx(float(E0), rel=0, abs=1e-13)
+    # the same from the recorded node coordinates of the initial snapshot
+    snap = ds.isel(snapshot=0)
+    assert str(snap["snapshot_kind"].values) == "initial"
+    assert -float(snap["y"][:N].sum()) / N + (N + 1) / (2 * N) == pytest.approx(float(E0), abs=1e-13)
+    # Euler-Maclaurin: y'(0) - y'(1) = 1/sqrt(a^2 + 1/4)
+    h = mp.mpf(1) / N
+    em = estimates.available_energy(chi) + float(h / 2 + h**2 / (12 * mp.sqrt(a**2 + mp.mpf(1) / 4)))
+    assert float(E0) == pytest.approx(em, abs=1e-11)
+
+
+def test_initial_energy_exact_chords_and_a_general_chain():
+    """The same for the angle-form DOP853 run (exact chords 1/N, nodes walked from the pin
+    on the catenary: recomputed in mpmath here) and for a tapered chain (general kernel):
+    E0 = sum_j m_j (|v_j|^2/2 - y_j) + sum_j m_j s_j from the Problem's nodes and masses."""
+    from snapping.simulate.problem import Links, Problem
+
+    chi, N = 0.25, 20
+    ds = run(chi, N, t_end=1e-4, method="dop853", chords="exact").dataset
+    mp, a, xy = _mp_catenary(chi)
+    h = mp.mpf(1) / N
+    s, nodes = mp.mpf(0), [(mp.mpf(0), mp.mpf(0))]
+    for _ in range(N):
+        x0, y0 = nodes[-1]
+        s = mp.findroot(lambda u: mp.hypot(xy(u)[0] - x0, xy(u)[1] - y0) - h, s + h)
+        nodes.append(xy(s))
+    E0 = mp.fsum(-yv / N for _, yv in nodes[1:]) + mp.mpf(N + 1) / (2 * N)
+    assert float(ds["energy"][0]) == pytest.approx(float(E0), rel=0, abs=1e-13)
+    assert ds.attrs["energy_initial"] == pytest.approx(float(E0), rel=0, abs=1e-13)
+    # a tapered chain (equal links 1/N, masses falling to half at the free end) on the
+    # exact-chord catenary nodes, spinning rigidly about the held end (v = w e3 x r)
+    links = Links.taper(N, 0.5)
+    st = initial_state(chi, N, chords="exact")
+    w = 0.4
+    q = Problem.nodes(st.x, st.y, links=links, vx=-w * st.y, vy=w * st.x)
+    assert not q.is_paper
+    dq = run(problem=q, t_end=1e-4, method="dop853").dataset
+    m, hl = links.m, links.h
+    s_node = np.cumsum(hl[::-1])[::-1]  # arclength of node j from the held end
+    v2 = w * w * (q.x[:N] ** 2 + q.y[:N] ** 2)
+    E_ref = math.fsum(m * (v2 / 2 - q.y[:N])) + math.fsum(m * s_node)
+    assert float(dq["energy"][0]) == pytest.approx(E_ref, rel=0, abs=1e-13)

@@ -39,12 +39,32 @@ def _as_float(name: str, value) -> float:
 
 
 def real(name: str, value) -> float:
-    """Return ``value`` as a finite float, or raise naming ``name``."""
+    """Return ``value`` as a finite float, or raise naming ``name``.
+
+    >>> real("t", 3)
+    3.0
+    >>> real("t", float("nan"))
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: t=nan must be a finite real number
+    >>> real("t", True)          # a bool is not a number here
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: t=True is not a real number (expected a finite float)
+    """
     return _as_float(name, value)
 
 
 def positive(name: str, value) -> float:
-    """Return ``value`` as a float in (0, inf), or raise naming ``name``."""
+    """Return ``value`` as a float in (0, inf), or raise naming ``name``.
+
+    >>> positive("tol", 1e-8)
+    1e-08
+    >>> positive("tol", 0)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: tol=0.0 is out of range: must be > 0
+    """
     x = _as_float(name, value)
     if not x > 0.0:
         raise SnappingInputError(f"{name}={x!r} is out of range: must be > 0")
@@ -52,7 +72,15 @@ def positive(name: str, value) -> float:
 
 
 def open_interval(name: str, value, lo: float, hi: float) -> float:
-    """Return ``value`` as a float in the open interval (lo, hi), or raise naming ``name``."""
+    """Return ``value`` as a float in the open interval (lo, hi), or raise naming ``name``.
+
+    >>> open_interval("chi", 0.25, 0.0, 1.0)
+    0.25
+    >>> open_interval("chi", 1.0, 0.0, 1.0)      # the end points are excluded
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: chi=1.0 is out of range: must lie in the open interval (0, 1)
+    """
     x = _as_float(name, value)
     if not lo < x < hi:
         raise SnappingInputError(f"{name}={x!r} is out of range: must lie in the open interval ({lo:g}, {hi:g})")
@@ -60,7 +88,19 @@ def open_interval(name: str, value, lo: float, hi: float) -> float:
 
 
 def integer(name: str, value, minimum: int = 1, maximum: int | None = None) -> int:
-    """Return ``value`` as an int in [minimum, maximum], or raise naming ``name``."""
+    """Return ``value`` as an int in [minimum, maximum], or raise naming ``name``.
+
+    >>> integer("N", 200.0)       # an integral float is accepted
+    200
+    >>> integer("N", 2.5)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: N=2.5 is not an integer
+    >>> integer("levels", 9, 1, 8)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: levels=9 is out of range: must be an integer in [1, 8]
+    """
     if isinstance(value, bool):
         raise SnappingInputError(f"{name}={value!r} is not an integer")
     if isinstance(value, numbers.Integral):
@@ -81,7 +121,15 @@ def _short(value) -> str:
 
 
 def float_array(name: str, value):
-    """Return ``value`` as a float ndarray, or raise naming ``name`` (strings, objects, ragged lists)."""
+    """Return ``value`` as a float ndarray, or raise naming ``name`` (strings, objects, ragged lists).
+
+    >>> float_array("s", [0, 0.5, 1])
+    array([0. , 0.5, 1. ])
+    >>> float_array("s", [[0.0, 1.0], [2.0]])
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: s=[[0.0, 1.0], [2.0]] is not an array of real numbers
+    """
     import numpy as np
 
     if isinstance(value, (str, bytes, dict)):
@@ -93,7 +141,15 @@ def float_array(name: str, value):
 
 
 def file_path(name: str, value) -> str:
-    """Return ``value`` as a non-empty path string, or raise naming ``name``."""
+    """Return ``value`` as a non-empty path string, or raise naming ``name``.
+
+    >>> file_path("output", "run.nc")
+    'run.nc'
+    >>> file_path("output", "")
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: output='' is not a file path
+    """
     import os
 
     if isinstance(value, bytes) or not isinstance(value, (str, os.PathLike)):

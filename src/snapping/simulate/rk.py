@@ -27,6 +27,25 @@ interpolated state; accelerations and tensions there from a tension solve). The 
 Cost: 12 right-hand-side evaluations per attempted step (first same as last), 3 more
 for the dense output of a step where it is needed, 1 per point of a peak search; all
 are counted in ``n_rhs``.
+
+Example: one step of this module's tableau (:func:`_stage_state`, :func:`end_state`)
+on dy/dt = y, y(0) = 1, against exp(h). An 8th-order method has a local error
+~ C h^9, so halving the step divides the error by about 2^9:
+
+>>> import math
+>>> def step(h):
+...     y0, K, tmp, y1 = np.ones(1), np.zeros((NSX, 1)), np.zeros(1), np.zeros(1)
+...     K[0] = y0                               # f(y) = y
+...     for st in range(1, NS):
+...         _stage_state(1, st, h, y0, K, tmp)
+...         K[st] = tmp
+...     end_state(1, h, y0, K, y1)
+...     return y1[0]
+>>> err = [abs(float(step(h)) - math.exp(h)) for h in (0.8, 0.4)]
+>>> round(math.log2(err[0] / err[1]))
+9
+>>> err[1] < 1e-10
+True
 """
 
 from __future__ import annotations
