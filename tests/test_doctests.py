@@ -5,7 +5,8 @@ import importlib
 
 import pytest
 
-MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", "snapping.ideal", "snapping._validate"]
+MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
+           "snapping._files"]
 
 
 @pytest.mark.parametrize("name", MODULES)
