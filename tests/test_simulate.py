@@ -382,3 +382,9 @@ def test_cli_snapshot_times_need_an_output_file(tmp_path, capsys):
     assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "0.1",
                  "-o", str(path), "--no-progress"]) == 0
     assert list(load_run(path)["snapshot_kind"].values).count("requested") == 1
+
+
+def test_cli_a_general_problem_has_no_chi_and_is_no_error(capsys):
+    assert main(["simulate", "--supports", "0.4,0.2", "--N", "5", "--method", "fast", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["chi"] is None and js["start"] == "supports" and js["snap_reached"] is True

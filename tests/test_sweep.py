@@ -349,3 +349,62 @@ def test_combine_refuses_runs_of_different_methods_or_tolerances(tmp_path):
         S.combine(a + c)
     comb = S.combine(a)
     assert comb.attrs["method"] == "euler-richardson" and comb.attrs["tol"] == 1e-7
+
+
+def test_combined_runs_that_ended_before_the_snap_say_so(tmp_path, capsys):
+    grid = S.Grid(chi=[0.5], N=[6, 8], options={"tol": 1e-6, "t_end": 0.05})
+    comb = S.combine(S.run_sweep(grid, tmp_path, workers=1, progress=False))
+    assert (comb["snap_reached"] == 0).all() and comb["t_snap_v"].isnull().all()
+    assert (comb["v_peak"] > 0).all()  # the maxima over the run are kept
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("to_group", [True, False], ids=["ctrl-c", "sigint-to-the-sweep-alone"])
+def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_path, to_group):
+    """SIGINT to the process group (Ctrl-C) or to the sweep alone: exit 130 with one line, no
+    traceback, the queued runs not started, the runs in progress saved resumable, no worker left."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import snapping
+
+    pid_file, out = tmp_path / "pids", tmp_path / "out"
+    env = {**os.environ, S._WORKER_PID_FILE_ENV: str(pid_file),
+           "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    # the CLI's sweep, with runs that checkpoint every 0.5 s (to see them under way) and last ~1 min
+    script = ("import sys\nfrom snapping import sweep as S\nfrom snapping.cli import main\nG = S.Grid\n"
+              "S.Grid = lambda chi, N, options: G(chi, N, {**options, 't_end': 60.0, 'checkpoint_every': 0.5})\n"
+              f"sys.exit(main(['sweep', '--chi', '0.3,0.4,0.5,0.6', '--N', '200', '--method', 'fast', '--workers', "
+              f"'2', '-o', {str(out)!r}]))\n")
+    cmd = [sys.executable, "-c", script]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    pids = []
+    try:
+        deadline = time.monotonic() + 120
+        while len(pids) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+            pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+        assert len(pids) == 2, f"the workers did not start ({pids})"
+        while len(list(out.glob("run_*.nc"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # until both runs are under way (their first checkpoints)
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        t0 = time.monotonic()
+        (os.killpg if to_group else os.kill)(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        elapsed = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for p in pids:
+            if _alive(p):
+                os.kill(p, signal.SIGKILL)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and err.strip().count("\n") == 0 and "interrupted" in err
+    assert elapsed < 20.0  # the runs take a minute each: the queued ones were not run
+    statuses = [str(simulate.load_run(p).attrs["status"]) for p in sorted(out.glob("run_*.nc"))]
+    assert statuses == ["interrupted", "interrupted"]  # the two in progress, resumable; the others not started
+    assert not [p for p in pids if _alive(p)]

@@ -566,7 +566,7 @@ def _cmd_sweep(args) -> int:
                       f"{r.get('a_peak', float('nan')):>11.5g} {r.get('sigma_peak', float('nan')):>11.5g} "
                       f"{t_snap:>10}")
             if any(not r["snap_reached"] for r in rows):
-                print("  no snap: the run ended (t_end) before the snap; its peaks are maxima over the run")
+                print("  no snap: the run ended before the snap (see its snap_note); its peaks are maxima over the run")
         else:
             print(f"no run of the sweep completed; nothing combined in {args.output}")
     if failed is not None:

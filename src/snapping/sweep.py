@@ -232,6 +232,9 @@ def _run_task(task: list) -> list:
     completed, else a dict (``kind``, ``message``, ``file``, see :func:`_failure_of`).
     A run that fails numerically, or on an input that is only refused at run time,
     does not end the task: every other member is still run and saved."""
+    if _STOP is not None and _STOP.is_set():  # the sweep was interrupted: start nothing new
+        return [{"kind": "cancelled", "message": "not started: the sweep was interrupted", "file": None}
+                for _ in task]
     if len(task) == 1:
         params, path = task[0]
         try:
@@ -262,16 +265,34 @@ def _run_task(task: list) -> list:
     return out
 
 
-def _watch_parent(parent_pid: int, interval: float = 0.2, grace: float = 3.0) -> None:
-    """Initializer of the local worker processes: a daemon thread that notices when the
-    sweep's process is gone (the worker has been re-parented: ``os.getppid()`` changed,
-    e.g. after a SIGKILL of the sweep) and ends this worker. It first sends itself
-    SIGTERM, so that a run in progress stops at a step boundary and saves its checkpoint
-    (a rerun of the sweep resumes it), and exits for good after ``grace`` seconds."""
+#: set in a local worker process: the sweep's "stop" event (set when the sweep is interrupted)
+_STOP = None
+
+
+def _worker_init(parent_pid: int, stop=None, interval: float = 0.2, grace: float = 3.0) -> None:
+    """Initializer of the local worker processes.
+
+    * SIGINT is ignored between runs: a Ctrl-C reaches the whole process group, and a
+      worker waiting for its next task must not print a ``KeyboardInterrupt``
+      traceback; a run in progress still stops at a step boundary and saves its
+      checkpoint (the driver installs its own handler while it runs).
+    * ``stop`` (an event the sweep sets when interrupted) makes the worker skip the
+      tasks still queued for it, and stops a run in progress at its next step boundary,
+      saved with its checkpoint, as SIGINT would (through the driver's chunk hook), so
+      that an interrupted sweep ends promptly whenever the signal reached the worker.
+    * A daemon thread notices when the sweep's process is gone (the worker has been
+      re-parented: ``os.getppid()`` changed, e.g. after a SIGKILL of the sweep) and
+      ends this worker: it first sends itself SIGTERM, so that a run in progress stops
+      at a step boundary and saves its checkpoint (a rerun of the sweep resumes it),
+      and exits for good after ``grace`` seconds.
+    """
     import signal
     import threading
     import time
 
+    global _STOP
+    _STOP = stop
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     pid_file = os.environ.get(_WORKER_PID_FILE_ENV)
     if pid_file:
         with open(pid_file, "a") as fh:
@@ -287,6 +308,10 @@ def _watch_parent(parent_pid: int, interval: float = 0.2, grace: float = 3.0) ->
             os._exit(1)
 
     threading.Thread(target=watch, name="snapping-sweep-parent-watchdog", daemon=True).start()
+    if stop is not None:
+        from .simulate import driver
+
+        driver._chunk_hook = lambda eng: signal.SIGINT if stop.is_set() else None
 
 
 def _check_out_dir(out_dir) -> Path:
@@ -393,11 +418,23 @@ class SweepFailed(RuntimeError):
 
 
 def _local_pool(n: int):
-    """``n`` local worker processes (spawned) that end themselves if this process dies."""
+    """``n`` local worker processes (spawned) that end themselves if this process dies,
+    and the event that tells them to start no further task (:func:`_worker_init`)."""
     import multiprocessing as mp
 
-    return ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context("spawn"), initializer=_watch_parent,
-                               initargs=(os.getpid(),))
+    ctx = mp.get_context("spawn")
+    stop = ctx.Event()
+    return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init,
+                               initargs=(os.getpid(), stop)), stop
+
+
+def _stop_pool(stop, futures) -> None:
+    """The sweep was interrupted: no queued task starts, and every run in progress
+    stops at a step boundary and saves its checkpoint (:func:`_worker_init`), whether
+    the SIGINT reached the workers too (Ctrl-C) or this process alone."""
+    stop.set()
+    for fut in futures:
+        fut.cancel()
 
 
 def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True,
@@ -475,10 +512,14 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
             from dask.distributed import as_completed as dask_completed
 
             client, owned = _client_for(scheduler)
+            futures = {}
             try:
                 futures = {client.submit(_run_task, task, pure=False): task for task in tasks}
                 for fut in dask_completed(futures):
                     collect(futures[fut], fut.result)
+            except BaseException:  # interrupted: the runs not done are not left running on the cluster
+                client.cancel(list(futures))
+                raise
             finally:
                 if owned:
                     client.close()
@@ -488,10 +529,17 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
                 for task in tasks:
                     collect(task, lambda task=task: _run_task(task))
             else:
-                with _local_pool(n) as pool:
+                pool, stop = _local_pool(n)
+                futures = {}
+                try:
                     futures = {pool.submit(_run_task, task): task for task in tasks}
                     for fut in as_completed(futures):
                         collect(futures[fut], fut.result)
+                except BaseException:  # SIGINT: stop promptly, the runs in progress saved
+                    _stop_pool(stop, futures)
+                    raise
+                finally:
+                    pool.shutdown(wait=True, cancel_futures=True)
     finally:
         bar.close()
     paths = grid.paths(out)

@@ -78,6 +78,8 @@ def summary(ds: xr.Dataset) -> dict:
         if k in ds.attrs:
             v = ds.attrs[k]
             out[k] = v.item() if isinstance(v, np.generic) else v
+    if isinstance(out.get("chi"), float) and np.isnan(out["chi"]):
+        out["chi"] = None  # a general problem's start is not a catenary of some chi ('start' says what it is)
     if "snap_reached" in out:
         out["snap_reached"] = bool(out["snap_reached"])
         for k in SNAP_TIMES:
