@@ -408,3 +408,17 @@ def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_pat
     statuses = [str(simulate.load_run(p).attrs["status"]) for p in sorted(out.glob("run_*.nc"))]
     assert statuses == ["interrupted", "interrupted"]  # the two in progress, resumable; the others not started
     assert not [p for p in pids if _alive(p)]
+
+
+def test_cli_reproduce_with_failed_runs_prints_the_table_and_exits_1(tmp_path, capsys, monkeypatch):
+    import snapping.reproduce as R
+    from snapping.cli import main
+
+    def failing(*a, **k):
+        raise S.SweepFailed([S.RunFailure(0.1, 2000, {"tol": 1e-8}, "step_size", "time-step underflow at t=1.2",
+                                          str(tmp_path / "run.nc"))], [], 5)
+
+    monkeypatch.setattr(R, "reproduce", failing)
+    assert main(["reproduce", "--quick", "-o", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "1 of the runs failed" in err and "step_size" in err and "2000" in err

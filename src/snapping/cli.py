@@ -665,9 +665,16 @@ def _add_reproduce(sub) -> None:
 
 def _cmd_reproduce(args) -> int:
     from .reproduce import reproduce
+    from .sweep import SweepFailed
 
-    report = reproduce(args.output, args.mode, workers=args.workers, progress=sys.stderr.isatty(),
-                       log=lambda msg: print(msg, file=sys.stderr))
+    try:
+        report = reproduce(args.output, args.mode, workers=args.workers, progress=sys.stderr.isatty(),
+                           log=lambda msg: print(msg, file=sys.stderr))
+    except SweepFailed as exc:  # some runs failed: which and why, no traceback
+        print(f"snapping reproduce: error: {len(exc.failures)} of the runs failed (the others are saved; rerun "
+              f"the same command to retry only the failed ones):", file=sys.stderr)
+        print(exc.table(), file=sys.stderr)
+        return 1
     print(report.read_text().split("## Fit report")[0].rstrip())
     print(f"\nfull report: {report}")
     return 0
