@@ -24,6 +24,7 @@ from snapping.simulate import (
     load_run,
     rerun,
     run,
+    summary,
 )
 
 T_STAR = float(2 * mpmath.ellipe(mpmath.pi / 4, 2))  # ideal snapping time 2E(pi/4|2)
@@ -458,3 +459,79 @@ def test_initial_energy_exact_chords_and_a_general_chain():
     v2 = w * w * (q.x[:N] ** 2 + q.y[:N] ** 2)
     E_ref = math.fsum(m * (v2 / 2 - q.y[:N])) + math.fsum(m * s_node)
     assert float(dq["energy"][0]) == pytest.approx(E_ref, rel=0, abs=1e-13)
+
+
+# ---------------------------------------------------------------- results claim only what was computed
+@pytest.mark.parametrize("method", ["euler-richardson", "fast"])
+def test_a_run_ended_by_t_end_before_the_snap_has_no_snapping_time(method):
+    auto = run(0.5, 10, method=method).dataset.attrs
+    assert auto["snap_reached"] == 1 and auto["snap_note"] == ""
+    assert all(0 < auto[k] < auto["t_final"] for k in ("t_snap_v", "t_snap_a", "t_snap_sigma"))
+    early = run(0.5, 10, method=method, t_end=0.5).dataset.attrs  # the snap is near t = 1.15
+    assert early["snap_reached"] == 0 and early["status"] == "completed"
+    assert all(math.isnan(early[k]) for k in ("t_snap_v", "t_snap_a", "t_snap_sigma"))
+    assert "ended at t=0.5 before the snap" in early["snap_note"] and "stop_fraction=0.5" in early["snap_note"]
+    assert 0 < early["v_peak"] < auto["v_peak"]  # kept: the maximum over the run
+    s = summary(run(0.5, 10, method=method, t_end=0.5).dataset)
+    assert s["snap_reached"] is False and s["t_snap_v"] is None and s["t_snap_a"] is None
+    assert "maxima over the run" in s["peaks"] and s["snap_note"] == early["snap_note"]
+    # run on past the fall of v_max below stop_fraction of its peak: the same snap as the automatic run
+    late = run(0.5, 10, method=method, t_end=auto["t_final"] + 0.05).dataset.attrs
+    assert late["snap_reached"] == 1 and late["t_snap_v"] == auto["t_snap_v"]
+    # a larger stop_fraction accepts a smaller fall after the peak
+    between = dict(method=method, t_end=0.5 * (auto["t_snap_v"] + auto["t_final"]))
+    assert run(0.5, 10, **between).dataset.attrs["snap_reached"] == 0
+    assert run(0.5, 10, stop_fraction=0.95, **between).dataset.attrs["snap_reached"] == 1
+
+
+def test_a_run_that_fails_before_the_snap_has_no_snapping_time():
+    with pytest.raises(SimulationError) as info:
+        run(0.1, 40, method="fast", dt_min=3e-4)
+    a = info.value.dataset.attrs
+    assert a["status"] == "failed" and a["snap_reached"] == 0 and math.isnan(a["t_snap_v"])
+    assert "failed at t=" in a["snap_note"]
+
+
+def test_cli_says_when_the_snap_was_not_reached(capsys):
+    assert main(["simulate", "--chi", "0.5", "--N", "10", "--t-end", "0.5", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "t_snap_v" in out and "absent  no snap reached" in out
+    assert "maximum over the run, not a snap peak" in out and "note: the run ended at t=0.5 before the snap" in out
+    assert "nan" not in out.lower()
+    assert main(["simulate", "--chi", "0.5", "--N", "10", "--t-end", "0.5", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["t_snap_v"] is None and js["snap_reached"] is False and "before the snap" in js["snap_note"]
+    assert main(["simulate", "--chi", "0.5", "--N", "10", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["snap_reached"] is True and js["t_snap_v"] > 1 and "snap_note" not in js
+
+
+def test_cli_non_finite_results_are_an_error_not_null(capsys, monkeypatch):
+    import snapping.simulate.dataset as D
+
+    real = D.summary
+    monkeypatch.setattr(D, "summary", lambda ds: {**real(ds), "energy_drift": float("inf"), "v_peak": float("nan")})
+    for extra in ([], ["--json"]):
+        assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.05", *extra]) == 1
+        cap = capsys.readouterr()
+        assert cap.out == ""
+        assert cap.err.count("\n") == 1 and "non-finite result" in cap.err
+        assert "v_peak=nan" in cap.err and "energy_drift=inf" in cap.err
+
+
+def test_cli_snapshot_times_need_an_output_file(tmp_path, capsys):
+    assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert "without -o RUN.nc" in err and err.count("\n") == 1
+    assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "nan"]) == 2
+    assert "snapshot_times=nan" in capsys.readouterr().err  # a bad time is named first
+    path = tmp_path / "r.nc"
+    assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "0.1",
+                 "-o", str(path), "--no-progress"]) == 0
+    assert list(load_run(path)["snapshot_kind"].values).count("requested") == 1
+
+
+def test_cli_a_general_problem_has_no_chi_and_is_no_error(capsys):
+    assert main(["simulate", "--supports", "0.4,0.2", "--N", "5", "--method", "fast", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["chi"] is None and js["start"] == "supports" and js["snap_reached"] is True

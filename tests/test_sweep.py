@@ -149,6 +149,276 @@ def test_ensemble_sweep_bad_options(tmp_path):
 def test_ensemble_sweep_with_a_failing_member_keeps_the_other(tmp_path):
     # chi = 0.1 needs steps below dt_min = 3e-4 at N = 40, chi = 0.5 does not
     grid = S.Grid(chi=[0.1, 0.5], N=[40], options={"method": "fast", "dt_min": 3e-4})
-    with pytest.raises(RuntimeError, match=r"1 of 2 runs failed \(chi=0.1,0.5 N=40: ensemble members failed: chi=0.1"):
+    with pytest.raises(RuntimeError, match=r"1 of 2 runs failed \(chi=0.1 N=40: step_size: time-step underflow") as info:
         S.run_sweep(grid, tmp_path, workers=1, ensemble=2, progress=False)
+    _check_one_step_size_failure(info.value, grid, tmp_path)  # each member named, with its own failure
     assert S.is_complete_run(grid.path(tmp_path, 0.5, 40)) and not S.is_complete_run(grid.path(tmp_path, 0.1, 40))
+
+
+# ---------------------------------------------------------------- failed runs, killed sweeps, combine
+FAILING = {"method": "fast", "dt_min": 3e-4}  # chi = 0.1 needs steps below 3e-4 at N = 40, chi = 0.5 does not
+
+
+def _check_one_step_size_failure(exc, grid, out):
+    assert isinstance(exc, S.SweepFailed) and isinstance(exc, RuntimeError)
+    assert exc.n_runs == 2 and len(exc.failures) == 1
+    f = exc.failures[0]
+    assert (f.chi, f.N, f.kind) == (0.1, 40, "step_size") and f.options == grid.options
+    assert "time-step underflow" in f.message and "\n" not in f.message
+    # the failed run's partial file is named, and is what was computed until the failure
+    assert f.file == str(grid.path(out, 0.1, 40)) and simulate.load_run(f.file).attrs["status"] == "failed"
+    # every other run completed and was saved; they combine
+    assert exc.paths == [grid.path(out, 0.5, 40)] and S.is_complete_run(exc.paths[0])
+    comb = S.combine(exc.paths)
+    assert list(comb["chi"].values) == [0.5] and comb.attrs["method"] == "dop853"
+    table = exc.table()
+    assert "step_size" in table and f.file in table and "dt_min=0.0003" in table and "0.1" in table
+
+
+def test_failed_runs_on_local_workers_are_reported_and_the_others_saved(tmp_path):
+    grid = S.Grid(chi=[0.1, 0.5], N=[40], options=FAILING)
+    with pytest.raises(S.SweepFailed, match=r"1 of 2 runs failed \(chi=0.1 N=40: step_size: time-step underflow") as info:
+        S.run_sweep(grid, tmp_path, workers=2, progress=False)
+    _check_one_step_size_failure(info.value, grid, tmp_path)
+
+
+def test_failed_runs_on_dask_are_reported_and_the_others_saved(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    grid = S.Grid(chi=[0.1, 0.5], N=[40], options=FAILING)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cl:
+        with distributed.Client(cl) as client:
+            with pytest.raises(S.SweepFailed) as info:
+                S.run_sweep(grid, tmp_path, scheduler=client, progress=False)
+    _check_one_step_size_failure(info.value, grid, tmp_path)
+
+
+def test_a_run_time_refusal_and_a_crash_are_reported_with_their_kind(tmp_path, monkeypatch):
+    grid = S.Grid(chi=[0.3, 0.4, 0.5], N=[6], options=OPTS)
+    real = S._run_one
+
+    def fake(params, path):
+        if params["chi"] == 0.3:
+            raise SnappingInputError("tol=1e-07 is refused at run time\nsecond line")
+        if params["chi"] == 0.4:
+            raise MemoryError("out of memory")
+        return real(params, path)
+
+    monkeypatch.setattr(S, "_run_one", fake)
+    with pytest.raises(S.SweepFailed) as info:
+        S.run_sweep(grid, tmp_path, workers=1, progress=False)
+    kinds = [(f.chi, f.kind, f.message, f.file) for f in info.value.failures]
+    assert kinds == [(0.3, "SnappingInputError", "tol=1e-07 is refused at run time", None),
+                     (0.4, "MemoryError", "out of memory", None)]
+    assert info.value.paths == [grid.path(tmp_path, 0.5, 6)]
+
+
+def test_cli_sweep_with_a_failed_run_prints_the_table_and_exits_1(tmp_path, capsys, monkeypatch):
+    from snapping.cli import main
+
+    real = S._run_one
+    monkeypatch.setattr(S, "_run_one", lambda params, path: real({**params, "dt_min": 3e-4}, path))
+    argv = ["sweep", "--chi", "0.1,0.5", "--N", "40", "--method", "fast", "--workers", "1", "-o", str(tmp_path)]
+    assert main(argv) == 1
+    cap = capsys.readouterr()
+    assert "Traceback" not in cap.err and "1 of 2 runs failed" in cap.err
+    assert "step_size" in cap.err and "run_chi0.1_N40" in cap.err and "time-step underflow" in cap.err
+    assert "1 runs in" in cap.out and "0.5" in cap.out  # the finished run is combined and shown
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "sweep.nc") as sw:
+        assert list(sw["chi"].values) == [0.5]
+    assert main(argv + ["--json"]) == 1
+    import json
+
+    out = json.loads(capsys.readouterr().out)
+    assert [r["chi"] for r in out["runs"]] == [0.5]
+    assert out["failed"][0]["kind"] == "step_size" and out["failed"][0]["chi"] == 0.1
+
+
+def test_cli_sweep_sigint_prints_a_message_and_exits_130(tmp_path, capsys, monkeypatch):
+    from snapping.cli import main
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(S, "run_sweep", interrupted)
+    assert main(["sweep", "--chi", "0.5", "--N", "6", "-o", str(tmp_path)]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted" in err and "resume" in err and "Traceback" not in err
+
+
+def _alive(pid: int) -> bool:
+    """pid is a live (not zombie) process."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _children(pid: int) -> list[int]:
+    """Pids of the live child processes of pid (scanning /proc)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                stat = (d / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(stat[1]) == pid and stat[0] != "Z":
+                out.append(int(d.name))
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+def test_a_killed_sweep_leaves_no_worker_processes(tmp_path):
+    """SIGKILL the sweep's process while 2 workers run: the workers notice and end."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import snapping
+
+    pid_file = tmp_path / "pids"
+    out = tmp_path / "out"
+    script = ("from snapping import sweep as S\n"
+              "g = S.Grid(chi=[0.3, 0.4, 0.5, 0.6], N=[200], options={'method': 'fast', 't_end': 60.0})\n"
+              f"S.run_sweep(g, {str(out)!r}, workers=2, progress=False)\n")
+    env = {**os.environ, S._WORKER_PID_FILE_ENV: str(pid_file),
+           "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.Popen([sys.executable, "-c", script], env=env)
+    pids = []
+    try:
+        deadline = time.monotonic() + 120
+        while len(pids) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+            pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
+        time.sleep(3.0)  # the runs are under way
+        assert proc.poll() is None, "the sweep ended before it could be killed"
+        children = _children(proc.pid)  # the workers and multiprocessing's resource tracker
+        assert set(pids) <= set(children)
+        pids = sorted(set(pids) | set(children))
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+        t0 = time.monotonic()
+        while any(_alive(p) for p in pids) and time.monotonic() - t0 < 10.0:
+            time.sleep(0.1)
+        left = [p for p in pids if _alive(p)]
+        assert not left, f"processes {left} of the sweep outlived it by 10 s"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for p in pids:  # never leave them behind, even when the test fails
+            if _alive(p):
+                os.kill(p, signal.SIGKILL)
+
+
+def test_combine_refuses_what_is_not_a_run(tmp_path):
+    import xarray as xr
+
+    grid = S.Grid(chi=[0.5], N=[6], options=OPTS)
+    paths = S.run_sweep(grid, tmp_path, workers=1, progress=False)
+    with pytest.raises(SnappingInputError, match=r"paths\[0\] \(a Dataset\) is not a snapping run"):
+        S.combine([xr.Dataset({"x": ("a", [1.0, 2.0])})])
+    with pytest.raises(SnappingInputError, match="must be a list of run files"):
+        S.combine(simulate.load_run(paths[0]))
+    sweep_file = S.atomic_to_netcdf(S.combine(paths), tmp_path / "sweep.nc")
+    with pytest.raises(SnappingInputError, match="not a snapping run file"):
+        S.combine([sweep_file])
+    ds = simulate.load_run(paths[0])
+    ds.attrs["status"] = "failed"
+    with pytest.raises(SnappingInputError, match=r"not a completed run \(status='failed'"):
+        S.combine([ds])
+    del ds.attrs["chi"]
+    with pytest.raises(SnappingInputError, match="attribute 'chi' is missing"):
+        S.combine([ds])
+    assert float(S.combine([simulate.load_run(paths[0])])["v_peak"].squeeze()) > 0  # a run Dataset itself is fine
+
+
+def test_combine_refuses_runs_of_different_methods_or_tolerances(tmp_path):
+    a = S.run_sweep(S.Grid(chi=[0.5], N=[6], options={"tol": 1e-7}), tmp_path, workers=1, progress=False)
+    b = S.run_sweep(S.Grid(chi=[0.4], N=[6], options={"tol": 1e-7, "method": "fast"}), tmp_path, workers=1,
+                    progress=False)
+    c = S.run_sweep(S.Grid(chi=[0.5], N=[8], options={"tol": 1e-6}), tmp_path, workers=1, progress=False)
+    with pytest.raises(SnappingInputError, match=r"different method.*'euler-richardson'.*'dop853'"):
+        S.combine(a + b)
+    with pytest.raises(SnappingInputError, match=r"different tol"):
+        S.combine(a + c)
+    comb = S.combine(a)
+    assert comb.attrs["method"] == "euler-richardson" and comb.attrs["tol"] == 1e-7
+
+
+def test_combined_runs_that_ended_before_the_snap_say_so(tmp_path, capsys):
+    grid = S.Grid(chi=[0.5], N=[6, 8], options={"tol": 1e-6, "t_end": 0.05})
+    comb = S.combine(S.run_sweep(grid, tmp_path, workers=1, progress=False))
+    assert (comb["snap_reached"] == 0).all() and comb["t_snap_v"].isnull().all()
+    assert (comb["v_peak"] > 0).all()  # the maxima over the run are kept
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("to_group", [True, False], ids=["ctrl-c", "sigint-to-the-sweep-alone"])
+def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_path, to_group):
+    """SIGINT to the process group (Ctrl-C) or to the sweep alone: exit 130 with one line, no
+    traceback, the queued runs not started, the runs in progress saved resumable, no worker left."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import snapping
+
+    pid_file, out = tmp_path / "pids", tmp_path / "out"
+    env = {**os.environ, S._WORKER_PID_FILE_ENV: str(pid_file),
+           "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    # the CLI's sweep, with runs that checkpoint every 0.5 s (to see them under way) and last ~1 min
+    script = ("import sys\nfrom snapping import sweep as S\nfrom snapping.cli import main\nG = S.Grid\n"
+              "S.Grid = lambda chi, N, options: G(chi, N, {**options, 't_end': 60.0, 'checkpoint_every': 0.5})\n"
+              f"sys.exit(main(['sweep', '--chi', '0.3,0.4,0.5,0.6', '--N', '200', '--method', 'fast', '--workers', "
+              f"'2', '-o', {str(out)!r}]))\n")
+    cmd = [sys.executable, "-c", script]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    pids = []
+    try:
+        deadline = time.monotonic() + 120
+        while len(pids) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+            pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+        assert len(pids) == 2, f"the workers did not start ({pids})"
+        while len(list(out.glob("run_*.nc"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # until both runs are under way (their first checkpoints)
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        t0 = time.monotonic()
+        (os.killpg if to_group else os.kill)(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        elapsed = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for p in pids:
+            if _alive(p):
+                os.kill(p, signal.SIGKILL)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and err.strip().count("\n") == 0 and "interrupted" in err
+    assert elapsed < 20.0  # the runs take a minute each: the queued ones were not run
+    statuses = [str(simulate.load_run(p).attrs["status"]) for p in sorted(out.glob("run_*.nc"))]
+    assert statuses == ["interrupted", "interrupted"]  # the two in progress, resumable; the others not started
+    assert not [p for p in pids if _alive(p)]
+
+
+def test_cli_reproduce_with_failed_runs_prints_the_table_and_exits_1(tmp_path, capsys, monkeypatch):
+    import snapping.reproduce as R
+    from snapping.cli import main
+
+    def failing(*a, **k):
+        raise S.SweepFailed([S.RunFailure(0.1, 2000, {"tol": 1e-8}, "step_size", "time-step underflow at t=1.2",
+                                          str(tmp_path / "run.nc"))], [], 5)
+
+    monkeypatch.setattr(R, "reproduce", failing)
+    assert main(["reproduce", "--quick", "-o", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "1 of the runs failed" in err and "step_size" in err and "2000" in err

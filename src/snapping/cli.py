@@ -56,6 +56,28 @@ def print_json(obj) -> None:
     print(json.dumps(clean(obj), default=_json_default, indent=2))
 
 
+def _nonfinite(obj, path: str = "") -> list[str]:
+    """``name=value`` of every NaN or infinite number in ``obj`` (nested dicts and lists);
+    None (a value deliberately absent) is not one."""
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return [b for k, v in obj.items() for b in _nonfinite(v, f"{path}.{k}" if path else str(k))]
+    if isinstance(obj, (list, tuple)):
+        return [b for i, v in enumerate(obj) for b in _nonfinite(v, f"{path}[{i}]")]
+    if isinstance(obj, (float, np.floating)) and not math.isfinite(float(obj)):
+        return [f"{path}={float(obj)!r}"]
+    return []
+
+
+def _nonfinite_error(command: str, bad: list[str], where: str = "") -> int:
+    """Print the one-line error of results that are not finite numbers; exit status 1."""
+    more = f" and {len(bad) - 3} more" if len(bad) > 3 else ""
+    print(f"snapping {command}: error: non-finite result {', '.join(bad[:3])}{more}: the computation overflowed "
+          f"or is undefined at these inputs, so there is no result to print{where}", file=sys.stderr)
+    return 1
+
+
 def print_table(rows, title: str | None = None) -> None:
     """Print (name, value, unit/comment) rows as an aligned table."""
     if title:
@@ -177,7 +199,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
             "  snapping simulate --chi 0.1 --N 5000 --method fast --chords exact\n"
             "  snapping simulate --chi 0.25 --N 2000 --tol 1e-8 --json\n"
-            "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2\n"
+            "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2 -o run.nc\n"
             "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
             "\n"
             "other chains, starts and held ends (method fast; every option is nondimensional:\n"
@@ -258,6 +280,12 @@ def _cmd_simulate(args) -> int:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
+    if times and args.output is None:  # the snapshots are profiles: only a run file holds them
+        from .simulate.options import _times
+
+        _times(times)  # a bad time is named first
+        raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} without -o RUN.nc: the snapshots are "
+                                 f"profiles kept only in the run file; add -o RUN.nc (or leave out --snapshot-times)")
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
     if args.resume is None and (not start_given or args.N is None):
@@ -304,16 +332,33 @@ def _cmd_simulate(args) -> int:
         summary, failed = simulate.summary(exc.dataset), exc
     if args.output:
         summary["output"] = args.output
+    bad = _nonfinite(summary)
+    if bad and failed is None:  # a completed run whose results are not numbers: not a result
+        where = f" (the run file is {args.output})" if args.output else ""
+        return _nonfinite_error("simulate", bad, where)
+    reached = summary.get("snap_reached", True)
     if args.json:
         print_json(summary)
     else:
         units = {"wall_time": "s"}
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
+        rows = []
+        for k, v in summary.items():
+            if k in ("snap_note", "peaks"):
+                continue
+            note = units.get(k)
+            if v is None and k in precise:
+                v, note = "absent", ("no snap reached" if not reached else "its peak is at the run's last step")
+            elif k in ("v_peak", "a_peak", "sigma_peak", "kappa_peak") and not reached:
+                note = "maximum over the run, not a snap peak"
+            rows.append((k, f"{v:.10g}" if k in precise and isinstance(v, float) else v, note))
         print_table(
-            [(k, f"{v:.10g}" if k in precise and isinstance(v, float) else v, units.get(k)) for k, v in summary.items()],
+            rows,
             title=f"snapping simulate: chi={args.chi:g}, N={args.N}" if problem is None else
             f"snapping simulate: N={args.N}, {_problem_title(summary)}",
         )
+        if not reached and summary.get("snap_note"):
+            print(f"  note: {summary['snap_note']}")
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
@@ -522,6 +567,7 @@ def _cmd_sweep(args) -> int:
 
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
+    failed = None
     try:
         paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
                                 progress=sys.stderr.isatty(), ensemble=args.ensemble)
@@ -529,23 +575,53 @@ def _cmd_sweep(args) -> int:
         print(f"snapping sweep: interrupted; finished and checkpointed runs are kept in {args.output}: "
               "run the same command again to resume only the missing runs", file=sys.stderr)
         return 130
-    combined = sweep.combine(paths)
-    out = sweep.atomic_to_netcdf(combined, Path(args.output) / "sweep.nc")
-    rows = []
-    for chi in combined["chi"].values:
-        for N in combined["N"].values:
-            sel = combined.sel(chi=chi, N=N)
-            rows.append({k: float(sel[k]) for k in ("v_peak", "a_peak", "sigma_peak", "t_snap_v") if k in sel}
-                        | {"chi": float(chi), "N": int(N)})
+    except sweep.SweepFailed as exc:
+        failed, paths = exc, exc.paths
+    rows, out = [], None
+    if paths:
+        combined = sweep.combine(paths)
+        out = sweep.atomic_to_netcdf(combined, Path(args.output) / "sweep.nc")
+        for chi in combined["chi"].values:
+            for N in combined["N"].values:
+                sel = combined.sel(chi=chi, N=N)
+                if "n_steps" in sel and not math.isfinite(float(sel["n_steps"])):
+                    continue  # (chi, N) is no finished run (it failed): a hole of the grid
+                row = {"chi": float(chi), "N": int(N)}
+                row.update({k: float(sel[k]) for k in ("v_peak", "a_peak", "sigma_peak", "t_snap_v") if k in sel})
+                reached = float(sel["snap_reached"]) if "snap_reached" in sel else 1.0
+                row["snap_reached"] = bool(reached == 1.0)
+                if not row["snap_reached"]:
+                    row["t_snap_v"] = None  # absent: the run ended before the snap
+                rows.append(row)
+    bad = _nonfinite({"runs": rows})
     if args.json:
-        print_json({"sweep": str(out), "runs": rows})
+        obj = {"sweep": None if out is None else str(out), "runs": rows}
+        if failed is not None:
+            obj["failed"] = [f.to_dict() for f in failed.failures]
+        if bad:
+            return _nonfinite_error("sweep", bad)
+        print_json(obj)
     else:
-        print(f"{len(paths)} runs in {args.output}; combined: {out}")
-        print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
-        for r in rows:
-            print(f"  {r['chi']:>6g} {r['N']:>7d} {r.get('v_peak', float('nan')):>10.5g} "
-                  f"{r.get('a_peak', float('nan')):>11.5g} {r.get('sigma_peak', float('nan')):>11.5g} "
-                  f"{r.get('t_snap_v', float('nan')):>10.6g}")
+        if bad:
+            return _nonfinite_error("sweep", bad)
+        n_done = len(paths)
+        if out is not None:
+            print(f"{n_done} runs in {args.output}; combined: {out}")
+            print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
+            for r in rows:
+                t_snap = "no snap" if r["t_snap_v"] is None else f"{r['t_snap_v']:.6g}"
+                print(f"  {r['chi']:>6g} {r['N']:>7d} {r.get('v_peak', float('nan')):>10.5g} "
+                      f"{r.get('a_peak', float('nan')):>11.5g} {r.get('sigma_peak', float('nan')):>11.5g} "
+                      f"{t_snap:>10}")
+            if any(not r["snap_reached"] for r in rows):
+                print("  no snap: the run ended before the snap (see its snap_note); its peaks are maxima over the run")
+        else:
+            print(f"no run of the sweep completed; nothing combined in {args.output}")
+    if failed is not None:
+        print(f"snapping sweep: error: {len(failed.failures)} of {failed.n_runs} runs failed (the other runs are "
+              f"saved; rerun the same command to retry only the failed ones):", file=sys.stderr)
+        print(failed.table(), file=sys.stderr)
+        return 1
     return 0
 
 
@@ -638,9 +714,16 @@ def _add_reproduce(sub) -> None:
 
 def _cmd_reproduce(args) -> int:
     from .reproduce import reproduce
+    from .sweep import SweepFailed
 
-    report = reproduce(args.output, args.mode, workers=args.workers, progress=sys.stderr.isatty(),
-                       log=lambda msg: print(msg, file=sys.stderr))
+    try:
+        report = reproduce(args.output, args.mode, workers=args.workers, progress=sys.stderr.isatty(),
+                           log=lambda msg: print(msg, file=sys.stderr))
+    except SweepFailed as exc:  # some runs failed: which and why, no traceback
+        print(f"snapping reproduce: error: {len(exc.failures)} of the runs failed (the others are saved; rerun "
+              f"the same command to retry only the failed ones):", file=sys.stderr)
+        print(exc.table(), file=sys.stderr)
+        return 1
     print(report.read_text().split("## Fit report")[0].rstrip())
     print(f"\nfull report: {report}")
     return 0

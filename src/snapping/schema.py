@@ -154,13 +154,19 @@ RESULT_ATTRS: dict[str, str] = {
     "failure": ("kind of numerical failure: '' (none), 'non_finite', 'step_size', 'link_drift', "
                 "'energy_drift' or 'rejections'"),
     "failure_node": "index along 'node' of the worst node at a failure (-1: none)",
-    "t_snap_v": "snapping time from the peak of the maximum speed",
-    "t_snap_a": "snapping time from the peak of the maximum acceleration",
-    "t_snap_sigma": "snapping time from the peak of the maximum tension",
-    "v_peak": "peak of the maximum speed",
-    "a_peak": "peak of the maximum acceleration",
-    "sigma_peak": "peak of the maximum tension",
-    "kappa_peak": "peak of the maximum curvature",
+    "t_snap_v": "snapping time from the peak of the maximum speed (NaN: the run did not reach the snap)",
+    "t_snap_a": ("snapping time from the peak of the maximum acceleration (NaN: the run did not reach the snap, "
+                 "or this peak is at the run's last step)"),
+    "t_snap_sigma": ("snapping time from the peak of the maximum tension (NaN: the run did not reach the snap, "
+                     "or this peak is at the run's last step)"),
+    "snap_reached": ("1 if the run reached the snap: at some recorded step v_max fell below stop_fraction of its "
+                     "running peak (the rule that stops an automatic run, applied to a run with t_end too); 0 if "
+                     "not: then the t_snap_* are NaN and the *_peak are maxima over the run, not snap peaks"),
+    "snap_note": "'' if snap_reached, else one line saying why there is no snapping time",
+    "v_peak": "peak of the maximum speed (if snap_reached is 0: its maximum over the run)",
+    "a_peak": "peak of the maximum acceleration (if snap_reached is 0: its maximum over the run)",
+    "sigma_peak": "peak of the maximum tension (if snap_reached is 0: its maximum over the run)",
+    "kappa_peak": "peak of the maximum curvature (if snap_reached is 0: its maximum over the run)",
     "kappa_max_0": "maximum curvature at t = 0",
     "energy_drift": "max |E(t) - E(0)| over the run",
     "link_drift": "max relative link-length error against 1/N over the run",

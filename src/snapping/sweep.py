@@ -37,7 +37,8 @@ from . import schema
 if TYPE_CHECKING:  # annotations only
     import xarray as xr
 
-__all__ = ["Grid", "run_sweep", "combine", "atomic_to_netcdf", "is_complete_run"]
+__all__ = ["Grid", "run_sweep", "combine", "atomic_to_netcdf", "is_complete_run", "SweepFailed", "RunFailure",
+           "failure_table"]
 
 
 def atomic_to_netcdf(ds, path, *, overwrite: bool = True) -> Path:
@@ -186,27 +187,120 @@ def _label(task: list) -> str:
     return f"chi={chis} N={task[0][0]['N']}"
 
 
-def _run_task(task: list) -> list[str]:
+def _one_line(text) -> str:
+    """The first line of a message, at most 300 characters."""
+    line = (str(text).strip().splitlines() or [""])[0]
+    return line if len(line) <= 300 else line[:297] + "..."
+
+
+def _existing(path) -> str | None:
+    return str(path) if path is not None and Path(path).is_file() else None
+
+
+def _failure_of(exc: BaseException, path: str) -> dict:
+    """What a worker reports of a run that raised ``exc``: its failure kind, one-line
+    message and the file it left (if any). Plain values: they cross process boundaries."""
+    from .simulate.errors import SimulationError
+
+    if isinstance(exc, SimulationError):
+        ds = exc.dataset
+        msg = ds.attrs.get("stop_reason") if ds is not None and ds.attrs.get("stop_reason") else str(exc)
+        return {"kind": exc.kind or "simulation", "message": _one_line(msg), "file": _existing(exc.path or path)}
+    return {"kind": type(exc).__name__, "message": _one_line(exc) or type(exc).__name__, "file": _existing(path)}
+
+
+#: test hook: a path to which each local worker process appends its pid when it starts
+_WORKER_PID_FILE_ENV = "SNAPPING_SWEEP_WORKER_PID_FILE"
+
+
+def _run_task(task: list) -> list:
     """Worker: one run (:func:`_run_one`), or several runs of one N as one ensemble
     (:func:`snapping.simulate.run_ensemble`; each member saved atomically to its file).
-    A failed member raises (naming it) after every member is saved."""
+
+    Returns one outcome per run of the task, in its order: ``None`` for a run that
+    completed, else a dict (``kind``, ``message``, ``file``, see :func:`_failure_of`).
+    A run that fails numerically, or on an input that is only refused at run time,
+    does not end the task: every other member is still run and saved."""
+    if _STOP is not None and _STOP.is_set():  # the sweep was interrupted: start nothing new
+        return [{"kind": "cancelled", "message": "not started: the sweep was interrupted", "file": None}
+                for _ in task]
     if len(task) == 1:
-        return [_run_one(*task[0])]
+        params, path = task[0]
+        try:
+            _run_one(params, path)
+        except Exception as exc:  # numerical failures and run-time refusals are reported, not raised
+            return [_failure_of(exc, path)]
+        return [None]
     import warnings
 
     from .simulate import run_ensemble
 
     params = [p for p, _ in task]
     opts = {k: v for k, v in params[0].items() if k not in ("chi", "N")}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # failed members are reported below
-        dss = run_ensemble([p["chi"] for p in params], params[0]["N"], outputs=[path for _, path in task],
-                           overwrite=True, **opts)
-    bad = [f"chi={p['chi']:g}: {ds.attrs['stop_reason']}" for p, ds in zip(params, dss)
-           if ds.attrs["status"] != "completed"]
-    if bad:
-        raise RuntimeError("ensemble members failed: " + "; ".join(bad))
-    return [path for _, path in task]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # failed members are reported below
+            dss = run_ensemble([p["chi"] for p in params], params[0]["N"], outputs=[path for _, path in task],
+                               overwrite=True, **opts)  # the sweep owns its run files
+    except Exception as exc:  # the ensemble as a whole failed: every member with it
+        return [_failure_of(exc, path) for _, path in task]
+    out = []
+    for (_, path), ds in zip(task, dss):
+        if ds.attrs["status"] == "completed":
+            out.append(None)
+        else:
+            out.append({"kind": str(ds.attrs.get("failure") or ds.attrs["status"]),
+                        "message": _one_line(ds.attrs.get("stop_reason", "")), "file": _existing(path)})
+    return out
+
+
+#: set in a local worker process: the sweep's "stop" event (set when the sweep is interrupted)
+_STOP = None
+
+
+def _worker_init(parent_pid: int, stop=None, interval: float = 0.2, grace: float = 3.0) -> None:
+    """Initializer of the local worker processes.
+
+    * SIGINT is ignored between runs: a Ctrl-C reaches the whole process group, and a
+      worker waiting for its next task must not print a ``KeyboardInterrupt``
+      traceback; a run in progress still stops at a step boundary and saves its
+      checkpoint (the driver installs its own handler while it runs).
+    * ``stop`` (an event the sweep sets when interrupted) makes the worker skip the
+      tasks still queued for it, and stops a run in progress at its next step boundary,
+      saved with its checkpoint, as SIGINT would (through the driver's chunk hook), so
+      that an interrupted sweep ends promptly whenever the signal reached the worker.
+    * A daemon thread notices when the sweep's process is gone (the worker has been
+      re-parented: ``os.getppid()`` changed, e.g. after a SIGKILL of the sweep) and
+      ends this worker: it first sends itself SIGTERM, so that a run in progress stops
+      at a step boundary and saves its checkpoint (a rerun of the sweep resumes it),
+      and exits for good after ``grace`` seconds.
+    """
+    import signal
+    import threading
+    import time
+
+    global _STOP
+    _STOP = stop
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    pid_file = os.environ.get(_WORKER_PID_FILE_ENV)
+    if pid_file:
+        with open(pid_file, "a") as fh:
+            fh.write(f"{os.getpid()}\n")
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(interval)
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+        finally:
+            time.sleep(grace)
+            os._exit(1)
+
+    threading.Thread(target=watch, name="snapping-sweep-parent-watchdog", daemon=True).start()
+    if stop is not None:
+        from .simulate import driver
+
+        driver._chunk_hook = lambda eng: signal.SIGINT if stop.is_set() else None
 
 
 def _check_out_dir(out_dir) -> Path:
@@ -230,6 +324,103 @@ def _client_for(scheduler):
         raise V.SnappingInputError(f"scheduler={scheduler!r} cannot be reached: {exc}") from None
 
 
+@dataclass
+class RunFailure:
+    """One run of a sweep that did not complete.
+
+    Attributes
+    ----------
+    chi, N : float, int
+        The grid point.
+    options : dict
+        The grid's run options (the same for every run of the grid).
+    kind : str
+        Why: the failure kind of a numerical failure (``SimulationError.kind``:
+        'step_size', 'rejections', 'non_finite', 'link_drift', 'energy_drift'), or
+        the exception's type name for anything else (e.g. 'SnappingInputError' for an
+        option that is only refused at run time, 'BrokenProcessPool' for a worker that died).
+    message : str
+        One line saying what happened (the run's ``stop_reason`` for a numerical failure).
+    file : str or None
+        The run's file as it was left (status 'failed', what was computed until the
+        failure), or None when there is none.
+    """
+
+    chi: float
+    N: int
+    options: dict
+    kind: str
+    message: str
+    file: str | None = None
+
+    def to_dict(self) -> dict:
+        return {"chi": self.chi, "N": self.N, "options": dict(self.options), "kind": self.kind,
+                "message": self.message, "file": self.file}
+
+
+def failure_table(failures) -> str:
+    """The failed runs of a sweep as an aligned text table (one row per run)."""
+    rows = [("chi", "N", "options", "failure", "file", "message")]
+    for f in failures:
+        opts = ", ".join(f"{k}={v!r}" for k, v in sorted(f.options.items())) or "-"
+        rows.append((f"{f.chi:g}", str(f.N), opts, f.kind, f.file or "(none)", f.message))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    return "\n".join("  " + "  ".join(c.ljust(w) for c, w in zip(r[:5], widths)) + "  " + r[5] for r in rows).rstrip()
+
+
+class SweepFailed(RuntimeError):
+    """Some runs of a sweep failed; every other run completed and was saved.
+
+    Raised by :func:`run_sweep` after all runs have been tried (it is a
+    ``RuntimeError``, as the sweep's failures always were).
+
+    Attributes
+    ----------
+    failures : list of RunFailure
+        The runs that did not complete: which (chi, N, options), the failure kind, a
+        one-line message and the run's partial file, if any (:func:`failure_table`
+        prints them).
+    paths : list of Path
+        The files of the runs that completed (every grid point but the failed ones),
+        ready for :func:`combine`.
+    n_runs : int
+        The runs of the grid.
+    """
+
+    def __init__(self, failures: list, paths: list, n_runs: int):
+        self.failures = list(failures)
+        self.paths = list(paths)
+        self.n_runs = int(n_runs)
+        first = "; ".join(f"chi={f.chi:g} N={f.N}: {f.kind}: {f.message}" for f in self.failures[:3])
+        more = f"; and {len(self.failures) - 3} more" if len(self.failures) > 3 else ""
+        super().__init__(f"{len(self.failures)} of {self.n_runs} runs failed ({first}{more}); the other runs are "
+                         f"saved; rerun the sweep to retry only the failed ones")
+
+    def table(self) -> str:
+        """The failed runs as text (:func:`failure_table`)."""
+        return failure_table(self.failures)
+
+
+def _local_pool(n: int):
+    """``n`` local worker processes (spawned) that end themselves if this process dies,
+    and the event that tells them to start no further task (:func:`_worker_init`)."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")
+    stop = ctx.Event()
+    return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init,
+                               initargs=(os.getpid(), stop)), stop
+
+
+def _stop_pool(stop, futures) -> None:
+    """The sweep was interrupted: no queued task starts, and every run in progress
+    stops at a step boundary and saves its checkpoint (:func:`_worker_init`), whether
+    the SIGINT reached the workers too (Ctrl-C) or this process alone."""
+    stop.set()
+    for fut in futures:
+        fut.cancel()
+
+
 def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True,
               ensemble: int | None = None) -> list[Path]:
     """Run every point of ``grid`` not yet done in ``out_dir``; return all run paths.
@@ -242,6 +433,8 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
         Directory of the run files (created if missing; checked writable first).
     workers : int, optional
         Local worker processes (default: the number of cores, at most the runs to do).
+        Each watches this process and ends itself (after letting a run in progress
+        save its checkpoint) if this process dies, e.g. is killed with SIGKILL.
     scheduler : str or dask.distributed.Client, optional
         Run on this Dask cluster instead of local processes.
     progress : bool
@@ -253,6 +446,24 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
         bit for bit but ``wall_time``. Ensembles are not checkpointed: an interrupted
         one restarts. They save processes, not time (measured 1.1-1.2x the cost of
         single runs).
+
+    Returns
+    -------
+    list of Path
+        The files of every run of the grid (all complete).
+
+    Raises
+    ------
+    SweepFailed
+        Some runs failed (numerically, e.g. a step below ``dt_min``, or on an option
+        only refused at run time, or their worker died): raised once every other run
+        has completed and been saved; ``.failures`` says which and why, ``.paths``
+        lists the completed runs (for :func:`combine`). A rerun retries only the
+        failed runs.
+    SnappingInputError
+        Bad grid, ``out_dir``, ``workers``, ``ensemble`` or scheduler, before any run.
+    KeyboardInterrupt
+        SIGINT: the finished and checkpointed runs are kept; a rerun resumes.
 
     Examples
     --------
@@ -268,13 +479,16 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     todo = [(p, path) for p, path in todo if not is_complete_run(path)]
     tasks = _groups(todo, size)
     bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
-    failures = []
+    failures: list[RunFailure] = []
 
     def collect(task, result) -> None:  # keep going: the other runs are independent
         try:
-            result()
-        except Exception as exc:
-            failures.append((task, exc))
+            outcomes = result()
+        except Exception as exc:  # the task itself could not run (its worker died, ...): all its runs
+            outcomes = [_failure_of(exc, path) for _, path in task]
+        for (params, _), outcome in zip(task, outcomes):
+            if outcome is not None:
+                failures.append(RunFailure(chi=params["chi"], N=params["N"], options=dict(grid.options), **outcome))
         bar.update(len(task))
 
     try:
@@ -282,10 +496,14 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
             from dask.distributed import as_completed as dask_completed
 
             client, owned = _client_for(scheduler)
+            futures = {}
             try:
                 futures = {client.submit(_run_task, task, pure=False): task for task in tasks}
                 for fut in dask_completed(futures):
                     collect(futures[fut], fut.result)
+            except BaseException:  # interrupted: the runs not done are not left running on the cluster
+                client.cancel(list(futures))
+                raise
             finally:
                 if owned:
                     client.close()
@@ -295,19 +513,26 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
                 for task in tasks:
                     collect(task, lambda task=task: _run_task(task))
             else:
-                import multiprocessing as mp
-
-                with ProcessPoolExecutor(max_workers=n, mp_context=mp.get_context("spawn")) as pool:
+                pool, stop = _local_pool(n)
+                futures = {}
+                try:
                     futures = {pool.submit(_run_task, task): task for task in tasks}
                     for fut in as_completed(futures):
                         collect(futures[fut], fut.result)
+                except BaseException:  # SIGINT: stop promptly, the runs in progress saved
+                    _stop_pool(stop, futures)
+                    raise
+                finally:
+                    pool.shutdown(wait=True, cancel_futures=True)
     finally:
         bar.close()
+    paths = grid.paths(out)
     if failures:
-        lines = "; ".join(f"{_label(task)}: {exc}" for task, exc in failures)
-        n_failed = sum(not is_complete_run(path) for task, _ in failures for _, path in task)
-        raise RuntimeError(f"{n_failed} of {len(todo)} runs failed ({lines}); rerun to retry only those")
-    return grid.paths(out)
+        order = {(p["chi"], p["N"]): i for i, p in enumerate(grid.points())}
+        failures.sort(key=lambda f: order[(f.chi, f.N)])
+        bad = {str(grid.path(out, f.chi, f.N)) for f in failures}
+        raise SweepFailed(failures, [p for p in paths if str(p) not in bad], len(paths))
+    return paths
 
 
 _RUN_DIMS = (schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_DIM)
@@ -316,29 +541,81 @@ _RUN_DIMS = (schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_
 _SUMMARY_ATTRS = [k for k in schema.RESULT_ATTRS if k not in ("status", "stop_reason", "snapping_version")]
 
 
+#: Inputs that must agree between the runs of one combined sweep (``dt0`` too for the
+#: Euler-Richardson methods, where it is the step the user chose; the angle-form methods
+#: compute their own per run). The combined Dataset keeps them as attributes.
+COMBINE_SAME_INPUTS = ("method", "tol", "t_end", "stop_fraction", "t_end_max", "record_thin", "chords", "initial",
+                       "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
+
+
+def _same(a, b) -> bool:
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape:
+        return False
+    if a.dtype.kind in "fc" and b.dtype.kind in "fc":
+        return bool(np.array_equal(a, b, equal_nan=True))
+    return bool(np.all(a == b))
+
+
+def _run_piece(item, i: int):
+    """(name, run Dataset) of one entry of :func:`combine`: a run file or a run Dataset,
+    checked to be a completed run of the paper's problem (SnappingInputError if not)."""
+    import xarray as xr
+
+    from .simulate.dataset import load_run
+
+    if isinstance(item, xr.Dataset):
+        name, ds = f"paths[{i}] (a Dataset)", item
+        if "t" not in ds.variables or "N" not in ds.attrs:
+            raise V.SnappingInputError(f"{name} is not a snapping run (no time 't' or attribute 'N'; variables: "
+                                       f"{sorted(map(str, ds.variables))[:6]})")
+    else:
+        path = Path(V.file_path("paths", item))
+        name, ds = repr(str(path)), load_run(path)
+    for key in ("chi", "N", "status", "method", "tol"):
+        if key not in ds.attrs:
+            raise V.SnappingInputError(f"{name} is not a run: attribute {key!r} is missing")
+    if not np.isfinite(float(ds.attrs["chi"])):
+        raise V.SnappingInputError(f"{name} is a run without chi (a general problem or another start): combine "
+                                   f"takes runs of the paper's catenary, indexed by (chi, N)")
+    if str(ds.attrs["status"]) != "completed":
+        raise V.SnappingInputError(f"{name} is not a completed run (status={str(ds.attrs['status'])!r}: "
+                                   f"{_one_line(ds.attrs.get('stop_reason', ''))}); combine takes completed runs")
+    return name, ds
+
+
 def combine(paths) -> "xr.Dataset":
     """Combine run files into one Dataset with ``chi`` and ``N`` dimensions.
 
     Per-step and profile variables keep their ``step``/``snapshot``/``node``/``link``
     dimensions (padded with NaN where runs differ in length); the numeric result
-    attributes of each run (``v_peak``, ``t_snap_v``, ...) become variables over
-    (chi, N).
+    attributes of each run (``v_peak``, ``t_snap_v``, ``snap_reached``, ...) become
+    variables over (chi, N).
+
+    ``paths`` lists run files (or run Datasets). Each must be a completed run of the
+    paper's catenary (a sweep's run); anything else (another program's Dataset, a
+    combined sweep, a failed or checkpointed run) is refused with a
+    :class:`SnappingInputError` naming it. The runs must share their method and every
+    input that changes the numbers (:data:`COMBINE_SAME_INPUTS`): runs of different
+    methods or tolerances are refused, naming the input and the files that differ,
+    instead of being combined into one table that no longer says which is which. The
+    shared inputs are the combined Dataset's attributes (``method``, ``tol``, ...).
     """
     import xarray as xr
 
-    if isinstance(paths, (str, os.PathLike)) or not hasattr(paths, "__iter__"):
-        raise V.SnappingInputError(f"paths={paths!r} must be a list of run files")
-    paths = [Path(V.file_path("paths", p)) for p in paths]
-    if not paths:
+    if isinstance(paths, (str, os.PathLike, xr.Dataset)) or not hasattr(paths, "__iter__"):
+        raise V.SnappingInputError(f"paths={type(paths).__name__ if isinstance(paths, xr.Dataset) else paths!r} "
+                                   f"must be a list of run files")
+    items = list(paths)
+    if not items:
         raise V.SnappingInputError("combine needs at least one run file")
-    pieces = []
-    for path in paths:
-        from .simulate.dataset import load_run
-
-        ds = load_run(path)
-        for key in ("chi", "N"):
-            if key not in ds.attrs:
-                raise V.SnappingInputError(f"{str(path)!r} is not a run file: attribute {key!r} is missing")
+    pieces, names, inputs = [], [], []
+    for i, item in enumerate(items):
+        name, ds = _run_piece(item, i)
+        keys = COMBINE_SAME_INPUTS + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
+        inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
+                       for k in keys if k in ds.attrs})
+        names.append(name)
         chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
         summary = {
             k: ((), float(ds.attrs[k]), {"long_name": schema.RESULT_ATTRS[k], "units": schema.result_units(k)})
@@ -350,9 +627,18 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.assign_coords({d: np.arange(ds.sizes[d]) for d in _RUN_DIMS if d in ds.dims})
         ds = ds.drop_vars([v for v in ds.data_vars if ds[v].dtype.kind in "OUS"])
         ds = ds.expand_dims(chi=[chi], N=[N])
-        keep = {k: ds.attrs[k] for k in ("method", "tol") if k in ds.attrs}
-        ds.attrs = keep
+        ds.attrs = {}
         pieces.append(ds)
+    for k in COMBINE_SAME_INPUTS + ("dt0",):  # the method first: it decides whether dt0 is compared
+        ref = next((j for j, d in enumerate(inputs) if k in d), None)
+        if ref is None:
+            continue
+        for j, d in enumerate(inputs):
+            if k not in d or not _same(d[k], inputs[ref][k]):
+                have = repr(d[k]) if k in d else "missing"
+                raise V.SnappingInputError(
+                    f"runs with different {k} cannot be combined: {k}={inputs[ref][k]!r} in {names[ref]}, {have} in "
+                    f"{names[j]}; combine the runs of one grid (one method and set of options) at a time")
     opts = dict(join="outer", fill_value=np.nan, data_vars="all", coords="minimal", compat="override")
     chis = sorted({float(p["chi"].values[0]) for p in pieces})
     rows = []
@@ -363,7 +649,7 @@ def combine(paths) -> "xr.Dataset":
             raise V.SnappingInputError(f"two run files have the same chi={c:g} and N: {sorted(Ns)}")
         rows.append(xr.concat(row, dim="N", **opts))
     combined = xr.concat(rows, dim="chi", **opts)
-    combined.attrs = {k: v for k, v in pieces[0].attrs.items() if all(p.attrs.get(k) == v for p in pieces)}
+    combined.attrs = dict(inputs[0])
     combined["chi"].attrs.update(long_name="initial end-to-end separation", units="1")
     combined["N"].attrs.update(long_name="number of links", units="1")
     return combined

@@ -49,7 +49,7 @@ class Run:
 
 
 SUMMARY_KEYS = (
-    "chi", "N", "method", "tol", "dt0", "status", "stop_reason",
+    "chi", "N", "method", "tol", "dt0", "status", "stop_reason", "snap_reached", "snap_note",
     "t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_max_0",
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
@@ -57,14 +57,79 @@ SUMMARY_KEYS = (
 )
 
 
+#: The snapping times: absent (None in :func:`summary`) when the run did not reach the snap.
+SNAP_TIMES = ("t_snap_v", "t_snap_a", "t_snap_sigma")
+#: The peaks: maxima over the run when it did not reach the snap.
+PEAKS = ("v_peak", "a_peak", "sigma_peak", "kappa_peak")
+
+
 def summary(ds: xr.Dataset) -> dict:
-    """Inputs and detected results of a run Dataset, as a dict of plain Python values."""
+    """Inputs and detected results of a run Dataset, as a dict of plain Python values.
+
+    Only what was computed is claimed: when the run did not reach the snap
+    (``snap_reached`` false, e.g. it ended at ``t_end`` before it), ``snap_reached``
+    is False, the snapping times ``t_snap_*`` are None (absent, not a number) and
+    ``snap_note`` says why; the ``*_peak`` values are then the maxima over the run.
+    A snapping time whose peak was at the run's last step is None too. Files written
+    before ``snap_reached`` existed have none and are summarised as they are.
+    """
     out = {}
     for k in SUMMARY_KEYS:
         if k in ds.attrs:
             v = ds.attrs[k]
             out[k] = v.item() if isinstance(v, np.generic) else v
+    if isinstance(out.get("chi"), float) and np.isnan(out["chi"]):
+        out["chi"] = None  # a general problem's start is not a catenary of some chi ('start' says what it is)
+    if "snap_reached" in out:
+        out["snap_reached"] = bool(out["snap_reached"])
+        for k in SNAP_TIMES:
+            if k in out and isinstance(out[k], float) and np.isnan(out[k]):
+                out[k] = None  # deliberately absent: the peak was not reached (snap_note says why)
+        if not out["snap_reached"]:
+            out["peaks"] = "maxima over the run (the run did not reach the snap)"
+        else:
+            out.pop("snap_note", None)
     return out
+
+
+def snap_results(records: np.ndarray, inputs: dict, results: dict) -> dict:
+    """The result attributes with what the run did not compute taken out.
+
+    ``snap_reached`` is 1 if, at some recorded step, v_max fell below
+    ``stop_fraction`` of its running peak (the rule that stops an automatic run; for
+    a run with ``t_end`` it is applied to the record), or at the last step below
+    ``stop_fraction`` of ``v_peak`` (what the compiled loop tests). If not, the
+    snapping times ``t_snap_*`` are NaN and ``snap_note`` says why; the peaks stay,
+    as maxima over the run. A snapping time whose peak lies at the run's last step
+    (not strictly inside the run) is NaN as well.
+    """
+    res = dict(results)
+    if "v_peak" not in res or "stop_fraction" not in inputs:
+        return res
+    f = float(inputs["stop_fraction"])
+    rec = np.asarray(records, dtype=float)
+    v = rec[:, K.R_VMAX] if rec.ndim == 2 and len(rec) else np.zeros(0)
+    t_final = float(res.get("t_final", rec[-1, K.R_T] if len(v) else 0.0))
+    v_peak = float(res["v_peak"])
+    reached = False
+    if v.size and np.isfinite(v_peak) and v_peak > 0.0:
+        running = np.fmax.accumulate(v)
+        reached = bool(np.any(v < f * running) or v[-1] < f * v_peak)
+    res["snap_reached"] = int(reached)
+    for q in ("v", "a", "sigma"):
+        k = f"t_snap_{q}"
+        if k in res and not (reached and float(res[k]) < t_final):
+            res[k] = float("nan")
+    if reached:
+        res["snap_note"] = ""
+    else:
+        status = str(res.get("status", ""))
+        why = {"failed": "failed", "checkpoint": "has run so far", "interrupted": "was interrupted"}.get(status,
+                                                                                                   "ended")
+        res["snap_note"] = (f"the run {why} at t={t_final:.9g} before the snap (v_max never fell below "
+                            f"stop_fraction={f:g} of its running peak; a larger stop_fraction accepts a smaller fall): "
+                            f"no snapping time; the peaks are maxima over the run")
+    return res
 
 
 def _attr_value(v):
@@ -133,6 +198,7 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
     }
     attrs = {"title": "snapping: falling-chain run (nondimensional: length l, g, rho = 1)",
              "Conventions": "CF-1.8"}
+    results = snap_results(records, inputs, results)
     for k, v in {**inputs, **results}.items():
         attrs[k] = _attr_value(v)
     if problem is not None:
