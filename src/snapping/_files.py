@@ -190,6 +190,9 @@ def check_output_dir(path, *, name: str = "output") -> str:
         st = os.stat(p)
     except FileNotFoundError:
         st = None
+    except NotADirectoryError:
+        raise V.SnappingInputError(f"{name}={p!r}: the directory cannot be written (a part of its path is a file, "
+                                   f"not a directory)") from None
     except OSError as exc:
         raise V.SnappingInputError(f"{name}={p!r} cannot be examined ({exc.strerror or exc})") from None
     if st is not None and not stat.S_ISDIR(st.st_mode):

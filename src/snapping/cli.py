@@ -280,7 +280,7 @@ def _cmd_simulate(args) -> int:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
-    if times and args.output is None:  # the snapshots are profiles: only a run file holds them
+    if times and args.output is None and args.resume is None:  # snapshots are profiles: only a run file holds them
         from .simulate.options import _times
 
         _times(times)  # a bad time is named first

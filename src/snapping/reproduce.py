@@ -279,6 +279,9 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
         workers = V.integer("workers", workers, 1)
     out = Path(V.file_path("out_dir", out_dir))
     sweep._check_out_dir(out)
+    runs = sweep._check_out_dir(out / "runs")
+    sweep._check_room(runs, [(p, path) for g in plan.grids() for p in g.points()
+                             if not sweep.is_complete_run(path := g.path(runs, p["chi"], p["N"]))])
     figdir = out / "figures"
     timings: dict[str, float] = {}
     import os

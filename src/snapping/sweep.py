@@ -303,6 +303,21 @@ def _worker_init(parent_pid: int, stop=None, interval: float = 0.2, grace: float
         driver._chunk_hook = lambda eng: signal.SIGINT if stop.is_set() else None
 
 
+def _check_room(out: Path, todo: list) -> None:
+    """Refuse a sweep whose run files (estimated sizes) do not fit on the filesystem of ``out``."""
+    import shutil
+
+    from ._files import _size
+    from .simulate.driver import check_inputs
+
+    need = sum(check_inputs(p["chi"], p["N"], **{k: v for k, v in p.items() if k not in ("chi", "N")})["file_bytes"]
+               for p, _ in todo)
+    free = shutil.disk_usage(out).free
+    if need > free:
+        raise V.SnappingInputError(f"out_dir={str(out)!r}: the {len(todo)} run files to write need about "
+                                   f"{_size(need)} but its filesystem has only {_size(free)} free")
+
+
 def _check_out_dir(out_dir) -> Path:
     from ._files import check_output_dir
 
@@ -477,6 +492,7 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     size = _check_ensemble(grid, ensemble)
     todo = [(p, str(grid.path(out, p["chi"], p["N"]))) for p in grid.points()]
     todo = [(p, path) for p, path in todo if not is_complete_run(path)]
+    _check_room(out, todo)
     tasks = _groups(todo, size)
     bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
     failures: list[RunFailure] = []

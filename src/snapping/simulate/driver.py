@@ -272,9 +272,11 @@ def run(
                   wall_before=0.0, overwrite=overwrite)
 
 
-def check_inputs(chi=None, N=None, **options) -> None:
+def check_inputs(chi=None, N=None, **options) -> dict:
     """Check the inputs of :func:`run` without running it (a sweep checks every run
-    before the first starts); raises :class:`SnappingInputError` like :func:`run`.
+    before the first starts); raises :class:`SnappingInputError` like :func:`run`, or
+    returns the run's estimated needs (:func:`memory_need`, with ``file_bytes``, the
+    run file's size).
 
     >>> check_inputs(0.3, 10, tol=-1.0)
     Traceback (most recent call last):
@@ -299,6 +301,7 @@ def check_inputs(chi=None, N=None, **options) -> None:
     need = check_memory(N, opts, chi=chi, method=kw["method"])
     if kw["output"] is not None:
         check_writable(kw["output"], overwrite=kw["overwrite"], need_bytes=need["file_bytes"])
+    return need
 
 
 # ---------------------------------------------------------------- the driver: signals, checkpoints, results
