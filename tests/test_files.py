@@ -373,3 +373,36 @@ def test_resume_to_an_existing_other_file_needs_overwrite(checkpoint, tmp_path):
         resume(checkpoint, output=other)
     assert other.read_bytes() == b"precious"
     assert resume(checkpoint, output=other, overwrite=True).dataset.attrs["status"] == "completed"
+
+
+# ------------------------------------------------------------------ sweeps: one writer per directory, no swapped sweep.nc
+def test_a_second_sweep_in_the_same_directory_is_refused(tmp_path):
+    from snapping import sweep
+
+    holder = subprocess.Popen([PY, "-c", HOLD, str(tmp_path / "sweep.nc")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(_files.OutputBusyError, match=f"PID {holder.pid}"):
+            sweep.run_sweep(sweep.Grid(chi=[0.5], N=[6]), tmp_path, workers=1, progress=False)
+    finally:
+        holder.send_signal(signal.SIGKILL)
+        holder.wait()
+    assert [f.name for f in tmp_path.iterdir() if f.suffix == ".nc"] == []
+
+
+def test_sweep_nc_of_another_grid_is_not_replaced(tmp_path, capsys):
+    base = ["sweep", "--N", "6", "--method", "fast", "--workers", "1", "-o", tmp_path]
+    status, _, err = _cli([*base, "--chi", "0.5"], capsys)
+    assert status == 0, err
+    first = _digest(tmp_path / "sweep.nc")
+    status, _, err = _cli([*base, "--chi", "0.4"], capsys)
+    assert status == 2 and "another grid" in _one_line_error(err) and "chi=[0.5]" in err
+    assert _digest(tmp_path / "sweep.nc") == first
+    status, _, err = _cli([*base, "--chi", "0.5"], capsys)  # the same grid again: its own file, updated
+    assert status == 0, err
+    status, _, err = _cli([*base, "--chi", "0.4", "--overwrite"], capsys)
+    assert status == 0, err
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "sweep.nc") as ds:
+        assert list(ds["chi"].values) == [0.4]

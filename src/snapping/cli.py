@@ -556,6 +556,8 @@ def _add_sweep(sub) -> None:
     p.add_argument("--ensemble", type=int, default=None, metavar="K",
                    help="run up to K chi of one N together in one ensemble kernel (needs --method fast or dop853)")
     p.add_argument("-o", "--output", required=True, help="output directory")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace DIR/sweep.nc even if it holds another grid's runs (default: refuse)")
     p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
     p.set_defaults(func=_cmd_sweep)
 
@@ -567,6 +569,7 @@ def _cmd_sweep(args) -> int:
 
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
+    target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
     failed = None
     try:
         paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
@@ -580,7 +583,8 @@ def _cmd_sweep(args) -> int:
     rows, out = [], None
     if paths:
         combined = sweep.combine(paths)
-        out = sweep.atomic_to_netcdf(combined, Path(args.output) / "sweep.nc")
+        combined.attrs["sweep_grid"] = sweep.grid_key(grid)
+        out = sweep.atomic_to_netcdf(combined, target)
         for chi in combined["chi"].values:
             for N in combined["N"].values:
                 sel = combined.sel(chi=chi, N=N)

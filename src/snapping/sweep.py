@@ -303,6 +303,43 @@ def _worker_init(parent_pid: int, stop=None, interval: float = 0.2, grace: float
         driver._chunk_hook = lambda eng: signal.SIGINT if stop.is_set() else None
 
 
+def grid_key(grid: Grid) -> str:
+    """The grid as a JSON string (chi, N, options), stored in a combined sweep file as
+    attribute ``sweep_grid``."""
+    return json.dumps({"chi": [float(c) for c in grid.chi], "N": [int(n) for n in grid.N],
+                       "options": grid.options}, sort_keys=True, default=str)
+
+
+def check_combined(path, grid: Grid, *, overwrite: bool = False) -> Path:
+    """Refuse to replace the combined sweep file ``path`` when it holds another grid
+    (unless ``overwrite``): two sweeps into one directory would silently swap its
+    ``sweep.nc``. The same grid's file is replaced by its update."""
+    import xarray as xr
+
+    from ._files import check_output
+
+    path = Path(path)
+    if not os.path.lexists(path):
+        return path
+    check_output(path, name="output", overwrite=True)  # a regular file (not a device, FIFO, ...)
+    if overwrite:
+        return path
+    held = None
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as ds:
+            held = ds.attrs.get("sweep_grid")
+    except Exception:  # not a netCDF file: it is not ours to replace
+        pass
+    if held != grid_key(grid):
+        what = "a sweep of another grid" if held else "a file that is not this sweep's combined runs"
+        if held:
+            g = json.loads(held)
+            what += f" (chi={g['chi']}, N={g['N']}, options={g['options']})"
+        raise V.SnappingInputError(f"output={str(path)!r} holds {what}: give this sweep its own -o directory, or "
+                                   f"--overwrite (overwrite=True) to replace that file")
+    return path
+
+
 def _check_room(out: Path, todo: list) -> None:
     """Refuse a sweep whose run files (estimated sizes) do not fit on the filesystem of ``out``."""
     import shutil
@@ -484,6 +521,15 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     --------
     >>> paths = run_sweep(Grid(chi=[0.5], N=[8], options={"tol": 1e-6}), "/tmp/sw", progress=False)  # doctest: +SKIP
     """
+    from ._files import locked
+
+    out = _check_out_dir(out_dir)
+    with locked(out / "sweep.nc", name="out_dir"):  # one sweep at a time in a directory
+        return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, ensemble=ensemble)
+
+
+def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble) -> list[Path]:
+    """:func:`run_sweep` once its directory is checked and locked."""
     from tqdm.auto import tqdm
 
     out = _check_out_dir(out_dir)
