@@ -83,10 +83,9 @@ class RunOptions:
             if v is not None and not dt_min <= v <= T_MAX:
                 raise V.SnappingInputError(f"{name}={v!r} is out of range: must lie in [dt_min={dt_min:g}, "
                                            f"{T_MAX:g}]")
-        end = self.t_end_max if self.t_end is None else self.t_end
-        if self.dt0 is not None and not dt_min <= self.dt0 <= end:
+        if self.dt0 is not None and not dt_min <= self.dt0 <= T_MAX:
             raise V.SnappingInputError(f"dt0={self.dt0!r} is out of range: must lie in [dt_min={dt_min:g}, "
-                                       f"{'t_end' if self.t_end is not None else 't_end_max'}={end:g}]")
+                                       f"{T_MAX:g}]")
         put("snapshot_times", _times(self.snapshot_times))
         thin = V.real("record_thin", self.record_thin)
         if not 0.0 <= thin < 1.0:
