@@ -10,7 +10,12 @@ Each case asserts one of two outcomes:
   the option as typed, e.g. ``--chi`` (command line); never a traceback, an exception of another
   kind, a hang or a non-finite result;
 * valid (marked explicitly in ``VALID``/``CLI_VALID`` below): a finite, sensible result (exit 0
-  and JSON without null from the command line).
+  and JSON without null from the command line, beyond the nulls of the same command without the
+  bad value);
+
+and, for the one bound a user can set that a run cannot meet (``max_energy_drift=5e-324``,
+``FAILS``/``CLI_FAILS``), the run's one-line SimulationError (exit status 1). The data of the
+fits are attacked too (negative, zero, constant, all after t*, one or two samples, huge).
 
 Every call is cheap: N <= 10 links and t_end = 1e-3 for the simulator; a sweep, converge or
 reproduce case is refused before any work starts (the valid values that would start a long

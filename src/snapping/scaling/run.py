@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import estimates, schema
+from ..ideal import TAU_MIN
 from .fit import PeakTime, PowerLawFit, fit_power_law, local_slope, peak_time
 
 if TYPE_CHECKING:  # annotations only
@@ -578,11 +579,9 @@ def ideal_window_exponent(quantity: str, tau_lo: float, tau_hi: float) -> float:
     """
     from .. import ideal
 
-    import dataclasses
-
-    fields = [f.name for f in dataclasses.fields(ideal.KinkState) if f.name not in ("t", "tau")]
-    if quantity not in fields:
-        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {fields}")
+    names = [f.name for f in fields(ideal.KinkState) if f.name not in ("t", "tau")]
+    if quantity not in names:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {names}")
     tau_lo = V.real("tau_lo", tau_lo)
     tau_hi = V.real("tau_hi", tau_hi)
     if not ideal.TAU_MIN <= tau_lo < min(tau_hi, ideal.t_star()):
@@ -723,9 +722,7 @@ def fit_run(
         z, verdict = _verdict(f, spec)
         bw = math.nan
         if spec.ideal is not None:
-            from .. import ideal
-
-            bw = ideal_window_exponent(spec.ideal, max(f.tau_lo, ideal.TAU_MIN), f.tau_hi)
+            bw = ideal_window_exponent(spec.ideal, max(f.tau_lo, TAU_MIN), f.tau_hi)
             verdict += f"; {_judge(f, bw, spec)[1]} with the exact folded string in this window"
         rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw))
     if "min_width" in fit_kw and rows and all(r.fit is None for r in rows):  # the user's window width fits nothing
