@@ -32,7 +32,11 @@ def _as_float(name: str, value) -> float:
             ) from None
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise SnappingInputError(f"{name}={value!r} is not a real number (expected a finite float)")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:  # an integer beyond the doubles (10**400)
+        raise SnappingInputError(f"{name}={_short(value)} is too large: must be a finite float "
+                                 f"(|x| < 1.8e308)") from None
     if not math.isfinite(x):
         raise SnappingInputError(f"{name}={x!r} must be a finite real number")
     return x
@@ -87,8 +91,13 @@ def open_interval(name: str, value, lo: float, hi: float) -> float:
     return x
 
 
+#: the largest integer accepted when no maximum is given (a count beyond it cannot be meant)
+MAX_INTEGER = 2**53
+
+
 def integer(name: str, value, minimum: int = 1, maximum: int | None = None) -> int:
-    """Return ``value`` as an int in [minimum, maximum], or raise naming ``name``.
+    """Return ``value`` as an int in [minimum, maximum] (maximum default :data:`MAX_INTEGER`),
+    or raise naming ``name``.
 
     >>> integer("N", 200.0)       # an integral float is accepted
     200
@@ -111,11 +120,15 @@ def integer(name: str, value, minimum: int = 1, maximum: int | None = None) -> i
         raise SnappingInputError(f"{name}={value!r} is not an integer")
     hi = "inf" if maximum is None else str(maximum)
     if n < minimum or (maximum is not None and n > maximum):
-        raise SnappingInputError(f"{name}={n} is out of range: must be an integer in [{minimum}, {hi}]")
+        raise SnappingInputError(f"{name}={_short(n)} is out of range: must be an integer in [{minimum}, {hi}]")
+    if maximum is None and n > MAX_INTEGER:
+        raise SnappingInputError(f"{name}={_short(n)} is out of range: too large (at most 2**53 = {MAX_INTEGER})")
     return n
 
 
 def _short(value) -> str:
+    if isinstance(value, int) and abs(value) > 10**30:
+        return f"{'-' if value < 0 else ''}10**{len(str(abs(value))) - 1}..."
     r = repr(value)
     return r if len(r) <= 60 else r[:57] + "..."
 
@@ -138,6 +151,9 @@ def float_array(name: str, value):
         return np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers") from None
+    except OverflowError:  # an integer beyond the doubles (10**400)
+        raise SnappingInputError(f"{name}={_short(value)} holds a number too large for a float (|x| < 1.8e308)") \
+            from None
 
 
 def file_path(name: str, value) -> str:

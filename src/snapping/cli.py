@@ -762,6 +762,34 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: library parameters that come from inside an option's value (named after the option)
+_PART_OF = {"simulate": {"ratio": "--taper", "power": "--taper", "accel": "--pin-motion", "period": "--pin-motion",
+                         "duration": "--pin-motion", "t0": "--pin-motion", "dx": "--supports", "dy": "--supports"}}
+
+
+def _as_typed(parser, command: str, msg: str) -> str:
+    """The library's message with its parameter names as the user typed them (``t_end=`` ->
+    ``--t-end=``; ``ratio=`` of --taper -> ``--taper ratio=``)."""
+    import re
+
+    try:
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    except (StopIteration, KeyError):
+        return msg
+    names = {}
+    for a in sub._actions:
+        longs = [o for o in a.option_strings if o.startswith("--")]
+        if longs and a.dest not in ("help", "json"):
+            names[a.dest] = longs[0]
+    after = r"(?=[=\[]| contains| grid)"
+    for dest, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
+        msg = re.sub(rf"(?<![\w.\-]){re.escape(dest)}{after}", opt, msg)
+    for name, opt in _PART_OF.get(command, {}).items():
+        if opt not in msg:
+            msg = re.sub(rf"(?<![\w.\-]){re.escape(name)}{after}", f"{opt} {name}", msg, count=1)
+    return msg
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -772,7 +800,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
-        print(f"snapping {args.command}: error: {exc}", file=sys.stderr)
+        print(f"snapping {args.command}: error: {_as_typed(parser, args.command, str(exc))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"snapping {args.command}: interrupted", file=sys.stderr)

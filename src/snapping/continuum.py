@@ -45,6 +45,10 @@ __all__ = ["converge", "extrapolate", "level_parameters", "Convergence", "QUANTI
 QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v")
 #: the coarsest level's grading (fractions of the fold's radius, links at the free end, held arm)
 FRAC0, H_MIN0, H_MAX0 = 0.04, 4e-6, 4e-3
+#: most refinement levels, and the smallest length scales of the finest level (beyond, its chain
+#: has more links than a run can hold)
+MAX_LEVELS = 30
+FINEST = {"frac": 1e-6, "h_min": 1e-15, "h_max": 1e-7}
 
 
 def level_parameters(levels: int = 4, ratio: float = 0.5, *, frac0: float = FRAC0, h_min0: float = H_MIN0,
@@ -54,18 +58,41 @@ def level_parameters(levels: int = 4, ratio: float = 0.5, *, frac0: float = FRAC
     >>> [p["frac"] for p in level_parameters(3)]
     [0.04, 0.02, 0.01]
     """
-    levels = V.integer("levels", levels, 1)
+    levels = V.integer("levels", levels, 1, MAX_LEVELS)
     ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
-    return [{"frac": frac0 * ratio**k, "h_min": h_min0 * ratio**k, "h_max": min(0.5, h_max0 * ratio**k)}
-            for k in range(first, first + levels)]
+    first = V.integer("first", first, -20, 100)
+    frac0 = V.open_interval("frac0", frac0, 0.0, 1.0)
+    h_min0 = V.open_interval("h_min0", h_min0, 0.0, 1.0)
+    h_max0 = V.open_interval("h_max0", h_max0, 0.0, 1.0)
+    if h_max0 < h_min0:
+        raise V.SnappingInputError(f"h_max0={h_max0!r} is out of range: must be >= h_min0={h_min0!r}")
+    how = f"levels={levels}, ratio={ratio!r}, first={first}"
+    try:
+        out = [{"frac": frac0 * ratio**k, "h_min": h_min0 * ratio**k, "h_max": min(0.5, h_max0 * ratio**k)}
+               for k in range(first, first + levels)]
+    except (OverflowError, ZeroDivisionError):  # ratio**first beyond the doubles
+        raise V.SnappingInputError(f"{how}: ratio**first={ratio!r}**{first} leaves the doubles (use first >= 0 "
+                                   f"or a ratio closer to 1)") from None
+    c, f = out[0], out[-1]
+    if not c["frac"] < 1.0 or not c["h_min"] < 0.5:
+        raise V.SnappingInputError(f"{how} with frac0={frac0!r}, h_min0={h_min0!r} make the coarsest level's "
+                                   f"frac={c['frac']:.3g}, h_min={c['h_min']:.3g}: must be < 1 and < 0.5 (use a "
+                                   f"larger first)")
+    given = {"frac": frac0, "h_min": h_min0, "h_max": h_max0}
+    for key, floor in FINEST.items():
+        if not f[key] >= floor:
+            raise V.SnappingInputError(f"{how} with {key}0={given[key]!r} make the finest level's "
+                                       f"{key}={f[key]:.3g} < {floor:g} (too many links): use fewer levels, a "
+                                       f"smaller first or a ratio closer to 1")
+    return out
 
 
 def extrapolate(h, q) -> dict:
     """Observed order, Richardson limit and error bar of ``q`` sampled at resolutions ``h``
     (decreasing by a constant ratio). Returns ``limit``, ``error``, ``order``,
     ``converging`` (bool) and ``digits`` (significant digits the error bar supports)."""
-    h = np.asarray(h, dtype=float)
-    q = np.asarray(q, dtype=float)
+    h = np.asarray(V.float_array("h", h), dtype=float)
+    q = np.asarray(V.float_array("q", q), dtype=float)
     if h.size != q.size or h.size < 2:
         raise V.SnappingInputError(f"extrapolate needs h and q of one length >= 2; got {h.size} and {q.size}")
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(h)) and np.all(h > 0)):
@@ -209,10 +236,12 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     """
     import sys
 
-    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    from .estimates import check_chi
+
+    chi = check_chi(chi)
     workers = V.integer("workers", workers, 1)
-    params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0,
-                              first=V.integer("first", first, -20))
+    first = V.integer("first", first, -20, 100)
+    params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)
     paths = [None] * len(params)
     if output is not None:
         from ._files import check_output_dir

@@ -54,6 +54,20 @@ __all__ = [
 
 
 # ----------------------------------------------------------------------- catenary
+#: smallest end separation accepted: below it the scales of the catenary (delta_c ~ chi^(4/3))
+#: and the whirling-rod peaks (~ delta^-2) leave the doubles
+CHI_MIN = 1e-100
+
+
+def check_chi(chi, name: str = "chi") -> float:
+    """``chi`` as a float in [CHI_MIN, 1), or SnappingInputError naming ``name``."""
+    chi = V.open_interval(name, chi, 0.0, 1.0)
+    if chi < CHI_MIN:
+        raise V.SnappingInputError(f"{name}={chi!r} is out of range: must lie in [{CHI_MIN:g}, 1) (a smaller "
+                                   f"separation is the folded string, chi = 0: see snapping.ideal)")
+    return chi
+
+
 def _log_sinhc(b: float) -> float:
     """log(sinh(b)/b) for b > 0 without overflow or cancellation."""
     if b < 1e-4:
@@ -87,7 +101,7 @@ def catenary_parameter(chi: float) -> float:
     >>> abs(2 * a * math.sinh(0.1 / (2 * a)) - 1) < 1e-13
     True
     """
-    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    chi = check_chi(chi)
     target = -math.log(chi)
     # log(sinh b / b) ~ b^2/6 for small b and ~ b - log(2b) for large b.
     hi = max(1.0, 2.0 * (target + math.log(2.0 * target + 2.0)) + 2.0)
@@ -105,7 +119,16 @@ def chi_from_parameter(a: float) -> float:
     0.3
     """
     a = V.positive("a", a)
-    return 2.0 * a * math.asinh(1.0 / (2.0 * a))
+    chi = 2.0 * a * math.asinh(1.0 / (2.0 * a))
+    if not CHI_MIN <= chi < 1.0:  # (a huge: chi rounds to 1; a tiny: chi below CHI_MIN)
+        raise V.SnappingInputError(f"a={a!r} is out of range: the catenary's chi = {chi!r} must lie in "
+                                   f"[{CHI_MIN:g}, 1), i.e. a in [{_A_MIN:.3g}, {_A_MAX:.3g}]")
+    return chi
+
+
+#: the catenary parameters of chi = CHI_MIN and of the largest chi below 1 (where chi rounds to 1)
+_A_MIN = catenary_parameter(CHI_MIN)
+_A_MAX = catenary_parameter(float(np.nextafter(1.0, 0.0)))
 
 
 def catenary_shape(s, chi: float):
@@ -196,13 +219,20 @@ def delta_crude(chi: float) -> float:
     return 0.5 * (math.pi / kappa_m0(chi)) ** (4.0 / 3.0)
 
 
+#: most links of a chain (delta_N = 1/N and its peaks stay within the doubles)
+N_MAX = 10**15
+
+
 def delta_N(N: int) -> float:
     """delta_N = 1/N, the only scale if discreteness regularised the snap.
 
     >>> delta_N(2000)
     0.0005
     """
-    return 1.0 / V.integer("N", N, 1)
+    N = V.integer("N", N, 1)
+    if N > N_MAX:
+        raise V.SnappingInputError(f"N={N} is out of range: at most {N_MAX:g} links")
+    return 1.0 / N
 
 
 def whirling_rod(P: float, delta: float) -> dict[str, float]:
@@ -218,7 +248,11 @@ def whirling_rod(P: float, delta: float) -> dict[str, float]:
     P = V.positive("P", P)
     delta = V.positive("delta", delta)
     v = math.sqrt(6.0 * P / delta)
-    return {"v": v, "a": v * v / delta, "sigma": 0.5 * v * v}
+    out = {"v": v, "a": v * v / delta, "sigma": 0.5 * v * v}
+    if not all(1e-300 < x < 1e300 for x in out.values()):
+        raise V.SnappingInputError(f"P={P!r} with delta={delta!r} is out of range: the peaks {out} leave the "
+                                   f"doubles (P/delta and P/delta^2 must lie in (1e-300, 1e300))")
+    return out
 
 
 # ------------------------------------------------------------------ SI design rules
@@ -227,6 +261,10 @@ def _t_star() -> float:
     from .ideal import t_star
 
     return float(t_star())
+
+
+#: range of a chain's length, mass and gravity in SI
+CHAIN_RANGE = (1e-30, 1e30)
 
 
 @dataclass(frozen=True)
@@ -252,9 +290,12 @@ class Chain:
     g: float = 9.81
 
     def __post_init__(self):
-        V.positive("length", self.length)
-        V.positive("mass", self.mass)
-        V.positive("g", self.g)
+        lo, hi = CHAIN_RANGE
+        for name, unit in (("length", "m"), ("mass", "kg"), ("g", "m/s^2")):
+            x = V.positive(name, getattr(self, name))
+            if not lo <= x <= hi:
+                raise V.SnappingInputError(f"{name}={x!r} {unit} is out of range: must lie in [{lo:g}, {hi:g}] "
+                                           f"(beyond, the SI values leave the doubles)")
 
     def velocity(self, v):
         """Nondimensional speed -> m/s."""
@@ -349,17 +390,21 @@ def design_estimate(
     if separation is not None:
         sep = V.open_interval("separation", separation, 0.0, chain.length)
         chi = sep / chain.length
+        if chi < CHI_MIN:
+            raise V.SnappingInputError(f"separation={sep!r} m is out of range: must lie in "
+                                       f"[{CHI_MIN * chain.length:.3g}, {chain.length:g}) m for length "
+                                       f"{chain.length:g} m (chi >= {CHI_MIN:g})")
     elif curvature is not None:
         kappa = V.positive("curvature", curvature)
+        lo, hi = 1.0 / (_A_MAX * chain.length), 1.0 / (_A_MIN * chain.length)
+        if not lo <= kappa <= hi:  # curvature so small or large that chi rounds to 1 or leaves [CHI_MIN, 1)
+            raise V.SnappingInputError(f"curvature={kappa!r} 1/m is out of range: must lie in [{lo:.3g}, {hi:.3g}] "
+                                       f"1/m for length {chain.length:g} m (chi in [{CHI_MIN:g}, 1))")
         chi = chi_from_parameter(1.0 / (kappa * chain.length))
-        if not 0.0 < chi < 1.0:  # curvature so small or large that chi rounds to 0 or 1
-            raise V.SnappingInputError(
-                f"curvature={kappa!r} 1/m gives chi={chi!r}, outside (0, 1): give a curvature in "
-                f"(0, inf) that is not extreme for length {chain.length} m"
-            )
-    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    chi = check_chi(chi)
     if N is not None:
         N = V.integer("N", N, 1)
+        delta_N(N)
     a = catenary_parameter(chi)
     P = available_energy(chi)
     t_star = _t_star()

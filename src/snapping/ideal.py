@@ -593,10 +593,16 @@ def _as_array(name: str, value: ArrayLike) -> np.ndarray:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise SnappingInputError(f"{name}={value!r} is not a real number or array of real numbers") from None
+    except OverflowError:  # an integer beyond the doubles (10**400)
+        raise SnappingInputError(f"{name} holds a number too large for a float (|x| < 1.8e308)") from None
     if arr.size and not np.all(np.isfinite(arr)):
         bad = float(arr.ravel()[~np.isfinite(arr.ravel())][0])
         raise SnappingInputError(f"{name}={bad!r} must be a finite real number")
     return arr
+
+
+#: smallest t* - t accepted (below, s0'' ~ tau^(-4/3) overflows a double)
+TAU_MIN = 1e-230
 
 
 def kink_state(t: ArrayLike | None = None, *, tau: ArrayLike | None = None) -> KinkState:
@@ -619,8 +625,8 @@ def kink_state(t: ArrayLike | None = None, *, tau: ArrayLike | None = None) -> K
     t : array_like, optional
         Times in [0, t*).
     tau : array_like, keyword-only, optional
-        Times to snap t* - t in (0, t*], instead of ``t``; use this to resolve
-        tau below the double spacing near t* (~2e-16).
+        Times to snap t* - t in [TAU_MIN, t*] (TAU_MIN = 1e-230), instead of ``t``;
+        use this to resolve tau below the double spacing near t* (~2e-16).
 
     Returns
     -------
@@ -655,11 +661,12 @@ def kink_state(t: ArrayLike | None = None, *, tau: ArrayLike | None = None) -> K
             )
     else:
         tau_arr = _as_array("tau", tau)
-        bad = ~(tau_arr > 0.0) | (tau_arr > _T_HI)
+        bad = ~(tau_arr >= TAU_MIN) | (tau_arr > _T_HI)
         if np.any(bad):
             val = float(tau_arr.ravel()[bad.ravel()][0])
             raise SnappingInputError(
-                f"tau={val!r} is out of range: must lie in (0, t*] with t* = {_T_HI!r} (tau = t* - t)"
+                f"tau={val!r} is out of range: must lie in [{TAU_MIN:g}, t*] with t* = {_T_HI!r} (tau = t* - t; "
+                f"closer to t* the acceleration ~ tau^(-4/3) leaves the doubles)"
             )
         tt = (_T_HI - tau_arr) + _T_LO
         tt = np.where(tau_arr >= _T_HI, 0.0, tt)  # tau = t* (as a double) means t = 0
@@ -834,7 +841,12 @@ def kink_energy(s0: ArrayLike, s0_dot: ArrayLike) -> np.ndarray:
     s = _as_array("s0", s0)
     v = _as_array("s0_dot", s0_dot)
     x = 1.0 - s
-    return 2.0 * x * v * v + x * x - 0.5
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = 2.0 * x * v * v + x * x - 0.5
+    if not np.all(np.isfinite(e)):
+        raise SnappingInputError(f"s0={V._short(s0)} with s0_dot={V._short(s0_dot)} is out of range: the energy "
+                                 f"2 (1 - s0) s0'^2 + (1 - s0)^2 - 1/2 overflows a double")
+    return e
 
 
 # ====================================================================== scalings

@@ -30,6 +30,10 @@ __all__ = ["available_energy_shape", "kappa_m0_shape", "shape_estimate"]
 # Node order of the simulator: index 0 = free end, index N = pin; link j joins
 # nodes j and j + 1. Takes coordinates, never imports snapping.simulate.
 # =============================================================================
+#: range of the gravity of a shape's estimates (units of g)
+G_RANGE = (1e-30, 1e30)
+
+
 def _shape_arrays(x, y):
     """x, y as finite 1-D float arrays of one length N + 1 >= 2 with links of positive length."""
     x = V.float_array("x", x)
@@ -109,6 +113,9 @@ def available_energy_shape(x, y, m, g: float = 1.0) -> float:
         i = int(bad[0])
         raise V.SnappingInputError(f"m[{i}]={float(m[i])!r} is out of range: node masses must be finite and >= 0")
     g = V.positive("g", g)
+    if not G_RANGE[0] <= g <= G_RANGE[1]:
+        raise V.SnappingInputError(f"g={g!r} is out of range: must lie in [{G_RANGE[0]:g}, {G_RANGE[1]:g}] (units of "
+                                   f"the library's g)")
     s = np.zeros(x.size)
     s[:-1] = np.cumsum(h[::-1])[::-1]  # s_i = h_i + ... + h_{N-1}, s_N = 0
     return g * math.fsum(m * (s - (y - y[-1])))
@@ -195,7 +202,11 @@ def shape_estimate(x, y, m, g: float = 1.0) -> dict:
     if not k0 > 0.0:
         raise V.SnappingInputError("the start shape is straight (kappa_m(0) = 0): the curvature scales are undefined")
     scales = {"delta_kappa0": 0.5 * math.pi / k0, "delta_c": 0.5 * (math.pi / k0) ** (4.0 / 3.0)}
-    preds = {k: whirling_rod(P, d) for k, d in scales.items()} if P > 0.0 else {}
+    try:
+        preds = {k: whirling_rod(P, d) for k, d in scales.items()} if P > 0.0 else {}
+    except V.SnappingInputError as exc:
+        raise V.SnappingInputError(f"the shape x, y with masses m and g={g!r} is too extreme for the estimates "
+                                   f"(P={P:.3g}, kappa_m(0)={k0:.3g}): {exc}") from None
     return {"P": P, "kappa_m0": k0, **scales, "predictions": preds}
 
 

@@ -97,7 +97,9 @@ class Grid:
     options: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        self.chi = _check_values("chi", self.chi, lambda n, v: V.open_interval(n, v, 0.0, 1.0))
+        from .estimates import check_chi
+
+        self.chi = _check_values("chi", self.chi, lambda n, v: check_chi(v, n))
         self.N = _check_values("N", self.N, lambda n, v: V.integer(n, v, 1))
         if not isinstance(self.options, dict):
             raise V.SnappingInputError(f"options={self.options!r} must be a dict of keywords of simulate.run")

@@ -77,12 +77,50 @@ def _loglog(t: np.ndarray, y: np.ndarray, t_star: float):
     before t* with y > 0."""
     tau = t_star - t
     ok = (tau > 0) & (y > 0)
+    if not ok.any():  # every sample after t* (or y <= 0): nothing to fit
+        e = np.zeros(0)
+        return e, e, e, e
     X = np.log10(tau[ok])
     Y = np.log10(y[ok])
     order = np.argsort(X, kind="stable")
     X, Y, ts = X[order], Y[order], t[ok][order]
     X, Y, ts = _thin(X, Y, ts)
     return X, Y, _weights(X), ts
+
+
+def _before(t, y, t_star, min_points, name="t_star"):
+    """_loglog, refusing a t* (named ``name``) with fewer than ``min_points`` samples before it
+    or so far past the data that t* - t spans no range."""
+    X, Y, w, ts = _loglog(t, y, t_star)
+    if X.size < min_points:
+        raise V.SnappingInputError(
+            f"{name}={t_star!r}: only {X.size} samples with t < t_star and y > 0; at least {min_points} are needed"
+        )
+    if not X[-1] - X[0] > 1e-9:
+        raise V.SnappingInputError(f"{name}={t_star!r} is out of range: so far past the data that t* - t spans "
+                                   f"no range (the samples lie in [{t.min():.6g}, {t.max():.6g}])")
+    return X, Y, w, ts
+
+
+#: most local fits of a local-slope curve (data span / spacing)
+_MAX_CENTERS = 100_000
+
+
+def _grid(X, span, spacing, min_width=None):
+    """The centres of the local fits, refusing a spacing (or min_width) that the data cannot hold."""
+    width = float(X[-1] - X[0])
+    if not spacing <= width:
+        raise V.SnappingInputError(f"spacing={spacing!r} is out of range: must be <= the {width:.3g} decades of "
+                                   f"t* - t the data span")
+    if not width / spacing <= _MAX_CENTERS:
+        raise V.SnappingInputError(f"spacing={spacing!r} is out of range: the data span {width:.3g} decades of "
+                                   f"t* - t, which would make more than {_MAX_CENTERS} local fits (spacing >= "
+                                   f"{width / _MAX_CENTERS:.3g})")
+    if min_width is not None and not min_width <= width + spacing:
+        raise V.SnappingInputError(
+            f"the data span only {width:.3g} decades of t* - t; min_width={min_width!r} decades is needed"
+        )
+    return _center_grid(X, spacing)
 
 
 _PER_DECADE = 200  # resolution of the log10(tau) bins when records are long
@@ -231,7 +269,9 @@ def peak_time(t, y, *, name: str = "y", min_drop: float = 0.0) -> PeakTime:
     >>> round(p.t, 12)
     0.537
     """
-    min_drop = float(min_drop)
+    min_drop = V.real("min_drop", min_drop)
+    if not 0.0 <= min_drop < 1.0:
+        raise V.SnappingInputError(f"min_drop={min_drop!r} is out of range: must lie in [0, 1) (a relative fall)")
     t, y = _arrays(t, y, name)
     n = t.size
     i = int(np.argmax(y))
@@ -362,13 +402,15 @@ def local_slope(
     spacing = V.positive("spacing", spacing)
     min_points = V.integer("min_points", min_points, 3)
     t, y = _arrays(t, y)
-    X, Y, w, _ = _loglog(t, y, t_star)
-    if X.size < min_points:
-        raise V.SnappingInputError(
-            f"t_star={t_star!r}: only {X.size} samples with t < t_star and y > 0; at least {min_points} are needed"
-        )
-    centers = _center_grid(X, spacing)
+    if min_points > t.size:
+        raise V.SnappingInputError(f"min_points={min_points} is out of range: the data hold {t.size} finite samples")
+    X, Y, w, _ = _before(t, y, t_star, min_points)
+    centers = _grid(X, span, spacing)
     slope, se, nn = _local_slope_arrays(X, Y, w, centers, 0.5 * span, min_points)
+    if not np.isfinite(slope).any():
+        raise V.SnappingInputError(f"span={span!r}, spacing={spacing!r} (decades): no local fit has {min_points} "
+                                   f"samples spread over its span; the data span {X[-1] - X[0]:.3g} decades of "
+                                   f"t* - t")
     return LocalSlope(10.0**centers, slope, se, nn, span)
 
 
@@ -454,6 +496,7 @@ def find_window(
     slope_range: tuple[float, float] | None = None,
     span: float = 0.5,
     spacing: float = 0.05,
+    t_star_name: str = "t_star",
 ) -> Window:
     """Choose the window of tau = t* - t where the local log-log slope is flat.
 
@@ -488,6 +531,8 @@ def find_window(
         Allowed range of the mean local slope.
     span, spacing : float
         Local slope fits (see :func:`local_slope`).
+    t_star_name : str
+        Name of ``t_star`` in error messages.
 
     Returns
     -------
@@ -515,13 +560,9 @@ def find_window(
         if not slope_range[0] < slope_range[1]:
             raise V.SnappingInputError(f"slope_range={slope_range!r} must be an increasing pair (lo, hi)")
     t, y = _arrays(t, y)
-    X, Y, w, _ = _loglog(t, y, t_star)
-    if X.size < _MIN_POINTS:
-        raise V.SnappingInputError(
-            f"t_star={t_star!r}: only {X.size} samples with t < t_star and y > 0; at least {_MIN_POINTS} are needed"
-        )
+    X, Y, w, _ = _before(t, y, t_star, _MIN_POINTS, t_star_name)
     half = 0.5 * span
-    centers = _center_grid(X, spacing)
+    centers = _grid(X, span, spacing, min_width)
     slope, se, _ = _local_slope_arrays(X, Y, w, centers, half, 4)
     cands = list(
         _choose_window(
@@ -538,6 +579,7 @@ def find_window(
         raise V.SnappingInputError(
             "no window of t* - t with enough samples"
             + (f" and a mean local slope in slope_range={slope_range!r}" if slope_range else " and a non-zero slope")
+            + f" (span={span!r}, spacing={spacing!r}, min_width={min_width!r} decades)"
         )
     tol_eff = tol if Dmin <= tol else 1.5 * Dmin
     best = None
@@ -728,6 +770,10 @@ def _joint(t, y, t_guess, tau_lo, tau_hi, notes: list[str]):
     return t_best, t_err, best, betas
 
 
+#: largest edge displacement of the window uncertainty (decades)
+_MAX_PERTURB = 3.0
+
+
 def fit_power_law(
     t,
     y,
@@ -806,17 +852,17 @@ def fit_power_law(
     >>> round(g.t_star, 6)
     1.2
     """
-    t_star_err = float(t_star_err)
-    if not (math.isfinite(t_star_err) and t_star_err >= 0):
+    t_star_err = V.real("t_star_err", t_star_err)
+    if not t_star_err >= 0:
         raise V.SnappingInputError(f"t_star_err={t_star_err!r} is out of range: must be a finite number >= 0")
-    perturb = float(perturb)
-    if not (math.isfinite(perturb) and perturb >= 0):
-        raise V.SnappingInputError(f"perturb={perturb!r} is out of range: must be a finite number >= 0 (decades)")
+    perturb = V.real("perturb", perturb)
+    if not 0 <= perturb <= _MAX_PERTURB:
+        raise V.SnappingInputError(f"perturb={perturb!r} is out of range: must lie in [0, {_MAX_PERTURB:g}] (decades)")
     t, y = _arrays(t, y, name)
     if window is not None:
         try:
             tau_lo, tau_hi = (float(window[0]), float(window[1]))
-        except (TypeError, ValueError, IndexError):
+        except (TypeError, ValueError, IndexError, OverflowError):
             raise V.SnappingInputError(f"window={window!r} must be a pair (tau_lo, tau_hi)") from None
         if not (0 < tau_lo < tau_hi < math.inf):
             raise V.SnappingInputError(
@@ -833,9 +879,16 @@ def fit_power_law(
                 t_guess = float(t[-1] + (t[-1] - t[-2]))
         else:
             t_guess = V.real("t_star_guess", t_star_guess)
+            if not (np.count_nonzero(t < t_guess) >= _MIN_POINTS and t_guess <= t[-1] + (t[-1] - t[0])):
+                raise V.SnappingInputError(
+                    f"t_star_guess={t_guess!r} is out of range: must lie after {_MIN_POINTS} samples and not past "
+                    f"t[-1] + (t[-1] - t[0]) = {2 * t[-1] - t[0]:.6g}")
     else:
         t_star = V.real("t_star", t_star)
         t_guess = t_star
+        if t_star > t[0] and not t_star_err < t_star - t[0]:
+            raise V.SnappingInputError(f"t_star_err={t_star_err!r} is out of range: must be < t* - t[0] = "
+                                       f"{t_star - t[0]:.6g} (the time the data span before t*)")
 
     kw = dict(min_width=min_width, tol=tol, prefer=prefer, slope_range=slope_range, span=span, spacing=spacing)
 
@@ -843,7 +896,7 @@ def fit_power_law(
         if window is not None:
             _check_window(t, y, ts_, tau_lo, tau_hi, name)
             return tau_lo, tau_hi, True
-        w = find_window(t, y, ts_, **kw)
+        w = find_window(t, y, ts_, **kw, t_star_name="t_star" if not fitted else "t_star_guess")
         if not w.flat:
             notes.append(
                 f"no window of {min_width:g} decades is flat within tol={tol:g}; "

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import _validate as V
 from .. import estimates, schema
+from ..ideal import TAU_MIN
 from .fit import PeakTime, PowerLawFit, fit_power_law, local_slope, peak_time
 
 if TYPE_CHECKING:  # annotations only
@@ -578,8 +579,14 @@ def ideal_window_exponent(quantity: str, tau_lo: float, tau_hi: float) -> float:
     """
     from .. import ideal
 
-    if not 0.0 < tau_lo < tau_hi:
-        raise V.SnappingInputError(f"window [{tau_lo!r}, {tau_hi!r}] of t* - t must satisfy 0 < lo < hi")
+    names = [f.name for f in fields(ideal.KinkState) if f.name not in ("t", "tau")]
+    if quantity not in names:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {names}")
+    tau_lo = V.real("tau_lo", tau_lo)
+    tau_hi = V.real("tau_hi", tau_hi)
+    if not ideal.TAU_MIN <= tau_lo < min(tau_hi, ideal.t_star()):
+        raise V.SnappingInputError(f"tau_lo={tau_lo!r}, tau_hi={tau_hi!r}: the window of t* - t must satisfy "
+                                   f"{ideal.TAU_MIN:g} <= tau_lo < tau_hi and tau_lo < t* = {ideal.t_star():.6g}")
     tau = np.logspace(math.log10(tau_lo), math.log10(min(tau_hi, ideal.t_star())), 200)
     y = np.abs(getattr(ideal.kink_state(tau=tau), quantity))
     ok = y > 0  # the free end starts at rest (tau = t*)
@@ -676,6 +683,10 @@ def fit_run(
     for k in ("tol", "min_width"):  # chosen by the user: refuse rather than fail every row quietly
         if k in fit_kw:
             fit_kw[k] = V.positive(k, fit_kw[k])
+    span = V.positive("span", fit_kw.get("span", 0.5))
+    if "min_width" in fit_kw and not fit_kw["min_width"] > span:
+        raise V.SnappingInputError(f"min_width={fit_kw['min_width']!r} is out of range: must be > span={span!r} "
+                                   f"(decades)")
     specs = report_specs() if specs is None else specs
     if windows:
         known = {s.name for s in specs} | {s.var for s in specs}
@@ -711,9 +722,11 @@ def fit_run(
         z, verdict = _verdict(f, spec)
         bw = math.nan
         if spec.ideal is not None:
-            bw = ideal_window_exponent(spec.ideal, f.tau_lo, f.tau_hi)
+            bw = ideal_window_exponent(spec.ideal, max(f.tau_lo, TAU_MIN), f.tau_hi)
             verdict += f"; {_judge(f, bw, spec)[1]} with the exact folded string in this window"
         rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw))
+    if "min_width" in fit_kw and rows and all(r.fit is None for r in rows):  # the user's window width fits nothing
+        raise V.SnappingInputError(f"min_width={fit_kw['min_width']!r}: no row could be fitted ({rows[0].error})")
     dc = None
     notes = []
     if delta and "kappa_max" in ds.variables and "s_kappa_max" in ds.variables and "chi" in ds.attrs:

@@ -146,7 +146,7 @@ def initial_state(chi: float, N: int, chords: str = "arclength") -> ChainState:
     >>> bool(abs(initial_state(0.25, 4, chords="exact").link_lengths() - 0.25).max() < 1e-14)
     True
     """
-    chi = V.open_interval("chi", chi, 0.0, 1.0)
+    chi = estimates.check_chi(chi)
     N = V.integer("N", N, 1)
     if chords not in CHORDS:
         raise V.SnappingInputError(f"chords={chords!r} is not one of {CHORDS}")

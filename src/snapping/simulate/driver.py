@@ -24,6 +24,7 @@ import xarray as xr
 
 from .. import _files
 from .. import _validate as V
+from ..estimates import check_chi
 from . import kernels as K
 from . import methods as M
 from .chain import ChainState
@@ -94,7 +95,7 @@ def _validate_start(chi, N, method, chords, initial, problem):
         N = problem.N
         chi = float("nan")
     elif initial is None:
-        chi = V.open_interval("chi", chi, 0.0, 1.0)
+        chi = check_chi(chi)
         N = V.integer("N", N, 1)
     else:
         if not isinstance(initial, ChainState):
@@ -102,7 +103,7 @@ def _validate_start(chi, N, method, chords, initial, problem):
         if N is not None and V.integer("N", N, 1) != initial.N:
             raise V.SnappingInputError(f"N={N} does not match the initial state's N={initial.N}")
         N = initial.N
-        chi = float("nan") if chi is None else V.open_interval("chi", chi, 0.0, 1.0)
+        chi = float("nan") if chi is None else check_chi(chi)
     if not isinstance(method, str) or method not in METHODS:
         raise V.SnappingInputError(f"method={method!r} is not one of {METHODS}")
     if not isinstance(chords, str) or chords not in ("arclength", "exact"):
@@ -628,6 +629,9 @@ def integrate_fixed(state: ChainState, dt: float, n_steps: int) -> ChainState:
         raise V.SnappingInputError(f"state={type(state).__name__} is not a ChainState")
     dt = V.positive("dt", dt)
     n_steps = V.integer("n_steps", n_steps, 1)
-    r = run(initial=state, method="euler-richardson-fixed", dt0=dt, t_end=state.t + n_steps * dt,
-            max_link_error=0.5, progress=False)
+    try:
+        r = run(initial=state, method="euler-richardson-fixed", dt0=dt, t_end=state.t + n_steps * dt,
+                max_link_error=0.5, progress=False)
+    except V.SnappingInputError as exc:  # (t_end = t + n_steps dt: name what the user gave)
+        raise V.SnappingInputError(f"dt={dt!r}, n_steps={n_steps}: {exc}") from None
     return r.state

@@ -466,13 +466,15 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
         raise V.SnappingInputError(f"method={method!r}: ensembles run the angle-form methods {DOP.NAMES}")
     try:
         chis = [float(c) for c in np.atleast_1d(np.asarray(chis, dtype=float))]
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise V.SnappingInputError(f"chis={chis!r} is not a sequence of numbers") from None
     if not chis:
         raise V.SnappingInputError("chis=[] is empty: give at least one chi")
     if outputs is not None and len(outputs) != len(chis):
         raise V.SnappingInputError(f"outputs has {len(outputs)} paths for {len(chis)} members")
-    chis = [V.open_interval("chi", chi, 0.0, 1.0) for chi in chis]
+    from ..estimates import check_chi
+
+    chis = [check_chi(chi) for chi in chis]
     N = V.integer("N", N, 1)
     if not isinstance(chords, str) or chords not in ("arclength", "exact"):
         raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")

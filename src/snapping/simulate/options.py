@@ -33,6 +33,11 @@ __all__ = ["RunOptions", "memory_need", "check_memory", "check_progress", "check
 
 #: largest stepper tolerance accepted
 MAX_TOL = 0.1
+#: smallest stepper tolerance accepted (a few times the round-off of an O(1) velocity)
+MIN_TOL = 1e-15
+_DT_MIN_DEFAULT = 1e-14
+#: latest end time accepted (units of sqrt(l/g); the snap is at t ~ 1.2)
+T_MAX = 1e6
 #: fraction of the available memory a run may plan to use (resource guard)
 MEMORY_MARGIN = 0.8
 
@@ -60,14 +65,27 @@ class RunOptions:
             object.__setattr__(self, name, value)
 
         tol = V.positive("tol", self.tol)
-        if tol > MAX_TOL:
-            raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in (0, {MAX_TOL:g}] (the error "
-                                       "estimate is a velocity, of order 1)")
+        if not MIN_TOL <= tol <= MAX_TOL:
+            raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in [{MIN_TOL:g}, {MAX_TOL:g}] (the "
+                                       "error estimate is a velocity, of order 1)")
         put("tol", tol)
+        dt_min = V.positive("dt_min", self.dt_min)
         put("dt0", None if self.dt0 is None else V.positive("dt0", self.dt0))
         put("t_end", None if self.t_end is None else V.positive("t_end", self.t_end))
         put("stop_fraction", V.open_interval("stop_fraction", self.stop_fraction, 0.0, 1.0))
         put("t_end_max", V.positive("t_end_max", self.t_end_max))
+        end = self.t_end_max if self.t_end is None else self.t_end
+        if dt_min != _DT_MIN_DEFAULT and end is not None and dt_min > end:  # the user's dt_min is the culprit
+            raise V.SnappingInputError(f"dt_min={dt_min!r} is out of range: must be <= "
+                                       f"{'t_end' if self.t_end is not None else 't_end_max'}={end:g}")
+        for name in ("t_end", "t_end_max"):
+            v = getattr(self, name)
+            if v is not None and not dt_min <= v <= T_MAX:
+                raise V.SnappingInputError(f"{name}={v!r} is out of range: must lie in [dt_min={dt_min:g}, "
+                                           f"{T_MAX:g}]")
+        if self.dt0 is not None and not dt_min <= self.dt0 <= T_MAX:
+            raise V.SnappingInputError(f"dt0={self.dt0!r} is out of range: must lie in [dt_min={dt_min:g}, "
+                                       f"{T_MAX:g}]")
         put("snapshot_times", _times(self.snapshot_times))
         thin = V.real("record_thin", self.record_thin)
         if not 0.0 <= thin < 1.0:
@@ -76,7 +94,7 @@ class RunOptions:
         put("max_link_error", V.open_interval("max_link_error", self.max_link_error, 0.0, 1.0))
         put("max_energy_drift", None if self.max_energy_drift is None
             else V.positive("max_energy_drift", self.max_energy_drift))
-        put("dt_min", V.positive("dt_min", self.dt_min))
+        put("dt_min", dt_min)
         put("max_rejections", V.integer("max_rejections", self.max_rejections, 0))
 
     @classmethod
@@ -118,7 +136,7 @@ def _times(snapshot_times) -> tuple:
         raise V.SnappingInputError(f"snapshot_times={snapshot_times!r} is not a sequence of times")
     try:
         vals = np.atleast_1d(np.asarray(snapshot_times, dtype=float)).ravel()
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise V.SnappingInputError(f"snapshot_times={snapshot_times!r} is not a sequence of times") from None
     out = tuple(sorted(V.real("snapshot_times", float(v)) for v in vals))
     for v in out:
@@ -160,6 +178,10 @@ def _available_memory() -> int | None:
         return None
 
 
+#: a count beyond any run (steps, records): extreme inputs are counted as this, then refused
+_MAX_COUNT = 1e30
+
+
 def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: str = "euler-richardson",
                 dt0: float | None = None, t_end: float | None = None, t_end_max: float = 10.0,
                 snapshot_times=(), record_thin: float = 0.0) -> dict:
@@ -187,18 +209,35 @@ def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: 
     (1000, 1001)
     """
     N = V.integer("N", N, 1)
+    if chi is not None:
+        from ..estimates import check_chi
+
+        chi = check_chi(chi)
+    tol = V.positive("tol", tol)
+    if not MIN_TOL <= tol <= MAX_TOL:
+        raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in [{MIN_TOL:g}, {MAX_TOL:g}]")
+    dt0 = None if dt0 is None else V.positive("dt0", dt0)
+    t_end = None if t_end is None else V.positive("t_end", t_end)
+    t_end_max = V.positive("t_end_max", t_end_max)
+    record_thin = V.real("record_thin", record_thin)
     angle_form = method in ("dop853", "fast")
-    if method == "euler-richardson-fixed" and dt0:
-        steps = math.ceil((t_end if t_end else t_end_max) / dt0 * (1.0 - 1e-8))
-    else:
-        c = 0.25 if chi is None or not math.isfinite(chi) else chi
-        steps = math.ceil(4.0e5 * (0.25 / c) ** 0.9 * (max(N, 1) / 400.0) ** 0.35 * (1e-8 / tol) ** 0.5
-                          * (max(1.0, t_end / 1.5) if t_end else 1.0))
-        if angle_form:  # dop853: 6-40x fewer evaluations than Euler-Richardson, 12 per step
-            steps = math.ceil(steps / 10)
+    try:  # in floats: an extreme input makes an astronomical (not an overflowing) count, refused by the guard
+        if method == "euler-richardson-fixed" and dt0:
+            steps_f = (t_end if t_end else t_end_max) / dt0 * (1.0 - 1e-8)
+        else:
+            c = 0.25 if chi is None else chi
+            steps_f = (4.0e5 * (0.25 / c) ** 0.9 * (max(N, 1) / 400.0) ** 0.35 * (1e-8 / tol) ** 0.5
+                       * (max(1.0, t_end / 1.5) if t_end else 1.0))
+            if angle_form:  # dop853: 6-40x fewer evaluations than Euler-Richardson, 12 per step
+                steps_f = steps_f / 10
+    except OverflowError:
+        steps_f = math.inf
+    steps = math.ceil(min(steps_f, _MAX_COUNT))
     records = steps + 1
     if record_thin > 0.0:
-        records = min(records, int(4 * math.log(1e8) / math.log1p(record_thin)) + 1000)
+        cap = 4 * math.log(1e8) / math.log1p(record_thin)
+        if cap < _MAX_COUNT:
+            records = min(records, int(cap) + 1000)
     snaps = len(snapshot_times) + 40
     record_bytes = 3 * records * K.NREC * 8
     snapshot_bytes = snaps * (N + 1) * 23 * 8
@@ -214,6 +253,8 @@ def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "euler-ric
     """Raise SnappingInputError when the run's record and snapshots would not fit in memory;
     else return the estimate (:func:`memory_need`, with ``file_bytes``: the run file's size)."""
     dt0 = math.sqrt(opts.tol) if opts.dt0 is None else opts.dt0
+    if chi is not None and not math.isfinite(chi):  # (nan: a run from a given state, no catenary)
+        chi = None
     need = memory_need(N, chi=chi, tol=opts.tol, method=method, dt0=dt0, t_end=opts.t_end,
                        t_end_max=opts.t_end_max, snapshot_times=opts.snapshot_times, record_thin=opts.record_thin)
     need["file_bytes"] = need["record_bytes"] / 3 + need["snapshot_bytes"]
@@ -221,8 +262,10 @@ def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "euler-ric
     if avail is None or need["bytes"] <= MEMORY_MARGIN * avail:
         return need
     gib = 2.0 ** 30
+    inputs = ", ".join(f"{k}={v:g}" for k, v in (("N", N), ("chi", chi), ("tol", opts.tol), ("dt0", opts.dt0),
+                                                    ("t_end", opts.t_end)) if v is not None)
     raise V.SnappingInputError(
-        f"the run would need about {need['bytes'] / gib:.3g} GiB of memory (record: ~{need['records']:.3g} steps "
+        f"{inputs} ({method}): the run would need about {need['bytes'] / gib:.3g} GiB of memory (record: ~{need['records']:.3g} steps "
         f"x {K.NREC * 8} B x 3 = {need['record_bytes'] / gib:.3g} GiB; snapshots: {need['snapshots']} x {N + 1} "
         f"nodes = {need['snapshot_bytes'] / gib:.3g} GiB; state: {need['state_bytes'] / gib:.3g} GiB) but only "
         f"{avail / gib:.3g} GiB is available (a run may use {MEMORY_MARGIN:.0%} of it); thin the record with "

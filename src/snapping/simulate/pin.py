@@ -29,6 +29,9 @@ PIN_KINDS = ("fixed", "pull", "flick", "table")
 MAX_SAMPLES = 1_000_000
 #: shortest duration or period of a preset (nondimensional time)
 MIN_DURATION = 1e-9
+#: largest acceleration of a preset (units of g) and latest time of a sampled motion
+ACCEL_MAX = 1e6
+T_MAX = 1e6
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,6 +101,8 @@ class PinMotion:
         if not callable(r):
             raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y))")
         t_max = V.positive("t_max", t_max)
+        if not MIN_DURATION <= t_max <= T_MAX:
+            raise V.SnappingInputError(f"t_max={t_max!r} is out of range: must lie in [{MIN_DURATION:g}, {T_MAX:g}]")
         n = V.integer("samples", samples, 4)
         if n > MAX_SAMPLES:
             raise V.SnappingInputError(f"samples={n} is out of range: at most {MAX_SAMPLES}")
@@ -129,7 +134,8 @@ class PinMotion:
             raise V.SnappingInputError(f"pin table times must start at 0 and increase; got t[0]={t[0]!r}")
         scale = max(1.0, float(np.abs(np.concatenate([x, y])).max()))
         if abs(x[0]) > 1e-12 * scale or abs(y[0]) > 1e-12 * scale:
-            raise V.SnappingInputError(f"the held end must start at the origin: r(0)=({x[0]!r}, {y[0]!r})")
+            raise V.SnappingInputError(f"x[0], y[0] = ({float(x[0])!r}, {float(y[0])!r}): the held end must start "
+                                       f"at the origin")
         x = x.copy()
         y = y.copy()
         x[0] = y[0] = 0.0
@@ -139,10 +145,13 @@ class PinMotion:
     def _vector(name, v):
         try:
             a = np.asarray(v, dtype=float).ravel()
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise V.SnappingInputError(f"{name}={v!r} is not a pair of numbers (ax, ay)") from None
         if a.size != 2 or not np.all(np.isfinite(a)):
             raise V.SnappingInputError(f"{name}={v!r} must be two finite numbers (ax, ay)")
+        if np.abs(a).max() > ACCEL_MAX:
+            raise V.SnappingInputError(f"{name}={v!r} is out of range: each component must lie in "
+                                       f"[-{ACCEL_MAX:g}, {ACCEL_MAX:g}] (units of g)")
         return float(a[0]), float(a[1])
 
     # -- compiled form and evaluation

@@ -50,7 +50,7 @@ FREE_END_RULES = ("half", "whole")
 SHAPE_RTOL = 1e-6
 
 
-def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
+def _positive_array(name: str, a, n: int | None = None, bounds: tuple | None = None) -> np.ndarray:
     a = np.asarray(V.float_array(name, a), dtype=float)
     if a.ndim > 1:
         raise V.SnappingInputError(f"{name} must be one-dimensional (one value per link or node); got shape {a.shape}")
@@ -62,6 +62,12 @@ def _positive_array(name: str, a, n: int | None = None) -> np.ndarray:
     if bad.size:
         raise V.SnappingInputError(f"{name}[{bad[0]}]={a[bad[0]]!r} is out of range: every entry must be finite "
                                    f"and > 0")
+    if bounds is not None:
+        out = np.flatnonzero((a < bounds[0]) | (a > bounds[1]))
+        if out.size:
+            j = int(out[0])
+            raise V.SnappingInputError(f"{name}[{j}]={float(a[j])!r} is out of range: every entry must lie in "
+                                       f"[{bounds[0]:g}, {bounds[1]:g}]")
     return a
 
 
@@ -77,6 +83,29 @@ def _call(name: str, fn, args) -> np.ndarray:
 #: node masses are kept within this factor of the unit (the tension solve's leading minors are
 #: rescaled every general.BLOCK rows: they stay far from overflow for masses in [1/M, M])
 MASS_RANGE = 1e15
+
+#: link lengths (units of the chain's length) are kept within the same factor of the unit
+LENGTH_RANGE = (1.0 / MASS_RANGE, MASS_RANGE)
+#: largest gravity (units of g) and largest initial speed (units of sqrt(g l)) accepted
+GRAVITY_MAX = 1e6
+SPEED_MAX = 1e6
+
+
+def _tip(tip_mass) -> float:
+    tip = V.real("tip_mass", tip_mass)
+    if not 0.0 <= tip <= MASS_RANGE:
+        raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must lie in [0, {MASS_RANGE:g}] (a ratio to "
+                                   f"the chain's mass)")
+    return tip
+
+
+def _check_masses(m, source: str) -> None:
+    bad = np.flatnonzero(~((m >= 1.0 / MASS_RANGE) & (m <= MASS_RANGE)))
+    if bad.size:
+        j = int(bad[0])
+        raise V.SnappingInputError(f"{source}: node mass m[{j}]={float(m[j])!r} is out of range: node masses must "
+                                   f"lie in [{1.0 / MASS_RANGE:g}, {MASS_RANGE:g}] (units of the chain's mass)")
+
 
 #: bytes a chain needs per link, about (its arrays, the start, a run's state and stages)
 BYTES_PER_LINK = 1000
@@ -198,7 +227,7 @@ class Links:
         >>> l.m.tolist()
         [0.375, 0.5]
         """
-        h = _positive_array("h", h)
+        h = _positive_array("h", h, bounds=LENGTH_RANGE)
         N = h.size
         if density is None:
             mu = h.copy()
@@ -216,7 +245,7 @@ class Links:
                 mu_p[k] = 0.5 * (b - a) * float(np.dot(wg, vals))
             mu = mu_p[::-1].copy()
         else:
-            mu = h * _positive_array("density", density, N)
+            mu = h * _positive_array("density", density, N, bounds=(1.0 / MASS_RANGE, MASS_RANGE))
         return cls._lumped(h, mu, tip_mass, lumping, kind, dict(params or {}), free_end)
 
     @classmethod
@@ -238,12 +267,11 @@ class Links:
         >>> Links.explicit([0.6, 0.4], [1.0, 2.0], tip_mass=0.5).m.tolist()
         [1.5, 2.0]
         """
-        h = _positive_array("h", h)
-        m = _positive_array("m", m, h.size)
-        tip = V.real("tip_mass", tip_mass)
-        if tip < 0.0:
-            raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must be >= 0")
+        h = _positive_array("h", h, bounds=LENGTH_RANGE)
+        m = _positive_array("m", m, h.size, bounds=(1.0 / MASS_RANGE, MASS_RANGE))
+        tip = _tip(tip_mass)
         m[0] += tip
+        _check_masses(m, "m with tip_mass")
         return cls(h, m, tip, "explicit", {}, None)
 
     @classmethod
@@ -252,9 +280,7 @@ class Links:
             raise V.SnappingInputError(f"lumping={lumping!r} is not one of {LUMPINGS}")
         if free_end not in (None, *FREE_END_RULES):
             raise V.SnappingInputError(f"free_end={free_end!r} is not one of {FREE_END_RULES}")
-        tip = V.real("tip_mass", tip_mass)
-        if tip < 0.0:
-            raise V.SnappingInputError(f"tip_mass={tip!r} is out of range: must be >= 0 (a ratio to the chain's mass)")
+        tip = _tip(tip_mass)
         if lumping == "paper":
             m = mu.copy()
         else:
@@ -264,6 +290,7 @@ class Links:
             m[0] = (0.5 if free_end == "half" else 1.0) * mu[0]
             params = {**params, "free_end": free_end}
         m[0] += tip
+        _check_masses(m, "h, density and tip_mass" if kind == "density" else f"the {kind} chain")
         return cls(h, m, tip, kind, {**params, "lumping": lumping}, np.asarray(mu, dtype=float))
 
     def describe(self) -> dict:
@@ -322,7 +349,9 @@ class Problem:
         _check_links(links)
         if N is not None and V.integer("N", N, 1) != links.N:
             raise V.SnappingInputError(f"N={N!r} disagrees with the chain's {links.N} links")
-        chi = V.open_interval("chi", chi, 0.0, 1.0)
+        from ..estimates import check_chi
+
+        chi = check_chi(chi)
         if links.is_paper:
             st = initial_state(chi, links.N, chords)
             x, y = st.x, st.y
@@ -395,6 +424,10 @@ class Problem:
         moving with the held end) must keep the links' lengths."""
         x = np.asarray(V.float_array("x", x), dtype=float).ravel()
         y = np.asarray(V.float_array("y", y), dtype=float).ravel()
+        for k, a in (("x", x), ("y", y)):
+            if not np.all(np.isfinite(a)):
+                j = int(np.flatnonzero(~np.isfinite(a))[0])
+                raise V.SnappingInputError(f"{k}[{j}]={float(a[j])!r} is not finite: node coordinates must be finite")
         if x.size != y.size or x.size < 2:
             raise V.SnappingInputError(f"shape x and y must have the same length N + 1 >= 2; got {x.size}, {y.size}")
         links = links if links is not None else Links.uniform(x.size - 1)
@@ -406,7 +439,7 @@ class Problem:
         rel = np.abs(lens - links.h) / links.h
         if rel.size and rel.max() > SHAPE_RTOL:
             j = int(np.argmax(rel))
-            raise V.SnappingInputError(f"shape link {j} has length {lens[j]:.9g} but the chain's link is "
+            raise V.SnappingInputError(f"x, y: shape link {j} has length {lens[j]:.9g} but the chain's link is "
                                        f"{links.h[j]:.9g} (relative difference {rel[j]:.3g} > {SHAPE_RTOL:g})")
         return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "nodes", "name": str(name)})
 
@@ -423,8 +456,9 @@ class Problem:
         if not isinstance(pin, PinMotion):
             raise V.SnappingInputError(f"pin={type(pin).__name__} is not a PinMotion")
         g = V.real("gravity", gravity)
-        if g < 0.0:
-            raise V.SnappingInputError(f"gravity={g!r} is out of range: must be >= 0 (along +e2, y downward)")
+        if not 0.0 <= g <= GRAVITY_MAX:
+            raise V.SnappingInputError(f"gravity={g!r} is out of range: must lie in [0, {GRAVITY_MAX:g}] (units of "
+                                       f"g, along +e2, y downward)")
         g = abs(g)  # (-0.0 is 0)
         x = np.array(x, dtype=float)
         y = np.array(y, dtype=float)
@@ -441,15 +475,21 @@ class Problem:
         for name, v in (("vx", vx), ("vy", vy)):
             if v.size != N + 1 or not np.all(np.isfinite(v)):
                 raise V.SnappingInputError(f"{name} must be {N + 1} finite numbers (one per node); got {v.size}")
+            if np.abs(v).max() > SPEED_MAX:
+                j = int(np.argmax(np.abs(v)))
+                raise V.SnappingInputError(f"{name}[{j}]={float(v[j])!r} is out of range: initial speeds must be "
+                                           f"at most {SPEED_MAX:g} (units of sqrt(g l))")
         if abs(vx[-1] - pvx) > 1e-12 or abs(vy[-1] - pvy) > 1e-12:
-            raise V.SnappingInputError(f"the held end's velocity ({vx[-1]!r}, {vy[-1]!r}) must be the pin's, "
+            raise V.SnappingInputError(f"vx, vy: the held end's velocity ({float(vx[-1])!r}, {float(vy[-1])!r}) "
+                                       f"must be the pin's, "
                                        f"({pvx!r}, {pvy!r}), at t = 0")
         dx, dy = np.diff(x), np.diff(y)
         stretch = np.abs(dx * np.diff(vx) + dy * np.diff(vy)) / np.hypot(dx, dy)
         vscale = max(1.0, float(np.abs(np.concatenate([vx, vy])).max()))
         if stretch.size and stretch.max() > 1e-9 * vscale:
             j = int(np.argmax(stretch))
-            raise V.SnappingInputError(f"initial velocities stretch link {j} at the rate {stretch[j]:.3g}: they "
+            raise V.SnappingInputError(f"vx, vy: the initial velocities stretch link {j} at the rate "
+                                       f"{stretch[j]:.3g}: they "
                                        f"must keep every link's length (relative velocity normal to the link)")
         if moving:
             start = {**start, "velocities": True}

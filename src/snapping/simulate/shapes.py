@@ -398,6 +398,9 @@ def catenary_between(dx: float, dy: float, length: float = 1.0) -> Catenary:
     chi = dx / Leff
     if not 0.0 < chi < 1.0:
         raise V.SnappingInputError(taut)
+    if chi < estimates.CHI_MIN:
+        raise V.SnappingInputError(f"dx={dx!r} is out of range: must be >= {estimates.CHI_MIN:g} sqrt(length^2 - "
+                                   f"dy^2) = {estimates.CHI_MIN * Leff:.3g} (a narrower catenary is a folded string)")
     a = Leff * estimates.catenary_parameter(chi)
     b = dx / (2.0 * a)
     sigma0 = -0.5 * (L + dy / math.tanh(b))
