@@ -524,7 +524,7 @@ def test_cli_snapshot_times_need_an_output_file(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "without -o RUN.nc" in err and err.count("\n") == 1
     assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "nan"]) == 2
-    assert "snapshot_times=nan" in capsys.readouterr().err  # a bad time is named first
+    assert "--snapshot-times=nan" in capsys.readouterr().err  # a bad time is named first
     path = tmp_path / "r.nc"
     assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "0.1",
                  "-o", str(path), "--no-progress"]) == 0

@@ -285,7 +285,7 @@ def test_a_killed_sweep_leaves_no_worker_processes(tmp_path):
     script = ("from snapping import sweep as S\n"
               "g = S.Grid(chi=[0.3, 0.4, 0.5, 0.6], N=[200], options={'method': 'fast', 't_end': 60.0})\n"
               f"S.run_sweep(g, {str(out)!r}, workers=2, progress=False)\n")
-    env = {**os.environ, S._WORKER_PID_FILE_ENV: str(pid_file),
+    env = {**os.environ, S._workers.WORKER_PID_FILE_ENV: str(pid_file),
            "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.Popen([sys.executable, "-c", script], env=env)
     pids = []
@@ -371,7 +371,7 @@ def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_pat
     import snapping
 
     pid_file, out = tmp_path / "pids", tmp_path / "out"
-    env = {**os.environ, S._WORKER_PID_FILE_ENV: str(pid_file),
+    env = {**os.environ, S._workers.WORKER_PID_FILE_ENV: str(pid_file),
            "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
     # the CLI's sweep, with runs that checkpoint every 0.5 s (to see them under way) and last ~1 min
     script = ("import sys\nfrom snapping import sweep as S\nfrom snapping.cli import main\nG = S.Grid\n"

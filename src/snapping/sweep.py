@@ -24,7 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _validate as V
+from . import _workers
 from . import schema
 
 if TYPE_CHECKING:  # annotations only
@@ -211,10 +212,6 @@ def _failure_of(exc: BaseException, path: str) -> dict:
     return {"kind": type(exc).__name__, "message": _one_line(exc) or type(exc).__name__, "file": _existing(path)}
 
 
-#: test hook: a path to which each local worker process appends its pid when it starts
-_WORKER_PID_FILE_ENV = "SNAPPING_SWEEP_WORKER_PID_FILE"
-
-
 def _run_task(task: list) -> list:
     """Worker: one run (:func:`_run_one`), or several runs of one N as one ensemble
     (:func:`snapping.simulate.run_ensemble`; each member saved atomically to its file).
@@ -223,7 +220,7 @@ def _run_task(task: list) -> list:
     completed, else a dict (``kind``, ``message``, ``file``, see :func:`_failure_of`).
     A run that fails numerically, or on an input that is only refused at run time,
     does not end the task: every other member is still run and saved."""
-    if _STOP is not None and _STOP.is_set():  # the sweep was interrupted: start nothing new
+    if _workers.stopped():  # the sweep was interrupted: start nothing new
         return [{"kind": "cancelled", "message": "not started: the sweep was interrupted", "file": None}
                 for _ in task]
     if len(task) == 1:
@@ -254,55 +251,6 @@ def _run_task(task: list) -> list:
             out.append({"kind": str(ds.attrs.get("failure") or ds.attrs["status"]),
                         "message": _one_line(ds.attrs.get("stop_reason", "")), "file": _existing(path)})
     return out
-
-
-#: set in a local worker process: the sweep's "stop" event (set when the sweep is interrupted)
-_STOP = None
-
-
-def _worker_init(parent_pid: int, stop=None, interval: float = 0.2, grace: float = 3.0) -> None:
-    """Initializer of the local worker processes.
-
-    * SIGINT is ignored between runs: a Ctrl-C reaches the whole process group, and a
-      worker waiting for its next task must not print a ``KeyboardInterrupt``
-      traceback; a run in progress still stops at a step boundary and saves its
-      checkpoint (the driver installs its own handler while it runs).
-    * ``stop`` (an event the sweep sets when interrupted) makes the worker skip the
-      tasks still queued for it, and stops a run in progress at its next step boundary,
-      saved with its checkpoint, as SIGINT would (through the driver's chunk hook), so
-      that an interrupted sweep ends promptly whenever the signal reached the worker.
-    * A daemon thread notices when the sweep's process is gone (the worker has been
-      re-parented: ``os.getppid()`` changed, e.g. after a SIGKILL of the sweep) and
-      ends this worker: it first sends itself SIGTERM, so that a run in progress stops
-      at a step boundary and saves its checkpoint (a rerun of the sweep resumes it),
-      and exits for good after ``grace`` seconds.
-    """
-    import signal
-    import threading
-    import time
-
-    global _STOP
-    _STOP = stop
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    pid_file = os.environ.get(_WORKER_PID_FILE_ENV)
-    if pid_file:
-        with open(pid_file, "a") as fh:
-            fh.write(f"{os.getpid()}\n")
-
-    def watch():
-        while os.getppid() == parent_pid:
-            time.sleep(interval)
-        try:
-            os.kill(os.getpid(), signal.SIGTERM)
-        finally:
-            time.sleep(grace)
-            os._exit(1)
-
-    threading.Thread(target=watch, name="snapping-sweep-parent-watchdog", daemon=True).start()
-    if stop is not None:
-        from .simulate import driver
-
-        driver._chunk_hook = lambda eng: signal.SIGINT if stop.is_set() else None
 
 
 def grid_key(grid: Grid) -> str:
@@ -455,26 +403,6 @@ class SweepFailed(RuntimeError):
         return failure_table(self.failures)
 
 
-def _local_pool(n: int):
-    """``n`` local worker processes (spawned) that end themselves if this process dies,
-    and the event that tells them to start no further task (:func:`_worker_init`)."""
-    import multiprocessing as mp
-
-    ctx = mp.get_context("spawn")
-    stop = ctx.Event()
-    return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(), stop)), stop
-
-
-def _stop_pool(stop, futures) -> None:
-    """The sweep was interrupted: no queued task starts, and every run in progress
-    stops at a step boundary and saves its checkpoint (:func:`_worker_init`), whether
-    the SIGINT reached the workers too (Ctrl-C) or this process alone."""
-    stop.set()
-    for fut in futures:
-        fut.cancel()
-
-
 def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True,
               ensemble: int | None = None) -> list[Path]:
     """Run every point of ``grid`` not yet done in ``out_dir``; return all run paths.
@@ -577,14 +505,14 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble) -
                 for task in tasks:
                     collect(task, lambda task=task: _run_task(task))
             else:
-                pool, stop = _local_pool(n)
+                pool, stop = _workers.local_pool(n)
                 futures = {}
                 try:
                     futures = {pool.submit(_run_task, task): task for task in tasks}
                     for fut in as_completed(futures):
                         collect(futures[fut], fut.result)
                 except BaseException:  # SIGINT: stop promptly, the runs in progress saved
-                    _stop_pool(stop, futures)
+                    _workers.stop_pool(stop, futures)
                     raise
                 finally:
                     pool.shutdown(wait=True, cancel_futures=True)

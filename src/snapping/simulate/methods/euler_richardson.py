@@ -336,13 +336,14 @@ def _results(eng: Engine, status: str, reason: str, wall: float, failure: str = 
 
 def complete(opts, method: str):
     """The options with this method's defaults filled in: the initial step dt0 = sqrt(tol)
-    (eps ~ dt^2 max|a|/4 at rest, accepted for max|a| ~ 1); the fixed-step variant needs dt0."""
+    (eps ~ dt^2 max|a|/4 at rest, accepted for max|a| ~ 1), or dt_min if that is larger
+    (a smaller first step would be below the floor); the fixed-step variant needs dt0."""
     import math
 
     if opts.dt0 is None:
         if method == "euler-richardson-fixed":
             raise V.SnappingInputError("dt0=None: method 'euler-richardson-fixed' needs the step dt0 > 0")
-        opts = opts.replace(dt0=math.sqrt(opts.tol))
+        opts = opts.replace(dt0=max(math.sqrt(opts.tol), opts.dt_min))
     return opts
 
 
