@@ -130,11 +130,16 @@ def pin_force(ds, chain: Chain = PAPER_CHAIN, units: str = "nondimensional"):
     plt = _plt()
     u = _units(units)
     _, time, force = _conv(units, chain)
-    t = time(ds["t"].values)
+    from .scaling.plots import thin_envelope
+
+    t = time(np.asarray(ds["t"].values, dtype=float))
+    fx, fy = force(np.asarray(ds["pin_force_x"].values)), force(np.asarray(ds["pin_force_y"].values))
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True, layout="constrained")
-    a1.plot(t, force(ds["pin_force_x"].values), color="tab:red")
+    k = thin_envelope(t, fx)  # 10^5-10^6 steps: the envelope of 2000 bins of t
+    a1.plot(t[k], fx[k], color="tab:red")
     a1.set_ylabel(f"horizontal force  [{u['force']}]")
-    a2.plot(t, force(ds["pin_force_y"].values), color="tab:red")
+    k = thin_envelope(t, fy)
+    a2.plot(t[k], fy[k], color="tab:red")
     a2.set_ylabel(f"vertical force  [{u['force']}]")
     a2.set_xlabel(f"time $t$  [{u['time']}]")
     for a in (a1, a2):

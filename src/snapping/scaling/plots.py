@@ -21,7 +21,7 @@ import numpy as np
 from .. import _validate as V
 from .. import estimates
 
-__all__ = ["plot_maxima", "plot_local_slopes", "plot_delta", "front_arclength", "thin_log", "chi_colours"]
+__all__ = ["plot_maxima", "plot_local_slopes", "plot_delta", "front_arclength", "thin_log", "thin_envelope", "chi_colours"]
 
 #: Units of the nondimensional quantities (length l, g, rho: paper section 3), for axis labels.
 U_TIME = r"$\sqrt{\ell/g}$"
@@ -125,18 +125,24 @@ def thin_log(tau, y, bins: int = PLOT_BINS):
     >>> bool(i.size <= 102), int(i[0]), int(i[-1])
     (True, 0, 99999)
     """
-    tau = np.asarray(tau, dtype=float)
+    return thin_envelope(np.log(np.asarray(tau, dtype=float)), y, bins)
+
+
+def thin_envelope(x, y, bins: int = 2000):
+    """Indices of the samples of ``y(x)`` to plot on a linear ``x`` axis: the smallest and
+    the largest ``y`` in each of ``bins`` equal bins of ``x`` (and the first and last
+    sample), in the record's order (:func:`thin_log` on log x)."""
+    lt = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
-    if tau.size <= 2 * bins + 2:
-        return np.arange(tau.size)
-    lt = np.log(tau)
+    if lt.size <= 2 * bins + 2:
+        return np.arange(lt.size)
     lo, hi = float(lt.min()), float(lt.max())
     b = np.minimum(((lt - lo) / max(hi - lo, 1e-300) * bins).astype(np.int64), bins - 1)
     order = np.lexsort((y, b))
     bs = b[order]
     first = np.flatnonzero(np.r_[True, bs[1:] != bs[:-1]])
     last = np.r_[first[1:] - 1, bs.size - 1]
-    return np.unique(np.concatenate([order[first], order[last], [0, tau.size - 1]]))
+    return np.unique(np.concatenate([order[first], order[last], [0, lt.size - 1]]))
 
 
 def front_arclength(t, s, s_node=None):
