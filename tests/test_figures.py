@@ -20,7 +20,7 @@ def test_shapes_draw_the_snapshots_in_metres(run025, tmp_path):
     x, y = first.get_xdata(), first.get_ydata()
     assert x[0] == pytest.approx(0.25 * PAPER_CHAIN.length)  # node 1, the free end
     assert y[0] == pytest.approx(0.0, abs=1e-12) and x[-1] == 0.0
-    assert ax.get_xlabel() == "$x$  [m]" and "[s]" in fig.axes[-1].get_ylabel()  # the colour bar: time in s
+    assert ax.get_xlabel() == "$x$  [m]" and "[s]" in ax.child_axes[0].get_ylabel()  # the colour bar: time in s
     paths = figures.save(fig, tmp_path / "shapes")
     assert [p.suffix for p in paths] == [".png", ".pdf"] and all(p.stat().st_size > 1000 for p in paths)
 

@@ -485,7 +485,8 @@ def test_scaling_figures_have_compact_legends_mathtext_and_thinned_lines(capture
         assert not any("chi =" in t for t in texts)  # runs are on the colour bar, not in legends
         assert not any("deltacrude" in t or "delta_kappa_m(0)" in t or "^(" in t for t in texts), texts
         # a colour bar for chi, with the runs' chi as ticks
-        cbars = [ax for ax in fig.axes if "chi" in ax.get_ylabel() and "separation" in ax.get_ylabel()]
+        every = [a for ax in fig.axes for a in (ax, *ax.child_axes)]
+        cbars = [ax for ax in every if "chi" in ax.get_ylabel() and "separation" in ax.get_ylabel()]
         assert len(cbars) == 1
         np.testing.assert_allclose(sorted(cbars[0].get_yticks()), chis)
     assert f3.axes[0].get_xlabel().startswith(r"$\tau = t^*_\chi - t$")

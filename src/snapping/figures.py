@@ -35,7 +35,7 @@ def save(fig, path_stem) -> list[Path]:
     try:
         for ext in (".png", ".pdf"):
             p = stem.with_suffix(ext)
-            save_figure(fig, p, dpi=150, bbox_inches="tight")
+            save_figure(fig, p, dpi=150)
             out.append(p)
     finally:
         _plt().close(fig)
@@ -101,7 +101,9 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
     u = _units(units)
     dist, time, _ = _conv(units, chain)
     runs = list(runs)
-    fig, axes = plt.subplots(1, len(runs), figsize=(4.6 * len(runs), 4.4), squeeze=False, layout="constrained")
+    fig, axes = plt.subplots(1, len(runs), figsize=(4.6 * len(runs), 4.4), squeeze=False)
+    # fixed positions (a layout engine costs seconds per save): room for each panel's colour bar
+    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86, wspace=0.55)
     from matplotlib.colors import Normalize
 
     for ax, ds in zip(axes[0], runs):
@@ -117,7 +119,10 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
         ax.set_title(rf"$\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
         ax.set_xlabel(f"$x$  [{u['length']}]")
         ax.set_ylabel(f"height  [{u['length']}]")
-        cb = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8, pad=0.02)
+        x0, x1 = ax.get_xlim()
+        y0, y1 = ax.get_ylim()
+        w = 0.05 * min(max(abs(y1 - y0) / max(abs(x1 - x0), 1e-12), 1.0), 5.0)  # equal aspect: as wide as tall
+        cb = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=ax.inset_axes((1.04, 0.0, w, 1.0)))
         cb.set_label(f"$t$  [{u['time']}]")
     what = f"chain of {chain.length:g} m" if units == "si" else "nondimensional"
     fig.suptitle(f"Falling chain shapes up to the snap ({what})")
@@ -134,7 +139,8 @@ def pin_force(ds, chain: Chain = PAPER_CHAIN, units: str = "nondimensional"):
 
     t = time(np.asarray(ds["t"].values, dtype=float))
     fx, fy = force(np.asarray(ds["pin_force_x"].values)), force(np.asarray(ds["pin_force_y"].values))
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True, layout="constrained")
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
+    fig.subplots_adjust(left=0.15, right=0.96, bottom=0.11, top=0.92, hspace=0.1)
     k = thin_envelope(t, fx)  # 10^5-10^6 steps: the envelope of 2000 bins of t
     a1.plot(t[k], fx[k], color="tab:red")
     a1.set_ylabel(f"horizontal force  [{u['force']}]")
@@ -156,7 +162,8 @@ def profiles(ds, n: int = 7):
     plt = _plt()
     u = _U["nondimensional"]
     idx = _snapshots_before(ds, n)
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), layout="constrained")
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.88, wspace=0.25)
     colors = plt.cm.plasma(np.linspace(0.85, 0.0, max(len(idx), 2)))[::-1]
     colors[-1] = (0.5, 0.0, 0.5, 1.0)  # the snap in purple, as in the paper
     s_node, s_link = ds["s_node"].values, ds["s_link"].values
@@ -184,7 +191,8 @@ def peak_speed_vs_N(table):
 
     ``table`` maps chi to a list of (N, v_peak)."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(5.5, 4.2), layout="constrained")
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig.subplots_adjust(left=0.15, right=0.97, bottom=0.13, top=0.91)
     for chi, rows in sorted(table.items()):
         rows = sorted(rows)
         N = np.array([r[0] for r in rows], float)

@@ -102,10 +102,13 @@ def chi_colours(chis):
     return [cmap(norm(c)) for c in chis], sm
 
 
-def _chi_bar(fig, sm, axes, chis):
+def _chi_bar(fig, sm, cax, chis):
+    """The chi colour bar in axes ``cax`` (fixed positions: no layout engine, which would
+    cost seconds per save on log axes of many decades)."""
     if sm is None:
+        cax.remove()
         return None
-    cb = fig.colorbar(sm, ax=axes, shrink=0.9, pad=0.02, aspect=40)
+    cb = fig.colorbar(sm, cax=cax)
     ticks = sorted(set(float(c) for c in chis))
     if len(ticks) <= 8:
         cb.set_ticks(ticks)
@@ -282,7 +285,8 @@ def plot_maxima(runs, results, path, *, show_fits: bool = True) -> Path:
 
     plt = _plt()
     specs = {s.name: s for s in report_specs()}
-    fig, axs = plt.subplots(2, 2, figsize=(10.5, 8), layout="constrained")
+    fig, axs = plt.subplots(2, 2, figsize=(10.5, 8))
+    fig.subplots_adjust(left=0.075, right=0.87, bottom=0.07, top=0.93, wspace=0.27, hspace=0.28)
     (ax_v, ax_a), (ax_s, ax_k) = axs
     cols, sm = chi_colours([r.chi for r in results])
     single = len(runs) == 1
@@ -374,7 +378,7 @@ def plot_maxima(runs, results, path, *, show_fits: bool = True) -> Path:
         if handles[ax]:  # below the plateaus at small tau (right) is free; (d) is free below 1 at large tau
             ax.legend(handles=handles[ax], fontsize=7, loc="lower left" if ax is ax_k else "lower right",
                       framealpha=0.85)
-    _chi_bar(fig, sm, axs, [r.chi for r in results])
+    _chi_bar(fig, sm, fig.add_axes((0.895, 0.12, 0.014, 0.76)), [r.chi for r in results])
     fig.suptitle("Maxima against the time to snap (paper Fig. 3), nondimensional" + _title_run(runs, results))
     return _save(fig, path)
 
@@ -399,7 +403,8 @@ def plot_local_slopes(runs, results, path) -> Path:
     vars_ = ("v_max", "a_end", "a_max", "sigma_max", "kappa_max")
     tex = {"v_max": r"$v_{\max}$", "a_end": r"$a_{\mathrm{end}}$", "a_max": r"$a_{\max}$",
            "sigma_max": r"$\sigma_{\max}$", "kappa_max": r"$\kappa_{\max}$"}
-    fig, axs = plt.subplots(len(vars_), 1, figsize=(8.5, 2.2 * len(vars_)), sharex=True, layout="constrained")
+    fig, axs = plt.subplots(len(vars_), 1, figsize=(8.5, 2.2 * len(vars_)), sharex=True)
+    fig.subplots_adjust(left=0.11, right=0.84, bottom=0.06, top=0.95, hspace=0.12)
     cols, sm = chi_colours([r.chi for r in results])
     for ds, res, c in zip(runs, results, cols):
         ls = local_slopes(ds, res.snap.t_star, vars_)
@@ -428,7 +433,7 @@ def plot_local_slopes(runs, results, path) -> Path:
         ax.grid(True, alpha=0.3)
     axs[0].invert_xaxis()
     axs[-1].set_xlabel(TAU_LABEL)
-    _chi_bar(fig, sm, axs, [r.chi for r in results])
+    _chi_bar(fig, sm, fig.add_axes((0.905, 0.15, 0.018, 0.7)), [r.chi for r in results])
     fig.suptitle("Local log-log slopes (dashed: reference exponents; shaded: fit windows)" + _title_run(runs, results))
     return _save(fig, path)
 
@@ -457,7 +462,8 @@ def plot_delta(runs, results, path) -> Path:
     from .. import ideal
 
     plt = _plt()
-    fig, axs = plt.subplots(2, 2, figsize=(10.5, 8), layout="constrained")
+    fig, axs = plt.subplots(2, 2, figsize=(10.5, 8))
+    fig.subplots_adjust(left=0.075, right=0.975, bottom=0.07, top=0.93, wspace=0.42, hspace=0.28)
     ax0, axs_b, axs_c, axs_d = axs[0, 0], axs[0, 1], axs[1, 0], axs[1, 1]
     cols, sm = chi_colours([r.chi for r in results])
     taus, data = [], []
@@ -503,7 +509,7 @@ def plot_delta(runs, results, path) -> Path:
     ax0.grid(True, which="major", alpha=0.3)
     _data_ylim(ax0, data, 1.5)
     ax0.legend(handles=handles, fontsize=7, loc="lower right", framealpha=0.85)
-    _chi_bar(fig, sm, ax0, [r.chi for r in results])
+    _chi_bar(fig, sm, ax0.inset_axes((1.03, 0.0, 0.035, 1.0)), [r.chi for r in results])
     fitted = [r for r in results if r.delta is not None]
     chis = np.array([r.chi for r in fitted])
     if chis.size:
