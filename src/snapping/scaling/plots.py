@@ -379,6 +379,8 @@ def plot_maxima(runs, results, path, *, show_fits: bool = True) -> Path:
             ax.legend(handles=handles[ax], fontsize=7, loc="lower left" if ax is ax_k else "lower right",
                       framealpha=0.85)
     _chi_bar(fig, sm, fig.add_axes((0.895, 0.12, 0.014, 0.76)), [r.chi for r in results])
+    if sm is None:  # one chi: no colour bar, the run is named in the title
+        fig.subplots_adjust(right=0.98)
     fig.suptitle("Maxima against the time to snap (paper Fig. 3), nondimensional" + _title_run(runs, results))
     return _save(fig, path)
 
@@ -434,6 +436,8 @@ def plot_local_slopes(runs, results, path) -> Path:
     axs[0].invert_xaxis()
     axs[-1].set_xlabel(TAU_LABEL)
     _chi_bar(fig, sm, fig.add_axes((0.905, 0.15, 0.018, 0.7)), [r.chi for r in results])
+    if sm is None:
+        fig.subplots_adjust(right=0.93)
     fig.suptitle("Local log-log slopes (dashed: reference exponents; shaded: fit windows)" + _title_run(runs, results))
     return _save(fig, path)
 
