@@ -219,6 +219,8 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         return s + f"\nmax |v| = {np.nanmax(S[i]):.3g}"
 
     text.set_text(label(0))
+    fig.canvas.draw()  # lay out once (the longest label is the first frame's), then freeze the positions:
+    fig.set_layout_engine("none")  # a layout engine would redo the layout for every frame
 
     def update(i):
         chain.set_segments(segments(i))
