@@ -660,9 +660,9 @@ def _add_animate(sub) -> None:
             "(--snapshot-times geometric in the time to the snap)."
         ),
         epilog=(
-            "examples:\n"
-            "  snapping simulate --chi 0.25 --N 200 -o run.nc\n"
+            "examples (run.nc from e.g. snapping simulate --chi 0.25 --N 200 -o run.nc):\n"
             "  snapping animate run.nc -o snap.gif\n"
+            "  snapping animate run.nc -o snap.gif --max-frames 30 --fps 5\n"
             "  snapping animate run.nc -o snap.mp4 --fps 12 --overwrite"
         ),
     )
