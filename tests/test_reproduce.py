@@ -136,3 +136,11 @@ def test_verdict_rules_on_the_papers_own_numbers():
     assert R.amplification_verdict([5.7], [51.0]).startswith("agrees")
     assert R.amplification_verdict([51.0 ** 0.25], [51.0]).startswith("agrees")
     assert R.amplification_verdict([51.0], [51.0]).startswith("differs")  # the inferred -2/3 law
+
+
+def test_wall_time_table_times_the_fits_and_each_figure_apart(tiny):
+    _, text = tiny
+    table = text.split("## Wall time")[1]
+    for part in ("runs", "fits (Fig. 3/4 runs)", "fig1_shapes", "fig1e_pin_force", "fig2_profiles",
+                 "fig2d_peak_speed_vs_N", "fig3_maxima", "fig3_local_slopes", "fig4_delta", "total"):
+        assert re.search(rf"^\| {re.escape(part)} \| \d+\.\d \|$", table, re.M), part

@@ -397,3 +397,112 @@ def test_verdict_is_inconclusive_when_the_uncertainty_cannot_tell_the_candidates
     assert v.startswith("inconclusive") and abs(z) <= 2
     # a window picked inside a slope range is flagged, since the range leans the fit
     assert "window constrained to local slopes in [-1, -0.02]" in v
+
+
+# ------------------------------------------------------------------------ figure helpers
+def test_front_arclength_between_nodes_follows_an_analytic_curvature_peak():
+    """The node of the largest discrete curvature is a staircase; front_arclength puts the
+    maximum at the midpoint of two nodes when the record switches between them and
+    interpolates in time. Profile: log kappa = -x^2/2 + c x^3 exp(-x^2/2), x = (s - m(t))/w,
+    skewed, whose maximum is at x = 0 exactly (m(t) is the truth; -x^2/2 + c x^3 e^(-x^2/2) < 0
+    for x != 0 at c = 0.2) with kappa'''/kappa'' = -6c/w there."""
+    from snapping.scaling.plots import front_arclength
+
+    N, w, c = 100, 0.03, 0.2
+    h = 1.0 / N
+    nodes = np.arange(N + 1) * h
+    t = np.linspace(0.0, 1.0, 10001)
+    m = 0.3 + 0.5 * t + 0.1 * t**2  # m' in [0.5, 0.7], m'' = 0.2
+    x = (nodes[None, :] - m[:, None]) / w
+    kappa = np.exp(-x**2 / 2 + c * x**3 * np.exp(-x**2 / 2))
+    s_rec = nodes[np.argmax(kappa, axis=1)]
+    stair = np.abs(s_rec - m).max()
+    assert stair > 0.45 * h  # the recorded staircase is off by up to half a link
+    s = front_arclength(t, s_rec, nodes)
+    # bound: (h^2/8)|kappa'''/kappa''| at a switch + (1/8) m'' (h/m'_min)^2 between switches
+    # + m'_max dt/2 from locating the switch between two samples
+    bound = h**2 / 8 * 6 * c / w + 0.2 * (h / 0.5) ** 2 / 8 + 0.7 * (t[1] - t[0]) / 2
+    assert bound < 0.1 * h
+    assert np.abs(s - m).max() <= 1.1 * bound
+    # without the nodes (uniform chain rule) the same answer
+    np.testing.assert_allclose(front_arclength(t, s_rec), s, rtol=0, atol=1e-15)
+    # a jump to another part of the chain stays a jump (no ramp across it)
+    s2 = np.where(t < 0.5, 0.3, 0.8)
+    f2 = front_arclength(t, s2, nodes)
+    assert f2[t < 0.5].max() == 0.3 and f2[t >= 0.5].min() == 0.8
+
+
+def test_thin_log_keeps_the_envelope_and_few_points():
+    from snapping.scaling.plots import thin_log
+
+    tau = np.geomspace(1.0, 1e-8, 300_000)
+    y = tau ** (-1 / 3)
+    y[123_457] *= 50.0  # a one-sample spike
+    k = thin_log(tau, y, bins=200)
+    assert k.size <= 2 * 200 + 2
+    assert y[k].max() == y.max() and y[k].min() == y.min()
+    assert 123_457 in k and np.all(np.diff(k) > 0)
+    # every decade of tau keeps points
+    assert np.all(np.histogram(np.log10(tau[k]), bins=8, range=(-8, 0))[0] > 0)
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """The figures the plot functions would save, kept open."""
+    from snapping.scaling import plots
+
+    figs = []
+
+    def keep(fig, path):
+        figs.append(fig)
+        return path
+
+    monkeypatch.setattr(plots, "_save", keep)
+    return figs
+
+
+def test_scaling_figures_have_compact_legends_mathtext_and_thinned_lines(captured):
+    import matplotlib as mpl
+
+    chis = (0.1, 0.15, 0.2, 0.25, 0.3, 0.4)
+    runs = [make_run(chi=c, t_star=1.15 + 0.1 * c, n=20_000) for c in chis]
+    results = [scaling.fit_run(r, joint=False) for r in runs]
+    with mpl.rc_context({"legend.loc": "best"}):
+        scaling.plot_maxima(runs, results, "f3.png")
+        scaling.plot_local_slopes(runs, results, "f3s.png")
+        scaling.plot_delta(runs, results, "f4.png")
+    f3, f3s, f4 = captured
+    for fig in captured:
+        texts = []
+        for ax in fig.axes:
+            leg = ax.get_legend()
+            if leg is not None:
+                assert leg._loc != 0  # never 'best'
+                assert len(leg.get_texts()) <= 5, [t.get_text() for t in leg.get_texts()]
+                texts += [t.get_text() for t in leg.get_texts()]
+            for line in ax.lines:
+                assert len(line.get_xdata()) <= 2 * 400 + 2  # thinned from 20 000 steps
+        assert not any("chi =" in t for t in texts)  # runs are on the colour bar, not in legends
+        assert not any("deltacrude" in t or "delta_kappa_m(0)" in t or "^(" in t for t in texts), texts
+        # a colour bar for chi, with the runs' chi as ticks
+        every = [a for ax in fig.axes for a in (ax, *ax.child_axes)]
+        cbars = [ax for ax in every if "chi" in ax.get_ylabel() and "separation" in ax.get_ylabel()]
+        assert len(cbars) == 1
+        np.testing.assert_allclose(sorted(cbars[0].get_yticks()), chis)
+    assert f3.axes[0].get_xlabel().startswith(r"$\tau = t^*_\chi - t$")
+    f4_legend = [t.get_text() for t in f4.axes[1].get_legend().get_texts()]
+    assert r"$\delta_{\kappa_0}$" in f4_legend and any(r"$\delta_c$" in t for t in f4_legend)
+    assert any(r"$\delta_{\kappa_m}$" in t for t in f4_legend)
+
+
+def test_single_run_fits_have_distinct_colours(captured):
+    from matplotlib.colors import to_rgba
+
+    ds = make_run(n=20_000)
+    res = scaling.fit_run(ds, joint=False)
+    scaling.plot_maxima([ds], [res], "f3.png")
+    ax_a = captured[0].axes[1]
+    fits = [l for l in ax_a.lines if l.get_label().startswith("fit")]
+    assert len(fits) == 3  # a_end, a_max (late), a_max (intermediate)
+    assert len({to_rgba(l.get_color()) for l in fits}) == 3
+    assert to_rgba("C0") not in {to_rgba(l.get_color()) for l in fits}  # none is the data's colour

@@ -733,6 +733,50 @@ def _cmd_reproduce(args) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------- animate
+def _add_animate(sub) -> None:
+    p = sub.add_parser(
+        "animate",
+        help="an animation of the snap from a run file's snapshots (GIF, or MP4 with ffmpeg)",
+        formatter_class=_formatter,
+        description=(
+            "Draw the chain of every profile snapshot of RUN.nc as one frame, coloured by speed\n"
+            "(log scale, colour bar), with the time and the time to the snap, nondimensional.\n"
+            "GIF through Pillow (always available); MP4 needs ffmpeg on PATH. A run with few\n"
+            "snapshots up to the snap gets a note with the command for a denser run\n"
+            "(--snapshot-times geometric in the time to the snap)."
+        ),
+        epilog=(
+            "examples (run.nc from e.g. snapping simulate --chi 0.25 --N 200 -o run.nc):\n"
+            "  snapping animate run.nc -o snap.gif\n"
+            "  snapping animate run.nc -o snap.gif --max-frames 30 --fps 5\n"
+            "  snapping animate run.nc -o snap.mp4 --fps 12 --overwrite"
+        ),
+    )
+    p.add_argument("file", metavar="RUN.nc", help="run file (snapping simulate -o)")
+    p.add_argument("-o", "--output", required=True, help="animation file: .gif or .mp4")
+    p.add_argument("--fps", type=float, default=8.0, help="frames per second (default 8)")
+    p.add_argument("--max-frames", type=int, default=None, help="at most this many frames (snapshots thinned evenly)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output (default: refuse it)")
+    p.set_defaults(func=_cmd_animate)
+
+
+def _cmd_animate(args) -> int:
+    from . import animation
+    from .simulate import load_run
+
+    animation.check_output(args.output, overwrite=args.overwrite)  # before reading the run
+    ds = load_run(args.file)
+    animation.frames_of(ds, args.max_frames)  # no snapshots: refused here
+    hint = animation.denser_run_hint(ds, args.file)
+    if hint:
+        print(f"snapping animate: note: {hint}", file=sys.stderr)
+    out = animation.animate(ds, args.output, fps=args.fps, max_frames=args.max_frames, overwrite=args.overwrite)
+    n = len(animation.frames_of(ds, args.max_frames))
+    print(f"wrote {out}: {n} frames at {args.fps:g} fps")
+    return 0
+
+
 # ---------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
@@ -757,7 +801,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"snapping {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
-    for add in (_add_ideal, _add_estimate, _add_simulate, _add_sweep, _add_fit, _add_converge, _add_reproduce):
+    for add in (_add_ideal, _add_estimate, _add_simulate, _add_sweep, _add_fit, _add_converge, _add_reproduce,
+                _add_animate):
         add(sub)
     return parser
 

@@ -35,11 +35,37 @@ def save(fig, path_stem) -> list[Path]:
     try:
         for ext in (".png", ".pdf"):
             p = stem.with_suffix(ext)
-            save_figure(fig, p, dpi=150, bbox_inches="tight")
+            save_figure(fig, p, dpi=150)
             out.append(p)
     finally:
         _plt().close(fig)
     return out
+
+
+UNITS = ("nondimensional", "si")
+
+#: Axis-label units: nondimensional (length l, velocity sqrt(g l), force rho g l, time sqrt(l/g)) or SI.
+_U = {
+    "nondimensional": {"length": r"$\ell$", "time": r"$\sqrt{\ell/g}$", "force": r"$\rho g \ell$",
+                       "speed": r"$\sqrt{g\ell}$", "accel": r"$g$"},
+    "si": {"length": "m", "time": "s", "force": "N", "speed": "m/s", "accel": r"m/s$^2$"},
+}
+
+
+def _units(units: str) -> dict:
+    if units not in UNITS:
+        from ._validate import SnappingInputError
+
+        raise SnappingInputError(f"units={units!r} must be one of {list(UNITS)}")
+    return _U[units]
+
+
+def _conv(units: str, chain: Chain):
+    """Converters (length, time, force) from the library's nondimensional values to ``units``."""
+    if units == "si":
+        return chain.distance, chain.time, chain.force
+    ident = lambda x: x  # noqa: E731
+    return ident, ident, ident
 
 
 def _snapshots_before(ds, n: int):
@@ -65,44 +91,68 @@ def _snapshots_before(ds, n: int):
     return np.unique(np.round(np.linspace(0, last, n)).astype(int))
 
 
-def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8):
-    """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run (in metres)."""
+def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimensional"):
+    """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run,
+    coloured by time (a colour bar per panel).
+
+    ``units="nondimensional"`` (default) draws lengths in units of the chain's length
+    and times in sqrt(l/g); ``units="si"`` in metres and seconds for ``chain``."""
     plt = _plt()
+    u = _units(units)
+    dist, time, _ = _conv(units, chain)
     runs = list(runs)
-    fig, axes = plt.subplots(1, len(runs), figsize=(5.2 * len(runs), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(runs), figsize=(4.6 * len(runs), 4.4), squeeze=False)
+    # fixed positions (a layout engine costs seconds per save): room for each panel's colour bar
+    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86, wspace=0.55)
+    from matplotlib.colors import Normalize
+
     for ax, ds in zip(axes[0], runs):
         idx = _snapshots_before(ds, n)
-        colors = plt.cm.viridis(np.linspace(0, 1, max(len(idx), 2)))
-        for c, i in zip(colors, idx):
+        ts = np.array([time(float(ds["t_snapshot"].values[int(i)])) for i in idx])
+        norm = Normalize(0.0, max(float(ts.max()), 1e-300))
+        cmap = plt.get_cmap("viridis")
+        for tt, i in zip(ts, idx):
             sn = ds.isel(snapshot=int(i))
-            ax.plot(chain.distance(sn["x"].values), -chain.distance(sn["y"].values), color=c, lw=1.2,
-                    label=f"t = {chain.time(float(sn['t_snapshot'])):.3f} s")
+            ax.plot(dist(sn["x"].values), -dist(sn["y"].values), color=cmap(norm(tt)), lw=1.2)
         ax.plot([0], [0], "ks", ms=5)
         ax.set_aspect("equal")
-        ax.set_title(f"chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("height [m]")
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    fig.suptitle(f"Falling chain shapes (length {chain.length:g} m)")
-    fig.tight_layout()
+        ax.set_title(rf"$\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
+        ax.set_xlabel(f"$x$  [{u['length']}]")
+        ax.set_ylabel(f"height  [{u['length']}]")
+        x0, x1 = ax.get_xlim()
+        y0, y1 = ax.get_ylim()
+        w = 0.05 * min(max(abs(y1 - y0) / max(abs(x1 - x0), 1e-12), 1.0), 5.0)  # equal aspect: as wide as tall
+        cb = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=ax.inset_axes((1.04, 0.0, w, 1.0)))
+        cb.set_label(f"$t$  [{u['time']}]")
+    what = f"chain of {chain.length:g} m" if units == "si" else "nondimensional"
+    fig.suptitle(f"Falling chain shapes up to the snap ({what})")
     return fig
 
 
-def pin_force(ds, chain: Chain = PAPER_CHAIN):
-    """Fig. 1(e): horizontal and vertical components of the force on the pin against time, in N and s."""
+def pin_force(ds, chain: Chain = PAPER_CHAIN, units: str = "nondimensional"):
+    """Fig. 1(e): horizontal and vertical components of the force on the pin against time;
+    nondimensional (rho g l, sqrt(l/g)) by default, or ``units="si"`` (N and s for ``chain``)."""
     plt = _plt()
-    t = chain.time(ds["t"].values)
+    u = _units(units)
+    _, time, force = _conv(units, chain)
+    from .scaling.plots import thin_envelope
+
+    t = time(np.asarray(ds["t"].values, dtype=float))
+    fx, fy = force(np.asarray(ds["pin_force_x"].values)), force(np.asarray(ds["pin_force_y"].values))
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6, 5), sharex=True)
-    a1.plot(t, chain.force(ds["pin_force_x"].values), color="tab:red")
-    a1.set_ylabel("horizontal force [N]")
-    a2.plot(t, chain.force(ds["pin_force_y"].values), color="tab:red")
-    a2.set_ylabel("vertical force [N]")
-    a2.set_xlabel("time [s]")
+    fig.subplots_adjust(left=0.15, right=0.96, bottom=0.11, top=0.92, hspace=0.1)
+    k = thin_envelope(t, fx)  # 10^5-10^6 steps: the envelope of 2000 bins of t
+    a1.plot(t[k], fx[k], color="tab:red")
+    a1.set_ylabel(f"horizontal force  [{u['force']}]")
+    k = thin_envelope(t, fy)
+    a2.plot(t[k], fy[k], color="tab:red")
+    a2.set_ylabel(f"vertical force  [{u['force']}]")
+    a2.set_xlabel(f"time $t$  [{u['time']}]")
     for a in (a1, a2):
         a.grid(alpha=0.3)
-    a1.set_title(f"Force on the pin, chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}, "
-                 f"chain {chain.length:g} m, {chain.mass:g} kg")
-    fig.tight_layout()
+    what = f", chain {chain.length:g} m, {chain.mass:g} kg" if units == "si" else " (nondimensional)"
+    a1.set_title(rf"Force on the pin, $\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}{what}",
+                 fontsize=10)
     return fig
 
 
@@ -110,47 +160,51 @@ def profiles(ds, n: int = 7):
     """Fig. 2(a)-(c): speed, acceleration and tension along the chain at several times up to the snap
     (the last, in purple, is the snap), nondimensional."""
     plt = _plt()
+    u = _U["nondimensional"]
     idx = _snapshots_before(ds, n)
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.88, wspace=0.25)
     colors = plt.cm.plasma(np.linspace(0.85, 0.0, max(len(idx), 2)))[::-1]
     colors[-1] = (0.5, 0.0, 0.5, 1.0)  # the snap in purple, as in the paper
     s_node, s_link = ds["s_node"].values, ds["s_link"].values
     for c, i in zip(colors, idx):
         sn = ds.isel(snapshot=int(i))
-        lab = f"t = {float(sn['t_snapshot']):.4f}"
+        lab = f"$t$ = {float(sn['t_snapshot']):.4f}"
         axes[0].plot(s_node, sn["speed"].values, color=c, label=lab)
         axes[1].semilogy(s_node[:-1], np.maximum(sn["accel"].values[:-1], 1e-3), color=c, label=lab)
         axes[2].plot(s_link, sn["tension"].values, color=c, label=lab)
-    for a, name in zip(axes, ("speed |v|", "acceleration |a|", "tension sigma")):
-        a.set_xlabel("arclength s from the pin (nondimensional)")
-        a.set_ylabel(f"{name} (nondimensional)")
+    for a, name in zip(axes, (rf"speed $|v|$  [{u['speed']}]", rf"acceleration $|a|$  [{u['accel']}]",
+                              rf"tension $\sigma$  [{u['force']}]")):
+        a.set_xlabel(f"arclength $s$ from the pin  [{u['length']}]")
+        a.set_ylabel(name)
         a.grid(alpha=0.3)
-    axes[0].legend(fontsize=7)
-    fig.suptitle(f"Along the chain up to the snap: chi = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
-    fig.tight_layout()
+    # the speed grows towards the free end (s = 1): the upper left of panel (a) is free
+    axes[0].legend(fontsize=7, loc="upper left", title=f"time [{u['time']}]", title_fontsize=7)
+    fig.suptitle(rf"Along the chain up to the snap: $\chi$ = {float(ds.attrs['chi']):g}, "
+                 f"N = {int(ds.attrs['N'])} (nondimensional)")
     return fig
 
 
 def peak_speed_vs_N(table):
     """Fig. 2(d): peak speed against N for several chi, with the N^(1/2) line a singularity
-    regularised by discreteness would follow.
+    regularised by discreteness would follow (nondimensional).
 
     ``table`` maps chi to a list of (N, v_peak)."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig.subplots_adjust(left=0.15, right=0.97, bottom=0.13, top=0.91)
     for chi, rows in sorted(table.items()):
         rows = sorted(rows)
         N = np.array([r[0] for r in rows], float)
         v = np.array([r[1] for r in rows], float)
-        line, = ax.loglog(N, v, "o-", label=f"chi = {chi:g}")
+        line, = ax.loglog(N, v, "o-", label=rf"$\chi$ = {chi:g}")
         ax.loglog(N, v[0] * np.sqrt(N / N[0]), ":", color=line.get_color(), lw=1)
-    ax.plot([], [], "k:", label="N^(1/2) (discreteness regularised)")
-    ax.set_xlabel("number of links N")
-    ax.set_ylabel("peak speed (nondimensional)")
-    ax.legend(fontsize=8)
+    ax.plot([], [], "k:", label=r"$N^{1/2}$ (discreteness regularised)")
+    ax.set_xlabel("number of links $N$")
+    ax.set_ylabel(r"peak speed $v$  [$\sqrt{g\ell}$]")
+    ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3, which="both")
     ax.set_title("Snapping velocity against N")
-    fig.tight_layout()
     return fig
 
 
@@ -199,9 +253,9 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
                   f"({ds.attrs.get('lumping', '')} lumping)")
     ax1.legend(fontsize=7, loc="lower right")
     ax2.set_xlabel("link length on the fold / its radius of curvature")
-    ax2.set_ylabel("|peak - limit| / limit")
+    ax2.set_ylabel(r"$|$peak $-$ limit$|$ / limit")
     ax2.set_title("(b) distance to the limit")
-    ax2.legend(fontsize=8)
+    ax2.legend(fontsize=8, loc="upper left")
     if path is not None:
         from ._files import save_figure
 

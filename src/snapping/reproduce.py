@@ -319,19 +319,17 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                  "typo in the paper (sign)" if ok_integral else "check"))
 
     # ---------------------------------------------------------------- Fig. 1
-    t1 = time.perf_counter()
     shape_runs = [_load(out, plan, c, plan.shapes_N, plan.tol) for c in plan.shapes_chi]
-    figures.save(figures.shapes(shape_runs), figdir / "fig1_shapes")
     r025 = _load(out, plan, 0.25, plan.shapes_N, plan.tol)
-    figures.save(figures.pin_force(r025), figdir / "fig1e_pin_force")
-    timings["fig1"] = time.perf_counter() - t1
-
-    # ---------------------------------------------------------------- Fig. 2
-    t1 = time.perf_counter()
-    figures.save(figures.profiles(r025), figdir / "fig2_profiles")
     table = {c: [(n, float(_load(out, plan, c, n, plan.tol).attrs["v_peak"])) for n in plan.speed_N] for c in plan.speed_chi}
-    figures.save(figures.peak_speed_vs_N(table), figdir / "fig2d_peak_speed_vs_N")
-    timings["fig2"] = time.perf_counter() - t1
+    for name, draw in (("fig1_shapes", lambda: figures.shapes(shape_runs)),
+                       ("fig1e_pin_force", lambda: figures.pin_force(r025)),
+                       # ---------------------------------------------------- Fig. 2
+                       ("fig2_profiles", lambda: figures.profiles(r025)),
+                       ("fig2d_peak_speed_vs_N", lambda: figures.peak_speed_vs_N(table))):
+        t1 = time.perf_counter()
+        figures.save(draw(), figdir / name)
+        timings[name] = time.perf_counter() - t1
     a_peak = float(r025.attrs["a_peak"])
     dur = _snap_duration(r025)
     rows.append((f"chi = 0.25 (N = {plan.shapes_N}): peak acceleration", _fmt(a_peak), "order 10^4",
@@ -351,13 +349,12 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     t1 = time.perf_counter()
     sc_runs = [_load(out, plan, c, plan.scaling_N, plan.tol) for c in plan.scaling_chi]
     results = [scaling.fit_run(ds) for ds in sc_runs]
-    scaling.plot_maxima(sc_runs, results, figdir / "fig3_maxima.png")
-    scaling.plot_maxima(sc_runs, results, figdir / "fig3_maxima.pdf")
-    scaling.plot_local_slopes(sc_runs, results, figdir / "fig3_local_slopes.png")
-    scaling.plot_local_slopes(sc_runs, results, figdir / "fig3_local_slopes.pdf")
-    scaling.plot_delta(sc_runs, results, figdir / "fig4_delta.png")
-    scaling.plot_delta(sc_runs, results, figdir / "fig4_delta.pdf")
-    timings["fig3_fig4"] = time.perf_counter() - t1
+    timings["fits (Fig. 3/4 runs)"] = time.perf_counter() - t1
+    for name, plot in (("fig3_maxima", scaling.plot_maxima), ("fig3_local_slopes", scaling.plot_local_slopes),
+                       ("fig4_delta", scaling.plot_delta)):
+        t1 = time.perf_counter()  # drawn once, saved as PNG and PDF
+        plot(sc_runs, results, [figdir / f"{name}.png", figdir / f"{name}.pdf"])
+        timings[name] = time.perf_counter() - t1
 
     def exponent_row(name, paper, ref):
         cells, agree, inconclusive, agree_w, n_w = [], 0, 0, 0, 0

@@ -7,7 +7,8 @@ Run Datasets (:mod:`snapping.scaling.run`)
     :func:`load_run`, :func:`iter_runs`, :func:`snapping_times`, :func:`fit_run`,
     :func:`delta_comparison`, :func:`report_rows`, :func:`summary_rows`, :func:`local_slopes`
 Figures (:mod:`snapping.scaling.plots`)
-    :func:`plot_maxima` (Fig. 3), :func:`plot_local_slopes`, :func:`plot_delta` (Fig. 4)
+    :func:`plot_maxima` (Fig. 3), :func:`plot_local_slopes`, :func:`plot_delta` (Fig. 4);
+    :func:`front_arclength` (the curvature maximum between nodes), :func:`thin_log`
 
 Example
 -------
@@ -51,7 +52,7 @@ from .run import (
 
 
 def __getattr__(name):  # figures import matplotlib lazily
-    if name in ("plot_maxima", "plot_local_slopes", "plot_delta"):
+    if name in ("plot_maxima", "plot_local_slopes", "plot_delta", "front_arclength", "thin_log"):
         from . import plots
 
         return getattr(plots, name)

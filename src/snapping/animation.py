@@ -1,0 +1,267 @@
+"""An animation of the snap from a run file's snapshots (``snapping animate``).
+
+Each frame is one profile snapshot of the run (``x``, ``y``, ``speed`` over the
+nodes, at ``t_snapshot``; names in :mod:`snapping.schema`): the chain drawn as a
+LineCollection coloured by the speed of each link (the mean of its two nodes' speeds)
+on a logarithmic colour scale, since the speeds span decades, with a colour bar,
+the time and the time to the snap shown, equal aspect, nondimensional units
+(lengths in chain lengths l, speeds in sqrt(g l), time in sqrt(l/g)).
+
+The automatic snapshots of a run (:func:`snapping.simulate.run`) are taken when the
+maximum speed first reaches 1, 1.5, 1.5^2, ... and pile up towards the snap, but
+give only some ten frames; :func:`dense_snapshot_times` suggests times for
+``snapping simulate --snapshot-times`` that make a smooth animation (geometric in
+the time to the snap), and ``snapping animate`` prints the command when a run has
+fewer than :data:`DENSE_FRAMES` snapshots up to the snap.
+
+GIF is written with matplotlib's PillowWriter (pillow comes with matplotlib), MP4
+with FFMpegWriter when ``ffmpeg`` is on PATH.
+
+Example
+-------
+>>> from snapping.animation import dense_snapshot_times
+>>> ts = dense_snapshot_times(1.2, n=5)
+>>> [round(t, 6) for t in ts]
+[0.0, 1.08, 1.188, 1.1988, 1.19988]
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from . import _validate as V
+
+__all__ = ["dense_snapshot_times", "frames_of", "animate", "DENSE_FRAMES", "SUFFIXES"]
+
+#: Fewer snapshots than this up to the snap make a jerky animation: ``snapping animate`` says how to get more.
+DENSE_FRAMES = 24
+
+#: Output formats by suffix.
+SUFFIXES = (".gif", ".mp4")
+
+#: Needed snapshot variables.
+_NEEDED = ("t_snapshot", "x", "y", "speed")
+
+
+def dense_snapshot_times(t_snap: float, n: int = 60, tau_min: float = 1e-4) -> list[float]:
+    """``n`` snapshot times from 0 to the snap ``t_snap``, geometric in the time to the
+    snap tau = t_snap - t from tau = t_snap (t = 0) down to ``tau_min * t_snap``: a
+    frame per equal factor of tau, so the slow fall and the fast snap both get frames.
+
+    Parameters
+    ----------
+    t_snap : float
+        Snapping time of the run (its ``t_snap_v`` attribute), > 0.
+    n : int
+        Number of times, >= 2.
+    tau_min : float
+        Smallest time to the snap, as a fraction of ``t_snap``, in (0, 1).
+
+    Returns
+    -------
+    list of float
+        Increasing times, the first 0; the last is ``t_snap (1 - tau_min)``.
+    """
+    t_snap = V.positive("t_snap", t_snap)
+    n = V.integer("n", n, 2)
+    if not (isinstance(tau_min, (int, float)) and 0.0 < tau_min < 1.0):
+        raise V.SnappingInputError(f"tau_min={tau_min!r} must be in (0, 1)")
+    tau = np.geomspace(1.0, tau_min, n) * t_snap
+    return [float(t) for t in t_snap - tau]
+
+
+def _check_run(ds, name: str = "run"):
+    missing = [v for v in _NEEDED if v not in ds.variables]
+    if missing:
+        raise V.SnappingInputError(f"{name} has no profile snapshots (missing {missing}): nothing to animate")
+    if ds.sizes.get("snapshot", 0) < 1:
+        raise V.SnappingInputError(f"{name} has no profile snapshots: nothing to animate")
+
+
+def frames_of(ds, max_frames: int | None = None) -> np.ndarray:
+    """Indices of the snapshots that become frames: all of them in time order (dropping
+    repeated times), thinned evenly in index to at most ``max_frames`` (first and last kept)."""
+    _check_run(ds)
+    t = np.asarray(ds["t_snapshot"].values, dtype=float)
+    order = np.argsort(t, kind="stable")
+    keep = order[np.r_[True, np.diff(t[order]) > 0]]
+    if max_frames is not None:
+        max_frames = V.integer("max_frames", max_frames, 2)
+        if keep.size > max_frames:
+            keep = keep[np.unique(np.round(np.linspace(0, keep.size - 1, max_frames)).astype(int))]
+    return keep
+
+
+def snapshots_before_snap(ds) -> int:
+    """Number of snapshots at or before the run's snapping time ``t_snap_v``."""
+    t = np.asarray(ds["t_snapshot"].values, dtype=float)
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    return int(np.sum(t <= t_snap)) if math.isfinite(t_snap) else int(t.size)
+
+
+def denser_run_hint(ds, path: str, n: int = 60) -> str | None:
+    """The command that makes a denser-snapshot run of ``ds``, or None where it has at least
+    :data:`DENSE_FRAMES` snapshots up to the snap (or no snapping time)."""
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    if not math.isfinite(t_snap) or t_snap <= 0 or snapshots_before_snap(ds) >= DENSE_FRAMES:
+        return None
+    times = ",".join(f"{t:.9g}" for t in dense_snapshot_times(t_snap, n)[1:])  # t = 0 is always taken
+    stem = Path(path).with_suffix("").name
+    head = (f"only {snapshots_before_snap(ds)} snapshots up to the snap (t = {t_snap:.6g}); for a smoother "
+            f"animation make a run with {n} snapshots dense towards the snap")
+    if str(ds.attrs.get("initial", "catenary")) == "catenary" and "chi" in ds.attrs:
+        opts = f"--chi {float(ds.attrs['chi']):g} --N {int(ds.attrs['N'])}"
+        for k, o in (("tol", "--tol"), ("method", "--method")):
+            if k in ds.attrs:
+                opts += f" {o} {ds.attrs[k]:g}" if k == "tol" else f" {o} {ds.attrs[k]}"
+        return f"{head}:\n  snapping simulate {opts} --snapshot-times {times} -o {stem}_dense.nc"
+    return f"{head}: add to the command that made it\n  --snapshot-times {times}"
+
+
+def _writer(suffix: str, fps: float):
+    from matplotlib import animation as A
+
+    if suffix == ".gif":
+        class _Gif(A.PillowWriter):  # the format named, not guessed from the temporary file's name
+            def finish(self):
+                self._frames[0].save(self.outfile, format="GIF", save_all=True, append_images=self._frames[1:],
+                                     duration=int(1000 / self.fps), loop=0)
+
+        return _Gif(fps=fps)
+    return A.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p", "-f", "mp4"])
+
+
+def check_output(output, *, overwrite: bool = False) -> str:
+    """The animation path to write, checked before any work: suffix .gif or .mp4 (ffmpeg on
+    PATH for .mp4), an existing directory, no existing file unless ``overwrite``."""
+    from . import _files
+
+    p = V.file_path("output", output)
+    suffix = Path(p).suffix.lower()
+    if suffix not in SUFFIXES:
+        raise V.SnappingInputError(f"output={p!r}: the animation suffix must be .gif or .mp4 (got {suffix or 'none'!r})")
+    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
+        raise V.SnappingInputError(f"output={p!r}: writing MP4 needs ffmpeg on PATH, which is not found; "
+                                   f"write a GIF instead (-o {Path(p).with_suffix('.gif').name})")
+    return _files.check_output(p, name="output", overwrite=overwrite)
+
+
+def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
+    """The figure and FuncAnimation of run ``ds`` (not saved), with ``artists``: a dict of
+    the LineCollection ``chain``, the colour ``norm``, the ``frames`` (snapshot indices) and
+    the time ``text``, for inspection.
+
+    Colours: the speed of each link (mean of its nodes' speeds) on a LogNorm from the
+    largest speed of all frames down to ``vmin_fraction`` of it (or the smallest positive
+    speed, if larger); slower links (the chain at rest at t = 0) take the lowest colour."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib import animation as A
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import LogNorm
+
+    frames = frames_of(ds, max_frames)
+    X = np.asarray(ds["x"].values, dtype=float)[frames]
+    H = -np.asarray(ds["y"].values, dtype=float)[frames]  # y points down: height = -y
+    S = np.asarray(ds["speed"].values, dtype=float)[frames]
+    T = np.asarray(ds["t_snapshot"].values, dtype=float)[frames]
+    seg_speed = 0.5 * (S[:, 1:] + S[:, :-1])
+    finite = seg_speed[np.isfinite(seg_speed)]
+    vmax = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
+    pos = finite[finite > 0]
+    vmin = max(float(pos.min()) if pos.size else vmax * vmin_fraction, vmax * vmin_fraction)
+    if vmin >= vmax:
+        vmin = vmax / 10.0
+    norm = LogNorm(vmin=vmin, vmax=vmax, clip=True)
+
+    ok = np.isfinite(X) & np.isfinite(H)
+    xlo, xhi, hlo, hhi = X[ok].min(), X[ok].max(), H[ok].min(), H[ok].max()
+    pad = 0.05 * max(xhi - xlo, hhi - hlo, 1e-9)
+    xr, hr = xhi - xlo + 2 * pad, hhi - hlo + 2 * pad
+    height = 5.0  # inches of the axes; the width follows the chain's extent (equal aspect) plus the colour bar
+    fig, ax = plt.subplots(figsize=(min(max(4.8, height * xr / hr + 2.2), 12.0), height + 1.0), dpi=100,
+                           layout="constrained")
+    ax.set_xlim(xlo - pad, xhi + pad)
+    ax.set_ylim(hlo - pad, hhi + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"$x$  [$\ell$]")
+    ax.set_ylabel(r"height  [$\ell$]")
+    ax.grid(alpha=0.25)
+
+    def segments(i):
+        pts = np.column_stack([X[i], H[i]])
+        return np.stack([pts[:-1], pts[1:]], axis=1)
+
+    chain = LineCollection(segments(0), cmap="viridis", norm=norm, linewidths=2.0, capstyle="round")
+    chain.set_array(np.maximum(seg_speed[0], vmin))
+    ax.add_collection(chain)
+    pin, = ax.plot([X[0, -1]], [H[0, -1]], "ks", ms=6, zorder=3)
+    cb = fig.colorbar(chain, ax=ax, shrink=0.85, pad=0.02)
+    cb.set_label(r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    text = ax.set_title("", fontsize=9, family="monospace", loc="left")
+    chi = ds.attrs.get("chi")
+    fig.suptitle(("falling chain" + (rf", $\chi$ = {float(chi):g}" if chi is not None else "")
+                  + f", N = {int(ds.attrs['N'])} (nondimensional)"), fontsize=10)
+
+    def label(i):
+        s = f"t = {T[i]:.6f}"
+        if math.isfinite(t_snap):
+            tau = t_snap - T[i]
+            s += f"\nt_snap - t = {tau:+.2e}" if abs(tau) < 1e-2 else f"\nt_snap - t = {tau:+.4f}"
+        return s + f"\nmax |v| = {np.nanmax(S[i]):.3g}"
+
+    text.set_text(label(0))
+    fig.canvas.draw()  # lay out once (the longest label is the first frame's), then freeze the positions:
+    fig.set_layout_engine("none")  # a layout engine would redo the layout for every frame
+
+    def update(i):
+        chain.set_segments(segments(i))
+        chain.set_array(np.maximum(seg_speed[i], vmin))
+        pin.set_data([X[i, -1]], [H[i, -1]])
+        text.set_text(label(i))
+        return chain, pin, text
+
+    anim = A.FuncAnimation(fig, update, frames=len(frames), blit=False, repeat=False)
+    return fig, anim, {"chain": chain, "norm": norm, "frames": frames, "text": text, "update": update,
+                       "segment_speed": seg_speed}
+
+
+def animate(ds, output, *, fps: float = 8.0, max_frames: int | None = None, overwrite: bool = False) -> str:
+    """Write the animation of run ``ds`` to ``output`` (.gif, or .mp4 with ffmpeg), atomically;
+    returns the path written.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A run with profile snapshots (:func:`snapping.simulate.load_run`).
+    output : path
+        ``.gif`` (PillowWriter) or ``.mp4`` (FFMpegWriter, needs ffmpeg on PATH).
+    fps : float
+        Frames per second, > 0.
+    max_frames : int, optional
+        At most this many frames (snapshots thinned evenly).
+    overwrite : bool
+        Replace an existing file (default: refuse it).
+    """
+    from . import _files
+
+    fps = V.positive("fps", fps)
+    p = check_output(output, overwrite=overwrite)
+    _check_run(ds)
+    import matplotlib.pyplot as plt
+
+    fig, anim, _ = build(ds, max_frames=max_frames)
+    writer = _writer(Path(p).suffix.lower(), fps)
+    try:
+        return _files.write_atomic(p, lambda tmp: anim.save(os.fspath(tmp), writer=writer), name="output",
+                                   overwrite=overwrite)
+    finally:
+        plt.close(fig)
