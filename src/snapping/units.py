@@ -48,7 +48,7 @@ from . import _validate as V
 from . import schema
 
 __all__ = ["Scales", "KIND_UNITS", "VARIABLE_KINDS", "VALUE_KINDS", "G_STANDARD", "NONDIMENSIONAL_NOTE",
-           "kind_of", "to_si", "from_si", "summary_to_si", "values_to_si", "si_rows", "fit_to_si"]
+           "kind_of", "to_si", "from_si", "summary_to_si", "values_to_si", "si_rows", "fit_rows", "fit_to_si"]
 
 #: the default gravity, m s-2 (what ``snapping estimate`` has always used)
 G_STANDARD = 9.81
@@ -441,19 +441,19 @@ def _scale_inputs(s: Scales) -> dict:
 _PEAK_KINDS = {"v_max": _V, "a_max": _A, "sigma_max": _F, "v": _V, "a": _A, "sigma": _F}
 
 
-def fit_to_si(fit: dict, scales: Scales) -> dict:
-    """The dimensional numbers of a fit report (``RunFit.to_dict()`` of
-    :func:`snapping.scaling.fit_run`) in SI, flat: ``{name: {"value", "units"}}`` with the
-    snapping time ``t_star`` (and ``t_star_err``), each peak's time and value
-    (``t_peak_v_max``, ``peak_v_max``, ...), the scales ``delta_*`` (lengths), the run's
-    and the whirling-rod peaks (``computed_v``, ``predicted_delta_c_sigma``, ...) and
-    ``kappa_max_0``. The exponents are dimensionless; the prefactors A (units that depend
-    on the exponent) stay nondimensional."""
+def fit_rows(fit: dict, scales: Scales) -> list[tuple[str, object, object, str]]:
+    """:func:`si_rows` of a fit report (``RunFit.to_dict()`` of :func:`snapping.scaling.fit_run`),
+    flat: the snapping time ``t_star`` (and ``t_star_err``), each peak's time and value
+    (``t_peak_v_max``, ``peak_v_max``, ...), the scales ``delta_*`` (lengths), the run's and
+    the whirling-rod peaks (``computed_v``, ``predicted_delta_c_sigma``, ...) and
+    ``kappa_max_0``. The exponents are dimensionless; the prefactors A (whose units depend
+    on the exponent) stay nondimensional. Entries missing from ``fit`` are left out."""
     flat, kinds = {}, {}
 
     def put(name, value, kind):
         if value is None or isinstance(value, (int, float)) and not isinstance(value, bool):
-            flat[name], kinds[name] = value, kind
+            flat[name] = None if value is None or not math.isfinite(value) else value
+            kinds[name] = kind
 
     snap = fit.get("snap") or {}
     put("t_star", snap.get("t_star"), _T)
@@ -474,5 +474,9 @@ def fit_to_si(fit: dict, scales: Scales) -> dict:
             if q in _PEAK_KINDS:
                 put(f"predicted_{k}_{q}", v, _PEAK_KINDS[q])
     put("kappa_max_0", fit.get("kappa_max_0"), _K)
-    return values_to_si({k: (None if v is None or not math.isfinite(v) else v) for k, v in flat.items()}, scales,
-                        kinds)
+    return si_rows(flat, scales, kinds)
+
+
+def fit_to_si(fit: dict, scales: Scales) -> dict:
+    """``{name: {"value": SI value, "units": CF string}}`` of the rows of :func:`fit_rows`."""
+    return {k: {"value": si, "units": u} for k, _, si, u in fit_rows(fit, scales)}
