@@ -224,7 +224,8 @@ def _add_estimate(sub) -> None:
     g.add_argument("--curvature", type=float, help="initial maximum curvature in 1/m (needs --length)")
     p.add_argument("--length", type=float, default=None, metavar="METERS",
                    help="chain length in m (default: the paper's 1.022)")
-    p.add_argument("--mass", type=float, default=None, metavar="KG", help="chain mass in kg (default: the paper's 0.0208)")
+    p.add_argument("--mass", type=float, default=None, metavar="KG",
+                   help="chain mass in kg (default: the paper's 0.0208)")
     _add_g_option(p)
     p.add_argument("--N", type=int, default=None, help="number of links, adds the delta_N = 1/N prediction")
     p.add_argument("--json", action="store_true", help="print one JSON object")
