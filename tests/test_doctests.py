@@ -6,7 +6,7 @@ import importlib
 import pytest
 
 MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
-           "snapping._files"]
+           "snapping._files", "snapping.units"]
 
 
 @pytest.mark.parametrize("name", MODULES)

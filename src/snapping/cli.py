@@ -97,6 +97,84 @@ def print_table(rows, title: str | None = None) -> None:
         print(f"  {r[0]:<{w0}}  {r[1]:>{w1}}  {rest}".rstrip())
 
 
+# ----------------------------------------------------------------------- SI units
+#: commands with --length/--mass/--g for SI output (their errors name these options themselves)
+_SI_COMMANDS = ("simulate", "fit", "sweep", "converge")
+_SI_DESTS = ("length", "mass", "g")
+
+
+def _add_g_option(p) -> None:
+    """--g: gravity in m/s^2, the same on every command that has it."""
+    p.add_argument("--g", type=float, default=9.81, metavar="M_PER_S2", help="gravity in m/s^2 (default 9.81)")
+
+
+def _add_si_options(p) -> None:
+    """--length, --mass and --g: the chain in SI, to print the results in SI too (snapping.units)."""
+    g = p.add_argument_group("SI units", "with --length and --mass the results are printed in SI too (text: a "
+                                         "table beside the nondimensional one; --json: an \"si\" object)")
+    g.add_argument("--length", type=float, default=None, metavar="METERS", help="the chain's length in m")
+    g.add_argument("--mass", type=float, default=None, metavar="KG", help="the chain's mass in kg")
+    _add_g_option(g)
+
+
+def _si_scales(args):
+    """The :class:`snapping.units.Scales` of --length/--mass/--g, or None when neither
+    --length nor --mass is given; SnappingInputError naming the option when one is bad."""
+    from ._validate import SnappingInputError
+    from .units import Scales
+
+    if args.length is None and args.mass is None:
+        if "g" in getattr(args, "_explicit", ()):
+            raise SnappingInputError(f"--g {args.g!r} needs --length METERS and --mass KG (it only scales SI output)")
+        return None
+    if args.length is None or args.mass is None:
+        given, missing = ("--length", "--mass") if args.mass is None else ("--mass", "--length")
+        raise SnappingInputError(f"{given} needs {missing} too: give both (the chain's length in m and mass in kg) "
+                                 f"for SI output, or neither")
+    try:
+        return Scales(args.length, args.mass, args.g)
+    except SnappingInputError as exc:
+        raise SnappingInputError(f"--{exc}") from None  # (its message starts with length=, mass= or g=)
+
+
+def _with_si(obj: dict, scales, si) -> dict:
+    """``obj`` (a --json answer) with its ``"si"`` part (``si()`` computes it), or, without
+    --length/--mass, a ``"units"`` line saying the numbers are nondimensional."""
+    from . import units
+
+    if scales is None:
+        return {**obj, "units": units.NONDIMENSIONAL_NOTE}
+    return {**obj, "si": {"system": "SI", "scales": units._scale_inputs(scales), **si()}}
+
+
+def _print_si(scales, rows, title: str = "") -> None:
+    """The SI part of a text answer: ``rows`` (name, nondimensional, SI, units; from
+    :func:`snapping.units.si_rows`) as a table, or, without --length/--mass, the line saying
+    the numbers are nondimensional and how to get SI."""
+    from . import units
+
+    if scales is None:
+        print(f"  {units.NONDIMENSIONAL_NOTE}")
+        return
+
+    def fmt(v):
+        if v is None:
+            return "absent"
+        if isinstance(v, list):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+    head = (f"In SI{f' ({title})' if title else ''}: chain length {scales.length:g} m, mass {scales.mass:g} kg, "
+            f"g = {scales.g:g} m/s^2 (time unit {scales.time:.6g} s)")
+    print()
+    print(head)
+    print("-" * len(head))
+    table = [("", "nondimensional", "SI", "units")] + [(str(k), fmt(v), fmt(si), u) for k, v, si, u in rows]
+    w = [max(len(r[i]) for r in table) for i in range(3)]
+    for r in table:
+        print(f"  {r[0]:<{w[0]}}  {r[1]:>{w[1]}}  {r[2]:>{w[2]}}  {r[3]}".rstrip())
+
+
 # --------------------------------------------------------------------------- ideal
 def _add_ideal(sub) -> None:
     p = sub.add_parser(
@@ -144,9 +222,11 @@ def _add_estimate(sub) -> None:
     g.add_argument("--chi", type=float, help="end separation / length, in (0, 1)")
     g.add_argument("--separation", type=float, help="end separation in metres (needs --length)")
     g.add_argument("--curvature", type=float, help="initial maximum curvature in 1/m (needs --length)")
-    p.add_argument("--length", type=float, default=None, help="chain length in m (default: the paper's 1.022)")
-    p.add_argument("--mass", type=float, default=None, help="chain mass in kg (default: the paper's 0.0208)")
-    p.add_argument("--g", type=float, default=None, help="gravity in m/s^2 (default 9.81)")
+    p.add_argument("--length", type=float, default=None, metavar="METERS",
+                   help="chain length in m (default: the paper's 1.022)")
+    p.add_argument("--mass", type=float, default=None, metavar="KG",
+                   help="chain mass in kg (default: the paper's 0.0208)")
+    _add_g_option(p)
     p.add_argument("--N", type=int, default=None, help="number of links, adds the delta_N = 1/N prediction")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=_cmd_estimate)
@@ -201,6 +281,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 2000 --tol 1e-8 --json\n"
             "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2 -o run.nc\n"
             "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
+            "  snapping simulate --chi 0.25 --N 229 --length 1.022 --mass 0.0208   # results in SI too\n"
             "\n"
             "other chains, starts and held ends (method fast; every option is nondimensional:\n"
             "lengths in chain lengths, masses in chain masses, time in sqrt(length/g)):\n"
@@ -269,13 +350,15 @@ def _add_simulate(sub) -> None:
                    help="fail after more than this many consecutive rejected steps (default 100)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (it is off anyway when not a tty)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    _add_si_options(p)
     p.set_defaults(func=_cmd_simulate)
 
 
 def _cmd_simulate(args) -> int:
-    from . import simulate
+    from . import simulate, units
     from ._validate import SnappingInputError
 
+    scales = _si_scales(args)
     try:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
@@ -338,15 +421,15 @@ def _cmd_simulate(args) -> int:
         return _nonfinite_error("simulate", bad, where)
     reached = summary.get("snap_reached", True)
     if args.json:
-        print_json(summary)
+        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales)}))
     else:
-        units = {"wall_time": "s"}
+        note_units = {"wall_time": "s"}
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         rows = []
         for k, v in summary.items():
             if k in ("snap_note", "peaks"):
                 continue
-            note = units.get(k)
+            note = note_units.get(k)
             if v is None and k in precise:
                 v, note = "absent", ("no snap reached" if not reached else "its peak is at the run's last step")
             elif k in ("v_peak", "a_peak", "sigma_peak", "kappa_peak") and not reached:
@@ -359,6 +442,7 @@ def _cmd_simulate(args) -> int:
         )
         if not reached and summary.get("snap_note"):
             print(f"  note: {summary['snap_note']}")
+        _print_si(scales, units.si_rows(summary, scales) if scales else [])
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
@@ -412,6 +496,7 @@ def _add_fit(sub) -> None:
             "examples:\n"
             "  snapping fit run.nc\n"
             "  snapping fit run.nc --json\n"
+            "  snapping fit run.nc --length 1.022 --mass 0.0208   # snapping time, peaks, scales in SI too\n"
             "  snapping fit run.nc --plot fig3.png --window v_max=1e-4,1e-2\n"
             "  snapping fit run_chi0.1.nc run_chi0.25.nc run_chi0.5.nc --plot collapse.pdf"
         ),
@@ -427,15 +512,17 @@ def _add_fit(sub) -> None:
         help="fix the window of t* - t of a variable or row, e.g. v_max=1e-4,1e-2 (repeatable)",
     )
     p.add_argument("--no-joint", action="store_true", help="skip the fits with t* fitted jointly")
+    _add_si_options(p)
     p.set_defaults(func=_cmd_fit)
 
 
 def _cmd_fit(args) -> int:
     from pathlib import Path
 
-    from . import scaling
+    from . import scaling, units
     from ._validate import SnappingInputError
 
+    scales = _si_scales(args)
     windows = {}
     for w in args.window:
         try:
@@ -469,7 +556,12 @@ def _cmd_fit(args) -> int:
         except SnappingInputError as exc:
             raise SnappingInputError(f"{name}: {exc}") from None
     if args.json:
-        print_json(results[0].to_dict() if len(results) == 1 else {"runs": [r.to_dict() for r in results]})
+        if len(results) == 1:
+            d = results[0].to_dict()
+            print_json(_with_si(d, scales, lambda: {"values": units.fit_to_si(d, scales)}))
+        else:
+            ds_ = [r.to_dict() for r in results]
+            print_json(_with_si({"runs": ds_}, scales, lambda: {"runs": [units.fit_to_si(d, scales) for d in ds_]}))
     elif len(results) == 1:
         res = results[0]
         s = res.snap
@@ -487,8 +579,15 @@ def _cmd_fit(args) -> int:
             if d.note:
                 print(f"  delta_kappa_m: {d.note}")
         print(f"\n  curvature amplification max kappa_max / kappa_max(0) = {res.kappa_amplification:.4g}")
+        _print_si(scales, units.fit_rows(res.to_dict(), scales) if scales else [])
     else:
         print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
+        if scales is None:
+            _print_si(None, [])
+        for name, res in zip(names, results):
+            if scales is not None:
+                _print_si(scales, [r for r in units.fit_rows(res.to_dict(), scales)
+                                   if r[0] in ("t_star", "peak_v_max", "peak_a_max", "peak_sigma_max")], name)
     if args.plot is not None:
         out = Path(args.plot)
         paths = [
@@ -543,6 +642,7 @@ def _add_sweep(sub) -> None:
         epilog=(
             "examples:\n"
             "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_out\n"
+            "  snapping sweep --chi 0.25,0.5 --N 50 -o sweep_out --length 1.022 --mass 0.0208   # SI too\n"
             "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --method fast --ensemble 4 -o sweep_out\n"
             "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_out"
         ),
@@ -559,14 +659,16 @@ def _add_sweep(sub) -> None:
     p.add_argument("--overwrite", action="store_true",
                    help="replace DIR/sweep.nc even if it holds another grid's runs (default: refuse)")
     p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
+    _add_si_options(p)
     p.set_defaults(func=_cmd_sweep)
 
 
 def _cmd_sweep(args) -> int:
     from pathlib import Path
 
-    from . import sweep
+    from . import sweep, units
 
+    scales = _si_scales(args)
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
@@ -604,7 +706,8 @@ def _cmd_sweep(args) -> int:
             obj["failed"] = [f.to_dict() for f in failed.failures]
         if bad:
             return _nonfinite_error("sweep", bad)
-        print_json(obj)
+        print_json(_with_si(obj, scales, lambda: {"runs": [{"chi": r["chi"], "N": r["N"],
+                                                            **units.values_to_si(r, scales)} for r in rows]}))
     else:
         if bad:
             return _nonfinite_error("sweep", bad)
@@ -619,6 +722,8 @@ def _cmd_sweep(args) -> int:
                       f"{t_snap:>10}")
             if any(not r["snap_reached"] for r in rows):
                 print("  no snap: the run ended before the snap (see its snap_note); its peaks are maxima over the run")
+            _print_si(scales, [(f"chi={r['chi']:g} N={r['N']} {k}", *rest) for r in rows if scales
+                               for k, *rest in units.si_rows(r, scales)])
         else:
             print(f"no run of the sweep completed; nothing combined in {args.output}")
     if failed is not None:
@@ -649,6 +754,7 @@ def _add_converge(sub) -> None:
             "  snapping converge --chi 0.1 --levels 5 --workers 2 -o conv01 --plot conv01.png\n"
             "  snapping converge --chi 0.25 --levels 3 --first -1 --json\n"
             "  snapping converge --chi 0.25 --lumping paper      # the paper's lumping: first order\n"
+            "  snapping converge --chi 0.25 --length 1.022 --mass 0.0208   # the limits in SI too\n"
             "\n"
             "With -o DIR every level's run file is kept there and a rerun reuses the finished levels."
         ),
@@ -667,12 +773,14 @@ def _add_converge(sub) -> None:
     p.add_argument("--plot", default=None, metavar="PATH", help="draw the convergence figure (.png, .pdf, .svg)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file (default: refuse it)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    _add_si_options(p)
     p.set_defaults(func=_cmd_converge)
 
 
 def _cmd_converge(args) -> int:
-    from . import continuum
+    from . import continuum, units
 
+    scales = _si_scales(args)
     if args.plot is not None:
         from ._validate import SnappingInputError
         from .simulate.dataset import check_writable
@@ -688,9 +796,13 @@ def _cmd_converge(args) -> int:
         res.plot(args.plot)
     if args.json:
         ds = res.dataset
-        print_json({**res.summary(), "levels": {k: ds[k].values.tolist() for k in ds.data_vars}})
+        levels = {k: ds[k].values.tolist() for k in ds.data_vars}
+        print_json(_with_si({**res.summary(), "levels": levels}, scales,
+                            lambda: {"values": units.values_to_si(res.summary(), scales),
+                                     "levels": units.values_to_si(levels, scales)}))
     else:
         print(res.table())
+        _print_si(scales, units.si_rows(res.summary(), scales) if scales else [])
     return 0
 
 
@@ -824,7 +936,8 @@ def _as_typed(parser, command: str, msg: str) -> str:
     names = {}
     for a in sub._actions:
         longs = [o for o in a.option_strings if o.startswith("--")]
-        if longs and a.dest not in ("help", "json"):
+        si_own = command in _SI_COMMANDS and a.dest in _SI_DESTS  # (their messages name the options)
+        if longs and a.dest not in ("help", "json") and not si_own:
             names[a.dest] = longs[0]
     after = r"(?=[=\[]| contains| grid)"
     for dest, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):

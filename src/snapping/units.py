@@ -1,0 +1,482 @@
+"""Unit conversion: the nondimensional numbers of the library to SI, and back.
+
+Every run, fit and sweep is nondimensional (:mod:`snapping.schema`): lengths in
+chain lengths L, masses in chain masses M, accelerations in g. A real chain fixes
+the three scales, ``Scales(length=L [m], mass=M [kg], g [m s-2])``, and every other
+unit follows by dimensional analysis: a quantity of dimension
+[length]^p [mass]^q [time]^r has the unit L^(p + r/2) M^q g^(-r/2), since the
+time unit is sqrt(L/g). So:
+
+=============  ==============  ==========
+kind           unit            CF units
+=============  ==============  ==========
+length         L               ``m``
+mass           M               ``kg``
+time           sqrt(L/g)       ``s``
+speed          sqrt(g L)       ``m s-1``
+acceleration   g               ``m s-2``
+force          M g             ``N``
+energy         M g L           ``J``
+curvature      1/L             ``m-1``
+dimensionless  1               ``1``
+=============  ==============  ==========
+
+The exponents are computed from each kind's SI unit with `pint
+<https://pint.readthedocs.io>`_ (the unit library), and pint checks that the
+product of the scales has that unit's dimension.
+
+:func:`to_si` converts a run Dataset (variables keep their names; ``units`` becomes
+the CF string), :func:`from_si` converts it back, :func:`summary_to_si` converts a
+run's summary dict (:func:`snapping.simulate.summary`).
+
+Example
+-------
+>>> s = Scales(length=1.022, mass=0.0208)        # the paper's chain, g = 9.81
+>>> round(s.time, 6), round(s.force, 6)          # sqrt(L/g) in s, M g in N
+(0.322768, 0.204048)
+>>> s.units("speed")
+'m s-1'
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+from . import _validate as V
+from . import schema
+
+__all__ = ["Scales", "KIND_UNITS", "VARIABLE_KINDS", "VALUE_KINDS", "G_STANDARD", "NONDIMENSIONAL_NOTE",
+           "kind_of", "to_si", "from_si", "summary_to_si", "values_to_si", "si_rows", "fit_rows", "fit_to_si"]
+
+#: the default gravity, m s-2 (what ``snapping estimate`` has always used)
+G_STANDARD = 9.81
+#: range of a length, mass or g in SI (as :data:`snapping.estimates.CHAIN_RANGE`): beyond, SI
+#: values of the library's numbers leave the doubles
+SCALE_RANGE = (1e-30, 1e30)
+
+#: The SI unit (CF string) of each kind of quantity.
+KIND_UNITS: dict[str, str] = {
+    "length": "m",
+    "mass": "kg",
+    "time": "s",
+    "speed": "m s-1",
+    "acceleration": "m s-2",
+    "force": "N",
+    "energy": "J",
+    "curvature": "m-1",
+    "dimensionless": "1",
+}
+
+#: What the nondimensional numbers mean, for output that prints no SI.
+NONDIMENSIONAL_NOTE = ("units: nondimensional (lengths in chain lengths L, masses in chain masses M, time in "
+                       "sqrt(L/g), speed sqrt(g L), acceleration g, force M g, energy M g L, curvature 1/L); "
+                       "for SI add --length METERS --mass KG (and --g M_PER_S2, default 9.81)")
+
+_L, _M, _T, _V, _A, _F, _E, _K, _1 = ("length", "mass", "time", "speed", "acceleration", "force", "energy",
+                                      "curvature", "dimensionless")
+
+#: The kind of every variable and coordinate of a run Dataset (:mod:`snapping.schema`; a test
+#: checks that none is missing), and of the ``chi``/``N`` coordinates of a combined sweep.
+VARIABLE_KINDS: dict[str, str] = {
+    # coordinates
+    "t": _T, "t_snapshot": _T, "s_node": _L, "s_link": _L, "chi": _1, "N": _1,
+    # per step
+    "dt": _T, "v_max": _V, "a_max": _A, "sigma_max": _F, "kappa_max": _K, "s_kappa_max": _L, "s_a_max": _L,
+    "s_v_max": _L, "v_end": _V, "a_end": _A, "pin_force_x": _F, "pin_force_y": _F, "energy": _E,
+    "link_error": _1, "error_estimate": _1,
+    # profiles
+    "x": _L, "y": _L, "vx": _V, "vy": _V, "ax": _A, "ay": _A, "speed": _V, "accel": _A, "curvature": _K,
+    "tension": _F,
+    # the held end of a general run
+    "pin_x": _L, "pin_y": _L, "pin_vx": _V, "pin_vy": _V, "pin_work": _E,
+    # the problem of a general run
+    "link_length": _L, "node_mass": _M, "start_x": _L, "start_y": _L, "start_vx": _V, "start_vy": _V,
+    "pin_table_t": _T, "pin_table_x": _L, "pin_table_y": _L,
+}
+
+#: The kind of every numeric input and result attribute of a run (the keys of its summary, and
+#: the variables of a combined sweep). ``wall_time`` is not here: it is already in seconds.
+VALUE_KINDS: dict[str, str] = {
+    # inputs
+    "chi": _1, "N": _1, "tol": _1, "dt0": _T, "t_end": _T, "stop_fraction": _1, "snapshot_times": _T,
+    "record_thin": _1, "t_end_max": _T, "max_link_error": _1, "max_energy_drift": _E, "dt_min": _T,
+    "max_rejections": _1, "tip_mass": _M, "gravity": _A,
+    # results
+    "failure_node": _1, "t_snap_v": _T, "t_snap_a": _T, "t_snap_sigma": _T, "snap_reached": _1,
+    "v_peak": _V, "a_peak": _A, "sigma_peak": _F, "kappa_peak": _K, "kappa_max_0": _K, "energy_drift": _E,
+    "link_drift": _1, "link_drift_initial": _1, "length_drift": _1, "link_error_initial": _1, "t_final": _T,
+    "energy_initial": _E, "dt_min_accepted": _T, "dt_max_accepted": _T, "n_steps": _1, "n_rejected": _1,
+    "n_rhs": _1,
+}
+
+#: Suffixes of a value that has the kind of the value it is appended to (an error bar, a limit).
+_SAME_KIND_SUFFIXES = ("_limit", "_error", "_err")
+
+#: Variables of an unfinished run's checkpoint: its resumable state, not a result; :func:`to_si` leaves them out.
+_CHECKPOINT_NAMES = frozenset(schema.CHECKPOINT_VARS) | frozenset(schema.CHECKPOINT_VARS_DOP853) | {
+    schema.CHECKPOINT_KIND_VAR}
+
+#: Global attributes :func:`to_si` adds (and :func:`from_si` takes away again).
+SI_ATTRS = {
+    "units_system": "'SI': the variables are in SI units (their 'units' attribute); the global attributes "
+                    "(inputs and results) stay nondimensional, see snapping.units.summary_to_si",
+    "si_length": "the length unit L (the chain's length) in m",
+    "si_mass": "the mass unit M (the chain's mass) in kg",
+    "si_g": "the acceleration unit g in m s-2",
+    "nondimensional_title": "the title of the nondimensional Dataset",
+}
+
+
+# --------------------------------------------------------------------------- pint
+_REGISTRY = None
+
+
+def _cf_to_pint(text: str) -> str:
+    """CF exponents (``m s-1``) in pint's notation (``m s**-1``)."""
+    return re.sub(r"(?<=[A-Za-z])(-?\d+)", r"**\1", text)
+
+
+def registry():
+    """The :class:`pint.UnitRegistry` of this module (built once, on first use), which also
+    reads CF unit strings such as ``"m s-2"``."""
+    global _REGISTRY
+    if _REGISTRY is None:
+        import pint
+
+        _REGISTRY = pint.UnitRegistry(preprocessors=[_cf_to_pint], cache_folder=None)
+    return _REGISTRY
+
+
+def _unit(cf: str):
+    ureg = registry()
+    return ureg.dimensionless if cf == "1" else ureg.parse_units(cf)
+
+
+def _exponents(kind: str) -> tuple[float, float, float]:
+    """Exponents (a, b, c) of the unit L^a M^b g^c of ``kind``, from the dimension
+    [length]^p [mass]^q [time]^r of its SI unit: g^c carries [time]^(-2c), so c = -r/2,
+    and [length]^(a + c) = [length]^p gives a = p + r/2; b = q."""
+    dim = _unit(KIND_UNITS[kind]).dimensionality
+    extra = set(dim) - {"[length]", "[mass]", "[time]"}
+    if extra:  # (not reached by KIND_UNITS)
+        raise V.SnappingInputError(f"kind={kind!r} has a dimension {sorted(extra)} that L, M and g do not make")
+    p, q, r = (float(dim.get(d, 0)) for d in ("[length]", "[mass]", "[time]"))
+    return p + r / 2.0, q, -r / 2.0
+
+
+def _check_kind(kind: str) -> str:
+    if kind not in KIND_UNITS:
+        raise V.SnappingInputError(f"kind={kind!r} is not one of {list(KIND_UNITS)}")
+    return kind
+
+
+# ------------------------------------------------------------------------- scales
+@dataclass(frozen=True)
+class Scales:
+    """The SI value of the library's unit of each kind of quantity, for a chain of
+    ``length`` [m] and ``mass`` [kg] under gravity ``g`` [m s-2].
+
+    Each must be a positive finite number in [1e-30, 1e30]; else
+    :class:`~snapping._validate.SnappingInputError` names it.
+
+    >>> s = Scales(1.022, 0.0208)
+    >>> round(s.factor("speed"), 4), s.units("speed")   # sqrt(g L)
+    (3.1664, 'm s-1')
+    >>> round(s.to_si(2.0, "energy"), 6)                 # 2 M g L in J
+    0.417074
+    >>> Scales(-1.0, 0.02)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: length=-1.0 is out of range: must be > 0
+    """
+
+    length: float
+    mass: float
+    g: float = G_STANDARD
+    _factors: dict = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        lo, hi = SCALE_RANGE
+        for name, unit in (("length", "m"), ("mass", "kg"), ("g", "m s-2")):
+            x = V.positive(name, getattr(self, name))
+            if not lo <= x <= hi:
+                raise V.SnappingInputError(f"{name}={x!r} {unit} is out of range: must lie in [{lo:g}, {hi:g}] "
+                                           f"(beyond, the SI values leave the doubles)")
+            object.__setattr__(self, name, x)
+        object.__setattr__(self, "_factors", {k: self._derive(k) for k in KIND_UNITS})
+
+    def _derive(self, kind: str) -> float:
+        """L^a M^b g^c (exponents from :func:`_exponents`), converted by pint to the kind's SI
+        unit: a wrong exponent would raise pint's DimensionalityError here."""
+        ureg = registry()
+        a, b, c = _exponents(kind)
+        q = ((self.length * ureg.meter) ** a * (self.mass * ureg.kilogram) ** b
+             * (self.g * ureg.meter / ureg.second ** 2) ** c)
+        return float(q.to(_unit(KIND_UNITS[kind])).magnitude)
+
+    def factor(self, kind: str) -> float:
+        """The SI value of one library unit of ``kind`` (a key of :data:`KIND_UNITS`)."""
+        return self._factors[_check_kind(kind)]
+
+    def units(self, kind: str) -> str:
+        """The CF units string of ``kind`` in SI."""
+        return KIND_UNITS[_check_kind(kind)]
+
+    def quantity(self, kind: str):
+        """The library's unit of ``kind`` as a :class:`pint.Quantity` in SI."""
+        return self.factor(kind) * _unit(self.units(kind))
+
+    def to_si(self, value, kind: str):
+        """Nondimensional ``value`` (a number or an array) of ``kind`` -> SI."""
+        return value * self.factor(kind)
+
+    def from_si(self, value, kind: str):
+        """SI ``value`` of ``kind`` -> nondimensional."""
+        return value / self.factor(kind)
+
+    @property
+    def time(self) -> float:
+        """sqrt(L/g) in s."""
+        return self.factor(_T)
+
+    @property
+    def speed(self) -> float:
+        """sqrt(g L) in m s-1."""
+        return self.factor(_V)
+
+    @property
+    def acceleration(self) -> float:
+        """g in m s-2."""
+        return self.factor(_A)
+
+    @property
+    def force(self) -> float:
+        """M g in N."""
+        return self.factor(_F)
+
+    @property
+    def energy(self) -> float:
+        """M g L in J."""
+        return self.factor(_E)
+
+    @property
+    def curvature(self) -> float:
+        """1/L in m-1."""
+        return self.factor(_K)
+
+    def to_dict(self) -> dict:
+        """``{kind: {"value": factor, "units": CF string}}`` for every dimensional kind."""
+        return {k: {"value": self.factor(k), "units": u} for k, u in KIND_UNITS.items() if k != _1}
+
+
+def _scales(scales=None, length=None, mass=None, g=G_STANDARD) -> Scales:
+    if isinstance(scales, Scales):
+        return scales
+    if scales is not None:
+        raise V.SnappingInputError(f"scales={scales!r} is not a snapping.units.Scales")
+    if length is None or mass is None:
+        raise V.SnappingInputError("give length (m) and mass (kg), or scales=Scales(...)")
+    return Scales(length, mass, g)
+
+
+def kind_of(name: str, kinds: dict | None = None) -> str | None:
+    """The kind of the value ``name`` (:data:`VALUE_KINDS`, then :data:`VARIABLE_KINDS`, or
+    ``kinds``), also with a suffix ``_limit``/``_error``/``_err``; None if unknown."""
+    table = {**VARIABLE_KINDS, **VALUE_KINDS, **(kinds or {})}
+    if name in table:
+        return table[name]
+    for suffix in _SAME_KIND_SUFFIXES:
+        if name.endswith(suffix) and name[: -len(suffix)] in table:
+            return table[name[: -len(suffix)]]
+    return None
+
+
+# ------------------------------------------------------------------------ Datasets
+def to_si(ds, length=None, mass=None, g: float = G_STANDARD, *, scales: Scales | None = None):
+    """A run Dataset (or a combined sweep) converted to SI, for a chain of ``length`` [m] and
+    ``mass`` [kg] under ``g`` [m s-2] (or ``scales``).
+
+    Every variable and coordinate keeps its name and dimensions; its values are
+    multiplied by the SI value of its unit (:class:`Scales`) and its ``units``
+    attribute becomes the CF string (``"m"``, ``"m s-1"``, ``"N"``, ...; ``"1"`` for
+    dimensionless ones). Variables that already carry SI units (``wall_time`` in s)
+    and those without a ``units`` attribute stay as they are; a checkpoint's state
+    (an unfinished run's ``checkpoint_*``) is left out, and so is the integrity digest
+    (it would no longer match). The global attributes (the run's inputs and
+    results) stay nondimensional; ``units_system``, ``si_length``, ``si_mass`` and
+    ``si_g`` are added. :func:`from_si` undoes it.
+
+    Raises SnappingInputError for a variable with ``units = "1"`` whose kind is unknown.
+
+    >>> from snapping.simulate import run
+    >>> ds = run(0.5, 4, t_end=0.01, progress=False).dataset
+    >>> si = to_si(ds, length=1.022, mass=0.0208)
+    >>> si["v_max"].attrs["units"], si["tension"].attrs["units"]
+    ('m s-1', 'N')
+    >>> bool(si["t"][-1] == ds["t"][-1] * Scales(1.022, 0.0208).time)
+    True
+    """
+    import xarray as xr
+
+    if not isinstance(ds, xr.Dataset):
+        raise V.SnappingInputError(f"ds={type(ds).__name__} is not an xarray.Dataset")
+    if ds.attrs.get("units_system") == "SI":
+        raise V.SnappingInputError("ds is already in SI (its attribute units_system is 'SI')")
+    s = _scales(scales, length, mass, g)
+    out = ds.drop_vars([n for n in ds.variables if n in _CHECKPOINT_NAMES])
+    unknown = [str(n) for n in out.variables if n not in VARIABLE_KINDS and kind_of(str(n)) is None
+               and out.variables[n].attrs.get("units") == "1" and out.variables[n].dtype.kind not in "OUS"]
+    if unknown:
+        raise V.SnappingInputError(f"ds has nondimensional variables of unknown kind {sorted(unknown)}: no SI unit "
+                                   f"for them (snapping.units.VARIABLE_KINDS lists the known ones)")
+    out = _convert(out, s, to_si=True)
+    attrs = {k: v for k, v in ds.attrs.items() if k != schema.DIGEST_ATTR and k not in SI_ATTRS}
+    attrs.update(units_system="SI", si_length=s.length, si_mass=s.mass, si_g=s.g,
+                 nondimensional_title=str(ds.attrs.get("title", "")))
+    attrs["title"] = (f"snapping: falling-chain run in SI (chain length {s.length:g} m, mass {s.mass:g} kg, "
+                      f"g = {s.g:g} m s-2)")
+    out.attrs = attrs
+    return out
+
+
+def from_si(ds):
+    """The nondimensional Dataset of a Dataset from :func:`to_si` (the scales are its
+    attributes ``si_length``, ``si_mass``, ``si_g``)."""
+    import xarray as xr
+
+    if not isinstance(ds, xr.Dataset) or ds.attrs.get("units_system") != "SI":
+        raise V.SnappingInputError("ds is not a Dataset from snapping.units.to_si (no attribute units_system='SI')")
+    try:
+        s = Scales(ds.attrs["si_length"], ds.attrs["si_mass"], ds.attrs["si_g"])
+    except KeyError as exc:
+        raise V.SnappingInputError(f"ds has no attribute {exc.args[0]!r}: its SI scales are unknown") from None
+    out = _convert(ds, s, to_si=False)
+    attrs = {k: v for k, v in ds.attrs.items() if k not in SI_ATTRS}
+    if ds.attrs.get("nondimensional_title"):
+        attrs["title"] = ds.attrs["nondimensional_title"]
+    out.attrs = attrs
+    return out
+
+
+def _convert(ds, s: Scales, *, to_si: bool):
+    import numpy as np
+    import xarray as xr
+
+    data, coords = {}, {}
+    for name, var in ds.variables.items():
+        kind = kind_of(str(name))
+        if kind is None:
+            continue
+        units = var.attrs.get("units")
+        if units != ("1" if to_si else KIND_UNITS[kind]):
+            continue  # already SI (wall_time in s), no units (an index), or not from to_si
+        f = s.factor(kind)
+        values = var.values
+        if f != 1.0 and values.dtype.kind in "fiuc":
+            values = np.asarray(values, dtype=float) * f if to_si else np.asarray(values, dtype=float) / f
+        new = xr.Variable(var.dims, values, {**var.attrs, "units": KIND_UNITS[kind] if to_si else "1"},
+                          encoding=dict(var.encoding))
+        (coords if name in ds.coords else data)[name] = new
+    return ds.assign(data).assign_coords(coords)
+
+
+# --------------------------------------------------------------------------- values
+def si_rows(values: dict, scales: Scales, kinds: dict | None = None) -> list[tuple[str, object, object, str]]:
+    """``(name, nondimensional value, SI value, CF units)`` of each dimensional number of
+    ``values`` whose kind is known (:func:`kind_of`, or ``kinds``); absent values (None)
+    stay None, lists are converted element by element."""
+    rows = []
+    for k, v in values.items():
+        kind = kind_of(str(k), kinds)
+        if kind is None or kind == _1 or isinstance(v, (bool, str, dict)):
+            continue
+        if v is None:
+            rows.append((k, None, None, KIND_UNITS[kind]))
+        elif isinstance(v, (list, tuple)):
+            rows.append((k, list(v), [None if x is None else scales.to_si(float(x), kind) for x in v],
+                         KIND_UNITS[kind]))
+        else:
+            try:
+                x = float(v)
+            except (TypeError, ValueError):
+                continue
+            rows.append((k, v, scales.to_si(x, kind), KIND_UNITS[kind]))
+    return rows
+
+
+def values_to_si(values: dict, scales: Scales, kinds: dict | None = None) -> dict:
+    """``{name: {"value": SI value, "units": CF string}}`` of the dimensional numbers of
+    ``values`` (see :func:`si_rows`)."""
+    return {k: {"value": si, "units": u} for k, _, si, u in si_rows(values, scales, kinds)}
+
+
+def summary_to_si(summary: dict, length=None, mass=None, g: float = G_STANDARD, *,
+                  scales: Scales | None = None) -> dict:
+    """The SI part of a run's summary (:func:`snapping.simulate.summary`):
+    ``{"scales": ..., "values": {name: {"value", "units"}}}`` with every dimensional input
+    and result (peaks, snapping times, drifts, time steps, tip mass, gravity, ...) in SI.
+    Dimensionless entries (chi, N, tol, counts) are not repeated.
+
+    >>> si = summary_to_si({"chi": 0.25, "v_peak": 10.0, "t_snap_v": None}, 1.022, 0.0208)
+    >>> si["values"]["v_peak"]["units"], round(si["values"]["v_peak"]["value"], 3)
+    ('m s-1', 31.664)
+    >>> si["values"]["t_snap_v"]["value"] is None    # absent stays absent
+    True
+    """
+    if not isinstance(summary, dict):
+        raise V.SnappingInputError(f"summary={type(summary).__name__} is not a dict (a run's summary)")
+    s = _scales(scales, length, mass, g)
+    return {"system": "SI", "scales": _scale_inputs(s), "values": values_to_si(summary, s)}
+
+
+def _scale_inputs(s: Scales) -> dict:
+    return {"length": {"value": s.length, "units": "m"}, "mass": {"value": s.mass, "units": "kg"},
+            "g": {"value": s.g, "units": "m s-2"}, **{k: v for k, v in s.to_dict().items()
+                                                       if k not in ("length", "mass", "acceleration")}}
+
+
+#: the quantity of each peak variable of a fit (its peak value's kind)
+_PEAK_KINDS = {"v_max": _V, "a_max": _A, "sigma_max": _F, "v": _V, "a": _A, "sigma": _F}
+
+
+def fit_rows(fit: dict, scales: Scales) -> list[tuple[str, object, object, str]]:
+    """:func:`si_rows` of a fit report (``RunFit.to_dict()`` of :func:`snapping.scaling.fit_run`),
+    flat: the snapping time ``t_star`` (and ``t_star_err``), each peak's time and value
+    (``t_peak_v_max``, ``peak_v_max``, ...), the scales ``delta_*`` (lengths), the run's and
+    the whirling-rod peaks (``computed_v``, ``predicted_delta_c_sigma``, ...) and
+    ``kappa_max_0``. The exponents are dimensionless; the prefactors A (whose units depend
+    on the exponent) stay nondimensional. Entries missing from ``fit`` are left out."""
+    flat, kinds = {}, {}
+
+    def put(name, value, kind):
+        if value is None or isinstance(value, (int, float)) and not isinstance(value, bool):
+            flat[name] = None if value is None or not math.isfinite(value) else value
+            kinds[name] = kind
+
+    snap = fit.get("snap") or {}
+    put("t_star", snap.get("t_star"), _T)
+    put("t_star_err", snap.get("t_star_err"), _T)
+    for var, p in (snap.get("peaks") or {}).items():
+        if isinstance(p, dict):
+            put(f"t_peak_{var}", p.get("t"), _T)
+            if var in _PEAK_KINDS:
+                put(f"peak_{var}", p.get("value"), _PEAK_KINDS[var])
+    delta = fit.get("delta") or {}
+    for k, d in (delta.get("deltas") or {}).items():
+        put(k, d, _L)
+    for q, v in (delta.get("computed") or {}).items():
+        if q in _PEAK_KINDS:
+            put(f"computed_{q}", v, _PEAK_KINDS[q])
+    for k, pred in (delta.get("predicted") or {}).items():
+        for q, v in (pred or {}).items():
+            if q in _PEAK_KINDS:
+                put(f"predicted_{k}_{q}", v, _PEAK_KINDS[q])
+    put("kappa_max_0", fit.get("kappa_max_0"), _K)
+    return si_rows(flat, scales, kinds)
+
+
+def fit_to_si(fit: dict, scales: Scales) -> dict:
+    """``{name: {"value": SI value, "units": CF string}}`` of the rows of :func:`fit_rows`."""
+    return {k: {"value": si, "units": u} for k, _, si, u in fit_rows(fit, scales)}
