@@ -33,6 +33,8 @@ OPTIONS = [
     ("converge -o", ["converge", "--chi", "0.25", "--levels", "2", "-o", "{P}"], "dir"),
     ("converge --plot", ["converge", "--chi", "0.25", "--levels", "2", "--plot", "{P}"], "output"),
     ("reproduce -o", ["reproduce", "--quick", "-o", "{P}"], "dir"),
+    ("animate RUN", ["animate", "{P}", "-o", "anim.gif"], "input"),
+    ("animate -o", ["animate", "{RUN}", "-o", "{P}"], "output"),
 ]
 
 
@@ -156,7 +158,7 @@ def _alarm(signum, frame):
 def test_path_option_hostile(option, kind, tmp_path, finished_run, capsys, monkeypatch):
     name, template, role = option
     monkeypatch.chdir(tmp_path)
-    suffix = ".png" if "--plot" in name else (".nc" if role != "dir" else "")
+    suffix = ".png" if "--plot" in name else ".gif" if name == "animate -o" else (".nc" if role != "dir" else "")
     P, cleanup = _make(kind, tmp_path, suffix)
     if P is None:
         pytest.skip(f"{kind}: this machine cannot mount a tmpfs")

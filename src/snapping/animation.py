@@ -136,6 +136,10 @@ def _writer(suffix: str, fps: float):
     return A.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p", "-f", "mp4"])
 
 
+#: free space an animation file needs (checked before any work; a 70-frame GIF is ~2 MB)
+ANIMATION_BYTES = 5e6
+
+
 def check_output(output, *, overwrite: bool = False) -> str:
     """The animation path to write, checked before any work: suffix .gif or .mp4 (ffmpeg on
     PATH for .mp4), an existing directory, no existing file unless ``overwrite``."""
@@ -148,7 +152,7 @@ def check_output(output, *, overwrite: bool = False) -> str:
     if suffix == ".mp4" and shutil.which("ffmpeg") is None:
         raise V.SnappingInputError(f"output={p!r}: writing MP4 needs ffmpeg on PATH, which is not found; "
                                    f"write a GIF instead (-o {Path(p).with_suffix('.gif').name})")
-    return _files.check_output(p, name="output", overwrite=overwrite)
+    return _files.check_output(p, name="output", overwrite=overwrite, need_bytes=ANIMATION_BYTES)
 
 
 def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
