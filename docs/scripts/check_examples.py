@@ -58,6 +58,8 @@ def main() -> int:
     work = Path(args.dir or tempfile.mkdtemp(prefix="snapping_docs_"))
     work.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, MPLBACKEND="Agg")
+    if env.get("PYTHONPATH"):  # relative entries (PYTHONPATH=src) must still name this tree in the scratch directory
+        env["PYTHONPATH"] = os.pathsep.join(os.path.abspath(p) for p in env["PYTHONPATH"].split(os.pathsep))
     env["PATH"] = os.path.dirname(sys.executable) + os.pathsep + env.get("PATH", "")
     failed = 0
     for page in args.pages:
@@ -74,7 +76,7 @@ def main() -> int:
             failed += not ok
             head = text.strip().splitlines()[0]
             print(f"{'ok  ' if ok else 'FAIL'}  {page}: {head}  ({time.perf_counter() - t0:.1f} s)")
-            if not ok or os.environ.get("SHOW"):
+            if not ok or os.environ.get("SHOW"):  # SHOW=1: every example's output
                 print("    " + (proc.stdout + proc.stderr).strip().replace("\n", "\n    "))
     print(f"{failed} failed; scratch directory {work}")
     return 1 if failed else 0
