@@ -75,3 +75,34 @@ numpydoc_xref_param_type = False
 html_theme = "furo"
 html_title = f"snapping {release}"
 html_static_path: list[str] = []
+
+
+# --- docstrings written as plain-text math -------------------------------------------
+# The docstrings write absolute values and norms as |x| (|E(t) - E(0)|, |d_k|), which
+# reST reads as substitution references (an error under -W). Outside literal blocks,
+# doctest lines and ``inline literals``, such a pair is escaped before parsing.
+import re  # noqa: E402
+
+_ABS = re.compile(r"(?<![\w`\\|])\|(?=[^\s|`])([^|`\n]*?[^\s|`\\])\|(?![\w`|])")
+
+
+def _escape_abs_bars(app, what, name, obj, options, lines):
+    literal_indent = None
+    for i, line in enumerate(lines):
+        stripped = line.lstrip()
+        indent = len(line) - len(stripped)
+        if literal_indent is not None:
+            if stripped and indent <= literal_indent:
+                literal_indent = None
+            else:
+                continue
+        table_row = stripped.startswith("|") and stripped.rstrip().endswith("|")
+        if stripped.startswith((">>>", "...", "| ", "+-", "+=")) or table_row:  # doctest, line block, table
+            continue
+        lines[i] = _ABS.sub(r"\\|\1\\|", line)
+        if line.rstrip().endswith("::"):
+            literal_indent = indent
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _escape_abs_bars, priority=600)  # after numpydoc (500)

@@ -118,9 +118,9 @@ def kappa_m0_shape(x, y) -> float:
     """Maximum discrete curvature of a chain shape (the kappa_m(0) of any start shape).
 
     At each interior node i (between link i-1, nodes i-1 -> i, and link i,
-    nodes i -> i+1) the curvature is the turning angle ``|angle(d_{i-1}, d_i)|`` in
+    nodes i -> i+1) the curvature is the turning angle |angle(d_{i-1}, d_i)| in
     [0, pi] divided by the mean (h_{i-1} + h_i)/2 of the two link lengths. For
-    equal links 1/N this is ``|N (theta_{k+1} - theta_k)|`` of the paper's discrete
+    equal links 1/N this is |N (theta_{k+1} - theta_k)| of the paper's discrete
     curvature; for the catenary sampled at arclength 1/N (N even, a node at
     the vertex) it converges to :func:`kappa_m0` = 1/a as N^-2.
 

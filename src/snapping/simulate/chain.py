@@ -71,7 +71,7 @@ class ChainState:
         return self.x.size - 1
 
     def link_lengths(self) -> np.ndarray:
-        """``|r_{k+1} - r_k|`` for the N links (index 0: link 1 at the free end)."""
+        """|r_{k+1} - r_k| for the N links (index 0: link 1 at the free end)."""
         return np.hypot(np.diff(self.x), np.diff(self.y))
 
     def copy(self) -> "ChainState":

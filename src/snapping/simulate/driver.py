@@ -210,7 +210,7 @@ def run(
     progress : bool or None
         tqdm progress bar on stderr (None: only on a terminal).
     max_energy_drift : float, optional
-        The run fails when ``|E(t) - E(0)|`` exceeds this (default: no bound).
+        The run fails when |E(t) - E(0)| exceeds this (default: no bound).
     dt_min : float
         The run fails when the adaptive time step falls below this floor.
     max_rejections : int
