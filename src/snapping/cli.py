@@ -891,6 +891,11 @@ def _cmd_animate(args) -> int:
 
 # ---------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
+    """The ``snapping`` command's parser, with one subparser per subcommand.
+
+    >>> build_parser().parse_args(["estimate", "--chi", "0.25"]).chi
+    0.25
+    """
     from . import __version__
 
     parser = _Parser(
@@ -949,6 +954,8 @@ def _as_typed(parser, command: str, msg: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``snapping`` command on ``argv`` (default: ``sys.argv[1:]``); returns the exit status
+    (0 done, 1 numerical failure or I/O fault, 2 bad input, 130 or 143 interrupted by SIGINT or SIGTERM)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):

@@ -436,7 +436,7 @@ class Window:
         The flatness tolerance the window was accepted with (the requested one, or
         larger when no window of ``min_width`` met it).
     flat : bool
-        True when ``flatness <= `` the requested tolerance.
+        True when ``flatness`` <= the requested tolerance.
     slope : float
         Mean local slope inside the window.
     """
