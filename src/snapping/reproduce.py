@@ -302,7 +302,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
 
     t0 = time.perf_counter()
     for g in plan.grids():
-        sweep.run_sweep(g, out / "runs", workers=workers, progress=progress)
+        sweep.run_sweep(g, out / "runs", workers=workers, progress=progress, log=None if progress else log)
     timings["runs"] = time.perf_counter() - t0
 
     rows: list[tuple[str, str, str, str]] = []  # claim, measured, paper, verdict

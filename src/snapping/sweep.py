@@ -24,6 +24,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import time
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -404,7 +405,7 @@ class SweepFailed(RuntimeError):
 
 
 def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True,
-              ensemble: int | None = None) -> list[Path]:
+              ensemble: int | None = None, log=None) -> list[Path]:
     """Run every point of ``grid`` not yet done in ``out_dir``; return all run paths.
 
     Parameters
@@ -421,6 +422,9 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
         Run on this Dask cluster instead of local processes.
     progress : bool
         Show a progress bar counting finished runs.
+    log : callable, optional
+        Called with one line per finished run (``"run 3/20 done: chi=0.25 N=400 (12 s)"``):
+        progress where there is no terminal for a bar (a log file, CI).
     ensemble : int, optional
         Run up to this many chi of one N together in one ensemble kernel
         (:func:`snapping.simulate.run_ensemble`; the grid's ``method`` must be
@@ -455,10 +459,11 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
 
     out = _check_out_dir(out_dir)
     with locked(out / "sweep.nc", name="out_dir"):  # one sweep at a time in a directory
-        return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, ensemble=ensemble)
+        return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, ensemble=ensemble,
+                          log=log)
 
 
-def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble) -> list[Path]:
+def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble, log) -> list[Path]:
     """:func:`run_sweep` once its directory is checked and locked."""
     from tqdm.auto import tqdm
 
@@ -472,6 +477,7 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble) -
     tasks = _groups(todo, size)
     bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
     failures: list[RunFailure] = []
+    done, t_start = [0], time.perf_counter()
 
     def collect(task, result) -> None:  # keep going: the other runs are independent
         try:
@@ -481,6 +487,11 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble) -
         for (params, _), outcome in zip(task, outcomes):
             if outcome is not None:
                 failures.append(RunFailure(chi=params["chi"], N=params["N"], options=dict(grid.options), **outcome))
+            done[0] += 1
+            if log is not None:
+                what = "done" if outcome is None else f"FAILED ({outcome['kind']})"
+                log(f"  run {done[0]}/{len(todo)} {what}: chi={params['chi']:g} N={params['N']} "
+                    f"({time.perf_counter() - t_start:.0f} s since the start)")
         bar.update(len(task))
 
     try:
