@@ -89,7 +89,9 @@ def _check_values(name: str, values, check) -> list:
 @dataclass
 class Grid:
     """A grid of runs: every combination of ``chi`` and ``N``, with the same ``options``
-    (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``).
+    (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``); what
+    ``options`` leaves out takes :func:`snapping.simulate.run`'s default (method ``fast``,
+    chords ``exact``, the method's tol).
     """
 
     chi: list
@@ -162,7 +164,9 @@ def _check_ensemble(grid: Grid, ensemble) -> int:
         return 0
     from .simulate.methods.dop853 import NAMES as HIGH_ORDER_METHODS
 
-    method = grid.options.get("method", "euler-richardson")
+    from .simulate.driver import DEFAULT_METHOD
+
+    method = grid.options.get("method", DEFAULT_METHOD)
     if method not in HIGH_ORDER_METHODS:
         raise V.SnappingInputError(f"ensemble={size} needs an angle-form method {HIGH_ORDER_METHODS} in the grid "
                                    f"options (method={method!r})")

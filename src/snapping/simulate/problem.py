@@ -336,7 +336,7 @@ class Problem:
 
     # -- constructors
     @classmethod
-    def catenary(cls, chi: float, N: int | None = None, *, chords: str = "arclength", links: Links | None = None,
+    def catenary(cls, chi: float, N: int | None = None, *, chords: str = "exact", links: Links | None = None,
                  pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
         """The paper's start: the level catenary of end separation ``chi``, at rest. With the
         paper's links (default: ``Links.uniform(N)``) the nodes are those of
@@ -580,7 +580,7 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
     return x - x[0], y - y[0]
 
 
-def from_options(*, chi=None, N=None, chords: str = "arclength", supports=None, shape=None, tip_mass: float = 0.0,
+def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shape=None, tip_mass: float = 0.0,
                  taper=None, lumping: str | None = None, pin_motion=None, gravity: float = 1.0) -> Problem | None:
     """The problem the command-line options describe (``snapping simulate``), or None when
     they describe the paper's problem (then ``run(chi, N)``).

@@ -14,7 +14,7 @@ Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
   the ``peak`` snapshot exactly at ``t_snap_v``;
 * the initial chain has links of length exactly 1/N in the directions of the chosen
   sampling of the catenary: with ``chords="exact"`` this is the Euler-Richardson
-  initial state itself; with ``chords="arclength"`` (the default) the chords of the
+  initial state itself (the default of :func:`snapping.simulate.run`); with ``chords="arclength"`` the chords of the
   sampled catenary, slightly shorter than 1/N, are lengthened to 1/N. Compare with
   Euler-Richardson runs at ``chords="exact"``.
 
@@ -46,10 +46,16 @@ from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0,
                               checkpoint_getter)
 from ..chain import ChainState, initial_state
 
-__all__ = ["Engine", "setup", "complete", "resolve_method", "NAMES", "CHECKPOINT_VARS"]
+__all__ = ["Engine", "setup", "complete", "resolve_method", "NAMES", "CHECKPOINT_VARS", "DEFAULT_TOL"]
 
 #: the names this method answers to; ``fast`` always names the project's best exact method
 NAMES = ("dop853", "fast")
+#: tolerance of a run that gives none (the default method's): the largest tol of 1e-6 ... 1e-11
+#: whose peak speed, acceleration and tension agree with tol 1e-11 to within 1e-7 (relative) at
+#: chi 0.1, 0.25, 0.5 and N 200, 1000 (worst: 3.0e-8, a_peak at chi 0.25, N 200; below
+#: tol 1e-7 the errors stay at ~5e-9, the peak location's floor; 1e-6 takes 1.7-2.2x fewer
+#: evaluations than 1e-8): benchmarks/bench_default_tol.py, docs/benchmarks/bench_default_tol.txt
+DEFAULT_TOL = 1e-6
 FAST = "dop853"
 
 
@@ -493,7 +499,7 @@ def complete(opts, method: str):
     return opts
 
 
-def setup(chi, N, method: str, opts, *, chords: str = "arclength", initial=None, problem=None):
+def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, problem=None):
     """The input attributes and the engine of an angle-form run (``opts``: a validated
     :class:`RunOptions`). ``problem``: a general :class:`snapping.simulate.problem.Problem`
     (then ``chi``, ``chords`` and ``initial`` are not used)."""
