@@ -14,8 +14,8 @@ a ``dask.distributed.Client``) to run the same sweep on an existing cluster.
 Example
 -------
 >>> from snapping.sweep import Grid
->>> grid = Grid(chi=[0.25, 0.5], N=[50], options={"tol": 1e-6})
->>> [p.name for p in grid.paths("out")]
+>>> grid = Grid(chi=[0.25, 0.5], N=[50])       # run()'s defaults: method fast, chords exact
+>>> [p.name for p in grid.paths("out")]         # (options, when given, add their hash to the names)
 ['run_chi0.25_N50.nc', 'run_chi0.5_N50.nc']
 """
 

@@ -522,10 +522,10 @@ class Problem:
         (:func:`snapping.shape_estimates.shape_estimate`): P, kappa_m(0), the delta scales and
         the whirling-rod peaks.
 
-        >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared")).estimate()
+        >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared"), chords="arclength").estimate()
         >>> round(shared["P"], 5), round(shared["kappa_m0"], 2)     # the closed forms: 0.254055, 26.11
         (0.25405, 26.11)
-        >>> round(Problem.catenary(0.25, 2000).estimate()["P"], 5)   # the paper's lumping: O(1/N) off
+        >>> round(Problem.catenary(0.25, 2000, chords="arclength").estimate()["P"], 5)  # the paper's lumping: O(1/N) off
         0.2543
         """
         from ..shape_estimates import shape_estimate
