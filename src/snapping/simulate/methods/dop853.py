@@ -299,10 +299,12 @@ class Engine(CheckpointMixin):
             bar.set_postfix_str(f"v_max={self.meas[K.M_VMAX]:.4g} dt={c[R.Q_H]:.3g} steps={int(c[R.Q_NSTEPS])}",
                                 refresh=False)
         t = self.t
-        if code == K.RET_T_RETURN:
-            while self.requested and self.requested[0] <= t:
+        if code < K.RET_FAIL_NAN:  # every requested time the last step passed (the step that ends the run,
+            while self.requested and self.requested[0] <= t:  # or meets a speed level, may pass one too)
                 tr = self.requested.pop(0)
                 self.snapshots.append((tr, "requested", self.Z_at(tr)[0]))
+        if code == K.RET_T_RETURN:
+            pass
         elif code == K.RET_V_UP:
             self.snapshots.append((t, "speed_level", self.Z.copy()))
             while c[R.Q_VUP] <= self.meas[K.M_VMAX]:
