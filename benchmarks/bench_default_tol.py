@@ -21,7 +21,7 @@ import os
 import sys
 
 from snapping.simulate import run
-from snapping.simulate.options import RunOptions
+from snapping.simulate.driver import default_tol
 
 sys.path.insert(0, os.path.dirname(__file__))
 from bench_simulate import print_machine  # noqa: E402
@@ -42,8 +42,8 @@ def main(argv=None) -> int:
     ref_tol = tols[-1]
     print_machine()
     print(f"\nmethod fast (dop853, link angles), chords exact, automatic stop after the snap;"
-          f"\nerrors relative to tol={ref_tol:g} (t_snap_v: absolute); the current default is "
-          f"tol={RunOptions().tol:g}")
+          f"\nerrors relative to tol={ref_tol:g} (t_snap_v: absolute); the default of fast is now "
+          f"tol={default_tol('fast'):g}")
     print(f"  {'chi':>5} {'N':>5} {'tol':>7} {'rhs evals':>10} {'wall s':>7} {'v_peak':>12} {'err v':>8} "
           f"{'err a':>8} {'err sigma':>9} {'err t_snap':>10} {'max err':>8} {'E drift':>8}")
     worst = {tol: 0.0 for tol in tols}

@@ -131,6 +131,7 @@ def test_fit_table_has_one_row_per_quantity_and_plain_verdicts(tmp_path, capsys)
     names = [l.split()[0] for l in table.splitlines()[3:] if l.strip()]
     assert names == ["v_max", "a_end", "a_max", "sigma_max", "kappa_max"]
     assert "differs; differs" not in out and "(late)" not in out and "(intermediate)" not in out
+    assert "method dop853, chords exact, tol 1e-06" in out and UNITS in out
     for line in table.splitlines()[3:]:
         if line.strip():
             assert "agrees with" in line or "differs from" in line or "inconclusive:" in line, line

@@ -493,9 +493,15 @@ def _cmd_fit(args) -> int:
             )
         except SnappingInputError as exc:
             raise SnappingInputError(f"{name}: {exc}") from None
+    def run_line(ds) -> str:
+        a = ds.attrs
+        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')}; "
+                f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
+
     if args.json:
         print_json(results[0].to_dict() if len(results) == 1 else {"runs": [r.to_dict() for r in results]})
     elif len(results) == 1:
+        print(f"{names[0]}: {run_line(runs[0])}\n")
         res = results[0]
         s = res.snap
         print_table(
@@ -513,6 +519,9 @@ def _cmd_fit(args) -> int:
                 print(f"  delta_kappa_m: {d.note}")
         print(f"\n  curvature amplification max kappa_max / kappa_max(0) = {res.kappa_amplification:.4g}")
     else:
+        for line in dict.fromkeys(run_line(r) for r in runs):  # (each distinct one once)
+            print(f"runs: {line}")
+        print()
         print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
     if args.plot is not None:
         out = Path(args.plot)
