@@ -148,7 +148,7 @@ def _py_cases():
     for k, vals in numeric.items():
         for v in vals:
             add(f"run({k}={v!r})", lambda F, k=k, v=v: simulate.run(0.3, 10, **{k: v}))
-    for k, v in (("method", "rk4"), ("method", None), ("method", 3), ("chords", "foo"), ("chords", None),
+    for k, v in (("method", "rk4"), ("method", None), ("method", 3), ("chords", "foo"), ("chords", 3),
                  ("snapshot_times", "0.1,0.2"), ("snapshot_times", [NAN]), ("snapshot_times", [-1.0]),
                  ("snapshot_times", ["a"]), ("snapshot_times", {"a": 1}), ("initial", "state"), ("initial", 3)):
         add(f"run({k}={v!r})", lambda F, k=k, v=v: simulate.run(0.3, 10, **{k: v}))

@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ... import _validate as V
 from .. import angles as AG
 from .. import general as G
 from .. import kernels as K
@@ -501,6 +502,22 @@ def complete(opts, method: str):
     return opts
 
 
+def _check_initial(state) -> None:
+    """A given start state must have links close to 1/N (they are mapped to exactly 1/N
+    in the same directions) and a finite energy: else SnappingInputError."""
+    N = state.N
+    l0 = state.link_lengths()
+    err = float(np.max(np.abs(N * l0 - 1.0)))
+    if not (np.all(l0 > 0.0) and err < 0.5):
+        raise V.SnappingInputError(f"initial state: link lengths must be close to 1/N={1.0 / N:.6g} (largest relative "
+                                   f"error {err:.3g}, at most 0.5 allowed)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        ke = 0.5 * float(np.sum(state.vx ** 2 + state.vy ** 2)) / N
+    if not np.isfinite(ke):
+        raise V.SnappingInputError("initial state: non-finite accelerations, tension or energy "
+                                   "(positions or velocities far too large)")
+
+
 def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, problem=None):
     """The input attributes and the engine of an angle-form run (``opts``: a validated
     :class:`RunOptions`). ``problem``: a general :class:`snapping.simulate.problem.Problem`
@@ -512,6 +529,8 @@ def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, pro
         t0 = 0.0
     else:
         state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+        if initial is not None:  # a given state: the checks of the Euler-Richardson engine
+            _check_initial(state0)
         y0 = AG.state_to_angles(state0)
         mdl = None
         t0 = state0.t
