@@ -75,7 +75,10 @@ def small_chunks(monkeypatch):
     stepper._chunk_hook = None
 
 
-CASE = dict(chi=0.3, N=50, snapshot_times=[0.2, 0.9], tol=1e-7)
+#: the paper's method and chain: this file checks the Euler-Richardson checkpoints (dop853's:
+#: test_checkpoint_dop853.py)
+PAPER = dict(method="euler-richardson", chords="arclength")
+CASE = dict(chi=0.3, N=50, snapshot_times=[0.2, 0.9], tol=1e-7, **PAPER)
 
 
 def test_resume_after_interrupt_is_bit_for_bit(tmp_path, small_chunks, monkeypatch):
@@ -135,12 +138,12 @@ def _wait_for(path, proc, timeout=60.0):
         time.sleep(0.02)
 
 
-SIG_CASE = ["--chi", "0.25", "--N", "400"]
+SIG_CASE = ["--chi", "0.25", "--N", "400", "--method", "euler-richardson", "--chords", "arclength"]
 
 
 @pytest.fixture(scope="module")
 def sig_reference():
-    return run(0.25, 400).dataset
+    return run(0.25, 400, **PAPER).dataset
 
 
 @pytest.mark.parametrize("sig, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
@@ -171,7 +174,7 @@ def test_cli_signal_stops_saves_and_resumes(tmp_path, sig, status, sig_reference
 
 # ---------------------------------------------------------------- sweeps
 def test_sweep_resumes_checkpointed_runs_and_restarts_broken_ones(tmp_path, small_chunks, monkeypatch):
-    opts = {"tol": 1e-7}
+    opts = {"tol": 1e-7, **PAPER}
     grid = S.Grid(chi=[0.4, 0.6], N=[30], options=opts)
     p_int, p_bad = grid.path(tmp_path, 0.4, 30), grid.path(tmp_path, 0.6, 30)
     # a worker interrupted half way through its run
@@ -194,7 +197,7 @@ def test_sweep_resumes_checkpointed_runs_and_restarts_broken_ones(tmp_path, smal
     # a checkpoint of a different run under a sweep's file name is restarted, not resumed
     monkeypatch.setattr(stepper, "_chunk_hook", _StopAt(2))
     with pytest.raises(RunInterrupted):
-        run(0.6, 30, output=p_bad, tol=1e-6, overwrite=True)
+        run(0.6, 30, output=p_bad, tol=1e-6, overwrite=True, **PAPER)
     monkeypatch.setattr(stepper, "_chunk_hook", None)
     assert not is_resumable(p_bad, chi=0.6, N=30, tol=1e-7)
     before = os.stat(p_int).st_mtime_ns
@@ -223,14 +226,14 @@ def _check_failure(info, path, kind, cls):
 def test_step_size_floor(tmp_path):
     path = tmp_path / "f.nc"
     with pytest.raises(StepSizeError, match="dt_min") as info:
-        run(0.5, 10, dt_min=1e-3, output=path)
+        run(0.5, 10, dt_min=1e-3, dt0=1e-2, output=path, **PAPER)  # (dt0 = sqrt(tol) would be below dt_min)
     _check_failure(info, path, "step_size", StepSizeError)
 
 
 def test_too_many_rejections(tmp_path):
     path = tmp_path / "f.nc"
     with pytest.raises(RejectionError, match="consecutive rejected") as info:
-        run(0.5, 10, dt0=0.5, max_rejections=0, output=path)
+        run(0.5, 10, dt0=0.5, max_rejections=0, output=path, **PAPER)
     exc, ds = _check_failure(info, path, "rejections", RejectionError)
     assert exc.step == 0 and ds.attrs["n_rejected"] == 1
 
@@ -238,7 +241,7 @@ def test_too_many_rejections(tmp_path):
 def test_energy_drift_bound(tmp_path):
     path = tmp_path / "f.nc"
     with pytest.raises(EnergyDriftError, match="energy drift") as info:
-        run(0.5, 10, max_energy_drift=1e-300, output=path)
+        run(0.5, 10, max_energy_drift=1e-300, output=path, **PAPER)
     exc, ds = _check_failure(info, path, "energy_drift", EnergyDriftError)
     assert isinstance(exc, DriftError) and ds.attrs["energy_drift"] > 1e-300
 
@@ -262,7 +265,7 @@ def test_non_finite_state(tmp_path, small_chunks, monkeypatch):
     monkeypatch.setattr(stepper, "_chunk_hook", inject)
     path = tmp_path / "f.nc"
     with pytest.raises(NonFiniteError, match="non-finite") as info:
-        run(0.5, 50, output=path)
+        run(0.5, 50, output=path, **PAPER)
     exc, _ = _check_failure(info, path, "non_finite", NonFiniteError)
     assert exc.node == 7
 
@@ -273,11 +276,11 @@ def test_memory_guard_refuses_with_numbers(monkeypatch):
 
     monkeypatch.setattr(options, "_available_memory", lambda: 10 * 2**20)
     with pytest.raises(SnappingInputError, match=r"GiB.*available.*record_thin") as info:
-        run(0.25, 100)
+        run(0.25, 100, **PAPER)
     msg = str(info.value)
     assert "0.00977 GiB is available" in msg and "steps" in msg
     # thinning the record makes it fit
-    r = run(0.25, 100, record_thin=1e-2, t_end=0.05)
+    r = run(0.25, 100, record_thin=1e-2, t_end=0.05, **PAPER)
     assert r.dataset.attrs["status"] == "completed"
 
 

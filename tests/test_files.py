@@ -292,8 +292,8 @@ def checkpoint(tmp_path, monkeypatch):
 
     monkeypatch.setattr(driver, "_chunk_hook", stop)
     with pytest.raises(RunInterrupted):
-        run(0.5, 30, method="fast", output=p)
-    monkeypatch.setattr(driver, "_chunk_hook", None)
+        run(0.5, 30, method="fast", tol=1e-8, chords="arclength", output=p)  # (not the defaults: the edits and
+    monkeypatch.setattr(driver, "_chunk_hook", None)                           # contradicting options change them)
     return p
 
 

@@ -131,8 +131,8 @@ def test_double_pendulum_against_lagrange_equations():
 @pytest.fixture(scope="module")
 def pair():
     """chi = 0.5, N = 60 to the snap with both methods, same initial chain (exact chords)."""
-    er = run(0.5, 60, chords="exact")
-    ho = run(0.5, 60, chords="exact", method="fast", snapshot_times=(0.3, 0.71))
+    er = run(0.5, 60, chords="exact", method="euler-richardson")  # the paper's scheme, tol 1e-8
+    ho = run(0.5, 60, chords="exact", method="fast", tol=1e-8, snapshot_times=(0.3, 0.71))
     return er, ho
 
 
@@ -174,7 +174,7 @@ def test_dense_output_peak_matches_a_direct_evaluation(pair):
     assert float(pk["t_snapshot"]) == a["t_snap_v"]
     assert float(pk["speed"].max()) == pytest.approx(a["v_peak"], rel=1e-12)
     # integrating straight to t_snap_v (the last step lands on it) gives the same speed
-    direct = run(0.5, 60, chords="exact", method="dop853", t_end=a["t_snap_v"])
+    direct = run(0.5, 60, chords="exact", method="dop853", tol=1e-8, t_end=a["t_snap_v"])
     assert float(direct.dataset["v_max"][-1]) == pytest.approx(a["v_peak"], rel=1e-8)
     # and it is a maximum: the samples never exceed it
     assert float(ho.dataset["v_max"].max()) <= a["v_peak"] * (1 + 1e-12)
@@ -205,13 +205,29 @@ def test_rerun_and_file_round_trip(tmp_path):
 
 
 def test_arclength_chords_keep_directions_with_exact_lengths():
-    r = run(0.5, 30, method="dop853", t_end=0.05)
+    r = run(0.5, 30, method="dop853", chords="arclength", t_end=0.05)
     a = r.dataset.attrs
     assert a["link_error_initial"] < 1e-15 and a["link_drift"] < 1e-15
     ref = initial_state(0.5, 30)  # the paper's sampling: directions kept
     sn = r.dataset.isel(snapshot=0)
     th = np.arctan2(np.diff(sn["y"].values), np.diff(sn["x"].values))
     np.testing.assert_allclose(th, np.arctan2(np.diff(ref.y), np.diff(ref.x)), atol=1e-13)
+
+
+def test_a_requested_time_inside_the_run_s_last_step_is_taken():
+    """At tol 1e-6 a short run of N = 6 to t = 0.2 takes 3 steps: the last passes both
+    requested times and t_end (its end code wins over the requested-time return); the
+    snapshots are still taken there, from the dense output, and agree with runs that
+    end at those times (tol 1e-10)."""
+    ds = run(0.5, 6, method="fast", tol=1e-6, t_end=0.2, snapshot_times=(0.1, 0.15)).dataset
+    assert ds.sizes["step"] <= 4  # the case: few, long steps
+    kinds = [str(k) for k in ds["snapshot_kind"].values]
+    req = [i for i, k in enumerate(kinds) if k == "requested"]
+    assert [float(ds["t_snapshot"][i]) for i in req] == [0.1, 0.15]
+    for i, te in zip(req, (0.1, 0.15)):
+        s = run(0.5, 6, method="fast", tol=1e-10, t_end=te).state
+        sn = ds.isel(snapshot=i)
+        assert np.abs(sn["x"].values - s.x).max() < 1e-5 and np.abs(sn["vy"].values - s.vy).max() < 1e-4
 
 
 def test_cli_lists_methods_and_runs_fast(capsys):
@@ -235,11 +251,11 @@ def test_ensemble_members_equal_single_runs_bit_for_bit():
     from snapping.simulate import run_ensemble
 
     chis = [0.3, 0.5, 0.5, 0.42]
-    dss = run_ensemble(chis, 40, chords="exact", snapshot_times=(0.5,))
+    dss = run_ensemble(chis, 40, chords="exact", tol=1e-8, snapshot_times=(0.5,))
     assert sum(ds.attrs["n_rejected"] for ds in dss) > 0
     assert len({ds.attrs["n_steps"] for ds in dss}) > 1
     for chi, ds in zip(chis, dss):
-        single = run(chi, 40, chords="exact", method="fast", snapshot_times=(0.5,)).dataset
+        single = run(chi, 40, chords="exact", method="fast", tol=1e-8, snapshot_times=(0.5,)).dataset
         a, b = ds.attrs, single.attrs
         assert a["status"] == "completed" and a["chi"] == chi and a["method"] == "dop853"
         assert {k for k in set(a) | set(b) if str(a.get(k)) != str(b.get(k))} <= {"wall_time", "integrity_sha256"}
@@ -260,11 +276,11 @@ def test_ensemble_member_failing_on_a_rejected_step_equals_its_single_run(monkey
 
     monkeypatch.setattr(E, "SINGLE_BELOW", 1)
     with pytest.warns(UserWarning, match="chi=0.1 failed"):
-        dss = run_ensemble([0.1, 0.2], 40, dt_min=3e-4)
+        dss = run_ensemble([0.1, 0.2], 40, tol=1e-8, dt_min=3e-4)  # (chi = 0.1 needs steps below 3e-4)
     assert dss[0]["t"].values[-1] < dss[1]["t"].values[-1]  # failed while both were in the lanes
     with pytest.raises(SimulationError) as info:
-        run(0.1, 40, method="fast", dt_min=3e-4)
-    singles = [info.value.dataset, run(0.2, 40, method="fast", dt_min=3e-4).dataset]
+        run(0.1, 40, method="fast", tol=1e-8, dt_min=3e-4)
+    singles = [info.value.dataset, run(0.2, 40, method="fast", tol=1e-8, dt_min=3e-4).dataset]
     for ds, single in zip(dss, singles):
         a, b = ds.attrs, single.attrs
         assert {k for k in set(a) | set(b) if str(a.get(k)) != str(b.get(k))} <= {"wall_time", "integrity_sha256"}

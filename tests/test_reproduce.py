@@ -42,6 +42,9 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     from snapping.reproduce import _path
 
     u = load_run(_path(tmp_path, TINY, 0.25, 40, 1e-8))  # the paper's chain at the plan's largest N, tol
+    # the reproduction runs the paper's method and chain, not the library's defaults, and says so
+    assert (u.attrs["method"], u.attrs["chords"]) == ("euler-richardson", "arclength")
+    assert "method euler-richardson (the paper's), chords arclength" in text
     assert f"{float(u.attrs['v_peak']) / v_lim - 1:+.2%}" in row
     assert any(l.startswith("| 0.25 (") and "| kappa_max |" in l for l in text.splitlines())  # refitted exponents
     # every claim row has four cells and a verdict

@@ -13,6 +13,7 @@ from scipy.integrate import quad
 
 from snapping import SnappingInputError, estimates, ideal, schema, scaling, simulate
 from snapping.cli import main
+from snapping.scaling import run as R
 
 T_STAR_IDEAL = 1.1981402347355922  # 2 E(pi/4 | 2)
 
@@ -248,12 +249,21 @@ def test_synthetic_run_report_recovers_every_exponent_and_delta_c():
     ds = make_run()
     res = scaling.fit_run(ds)
     assert res.snap.t_star == pytest.approx(1.15, abs=1e-9)
-    expected = {"v_max": -1 / 3, "a_end": -4 / 3, "a_max (late)": -4 / 3, "a_max (intermediate)": -5 / 6,
-                "sigma_max": -2 / 3, "kappa_max": -1 / 6}
+    expected = {"v_max": -1 / 3, "a_end": -4 / 3, "a_max": -4 / 3, "sigma_max": -2 / 3, "kappa_max": -1 / 6}
+    assert [r.spec.name for r in res.rows] == list(expected)  # one row per quantity: a_max once
     for name, beta in expected.items():
         r = res.row(name)
         assert abs(r.fit.beta - beta) <= 2 * r.fit.beta_err, (name, r.fit)
-        assert r.verdict.startswith("agrees")
+        assert r.verdict.startswith(f"agrees with {R.exponent_text(beta)}"), r.verdict
+    # a_max is one fit judged against both references: its late window is the free end's -4/3,
+    # and the verdict says in words that it is not the paper's intermediate -5/6
+    a = res.row("a_max")
+    assert a.word(-4 / 3) == "agrees" and a.word(-5 / 6) == "differs"
+    assert f"differs from -5/6 (paper, near the fold) (z = {a.z_alt:+.1f})" in a.verdict
+    # the intermediate regime -5/6 (a_max = 5 tau^(-5/6) until a_end overtakes it at
+    # tau = (0.2912/5)^2 = 3.4e-3): a window there gives -5/6
+    mid = scaling.fit_run(ds, windows={"a_max": (2e-2, 5e-1)}, joint=False).row("a_max")
+    assert abs(mid.fit.beta + 5 / 6) <= 2 * mid.fit.beta_err and mid.word(-5 / 6) == "agrees", mid.verdict
     assert res.row("v_max").fit.A == pytest.approx(0.8736, rel=1e-3)
     # the paper's linear approximations of front and curvature meet exactly at delta_c
     d = res.delta
@@ -390,13 +400,22 @@ def test_verdict_is_inconclusive_when_the_uncertainty_cannot_tell_the_candidates
 
     spec = next(s for s in scaling.report_specs() if s.name == "kappa_max")  # -1/6, alternative -2/3
     fit = lambda b, e: SimpleNamespace(beta=b, beta_err=e, flat=True)
-    assert R._verdict(fit(-0.17, 0.01), spec)[1].startswith("agrees")
-    assert R._verdict(fit(-0.60, 0.01), spec)[1].startswith("differs")
+    # plain words against both exponents; z = (beta - ref) / err: (-0.17 + 2/3) / 0.01 = +49.7
+    assert R._verdict(fit(-0.17, 0.01), spec)[1] == ("agrees with -1/6; differs from -2/3 (inferred kappa' ~ v "
+                                                      "kappa^2) (z = +49.7)")
+    # (-0.60 + 1/6) / 0.01 = -43.3; (-0.60 + 2/3) / 0.01 = +6.7
+    assert R._verdict(fit(-0.60, 0.01), spec)[1] == ("differs from -1/6 (z = -43.3); differs from -2/3 (inferred "
+                                                      "kappa' ~ v kappa^2) (z = +6.7)")
     # an uncertainty of 0.3 covers both -1/6 and -2/3: no verdict either way
-    z, v = R._verdict(fit(-0.4, 0.3), spec)
-    assert v.startswith("inconclusive") and abs(z) <= 2
-    # a window picked inside a slope range is flagged, since the range leans the fit
-    assert "window constrained to local slopes in [-1, -0.02]" in v
+    z, v, notes, _ = R._verdict(fit(-0.4, 0.3), spec)
+    assert v.startswith("inconclusive: uncertainty 0.3 > 0.12") and abs(z) <= 2
+    # a window picked inside a slope range is flagged (a note, not the verdict), since the range leans the fit
+    assert notes == "window constrained to local slopes in [-1, -0.02]"
+    # a row without an alternative: the exact folded string on the window is the second reference
+    vspec = next(s for s in scaling.report_specs() if s.name == "v_max")
+    # (-0.3448 + 1/3) / 0.0041 = -2.80; against -0.3370: -1.9
+    assert R._verdict(fit(-0.3448, 0.0041), vspec, -0.3370)[1] == (
+        "differs from -1/3 (z = -2.8); agrees with the exact folded string on this window (-0.337)")
 
 
 # ------------------------------------------------------------------------ figure helpers

@@ -99,7 +99,7 @@ def test_hanging_chain_stays_at_rest_with_linear_tension():
     ev = evaluate(hanging_state(N))
     np.testing.assert_allclose(ev["tension"], np.arange(1, N + 1) / N, rtol=0, atol=1e-13)
     assert np.abs(ev["ax"]).max() < 1e-12 and np.abs(ev["ay"]).max() < 1e-12
-    r = run(initial=hanging_state(N), t_end=2.0)
+    r = run(initial=hanging_state(N), t_end=2.0, method="euler-richardson")  # (the position form)
     s = r.state
     np.testing.assert_allclose(s.y, hanging_state(N).y, atol=1e-12)
     assert np.abs(s.x).max() < 1e-12 and np.abs(s.vy).max() < 1e-12
@@ -118,8 +118,8 @@ def test_initial_tension_and_chords():
     assert (x[0], y[0], x[-1], y[-1]) == (0.25, 0.0, 0.0, 0.0)
     ev = evaluate(s0)
     assert ev["tension"][0] > 0 and np.all(np.diff(ev["tension"]) > 0)  # rises from the free end to the pin
-    # equal arclength sampling shortens the chords by about kappa^2 / (24 N^2)
-    r = run(0.25, N, t_end=1e-3)
+    # equal arclength sampling (the paper's chain) shortens the chords by about kappa^2 / (24 N^2)
+    r = run(0.25, N, t_end=1e-3, method="euler-richardson", chords="arclength")
     kappa0 = r.dataset.attrs["kappa_max_0"]
     assert r.dataset.attrs["link_error_initial"] == pytest.approx(kappa0**2 / (24 * N**2), rel=0.05)
     # exactly: the largest chord deficit 1 - N |r(s_k) - r(s_k+1)| of the closed-form catenary
@@ -133,7 +133,7 @@ def test_initial_tension_and_chords():
 
 
 def test_energy_and_link_drift_within_paper_bounds():
-    r = run(0.5, 100, chords="exact")  # tol 1e-8, to shortly after the snap
+    r = run(0.5, 100, method="euler-richardson", chords="exact")  # the paper's scheme, tol 1e-8, to after the snap
     a = r.dataset.attrs
     assert a["status"] == "completed" and "snap" in a["stop_reason"]
     assert a["energy_drift"] < 8e-7
@@ -171,7 +171,7 @@ def test_snapping_time_approaches_ideal_as_chi_decreases():
 
 
 def test_snap_diagnostics_agree():
-    ds = run(0.25, 300).dataset
+    ds = run(0.25, 300, method="euler-richardson", chords="arclength").dataset  # (peaks at recorded steps)
     a = ds.attrs
     # snapping times from speed, acceleration, tension agree (paper: ~5 significant digits at N = 2000)
     assert abs(a["t_snap_a"] - a["t_snap_v"]) < 1e-3 * a["t_snap_v"]
@@ -190,8 +190,9 @@ def test_snap_diagnostics_agree():
 
 
 def test_thinned_record_keeps_snap_results():
-    full = run(0.5, 40).dataset
-    thin = run(0.5, 40, record_thin=1e-3).dataset
+    ER = dict(method="euler-richardson", chords="arclength")  # (many small steps to thin)
+    full = run(0.5, 40, **ER).dataset
+    thin = run(0.5, 40, record_thin=1e-3, **ER).dataset
     assert thin.sizes["step"] < full.sizes["step"] / 5
     for k in ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "energy_drift"):
         assert thin.attrs[k] == full.attrs[k]
@@ -412,7 +413,7 @@ def test_initial_energy_is_the_catenarys_potential_energy_arclength_chords():
     from snapping import estimates
 
     chi, N = 0.25, 200
-    ds = run(chi, N, t_end=1e-4).dataset
+    ds = run(chi, N, t_end=1e-4, method="euler-richardson", chords="arclength").dataset
     assert float(ds["t"][0]) == 0.0
     mp, a, xy = _mp_catenary(chi)
     E0 = mp.fsum(-xy(mp.mpf(N - i) / N)[1] / N for i in range(N)) + mp.mpf(N + 1) / (2 * N)
@@ -486,7 +487,7 @@ def test_a_run_ended_by_t_end_before_the_snap_has_no_snapping_time(method):
 
 def test_a_run_that_fails_before_the_snap_has_no_snapping_time():
     with pytest.raises(SimulationError) as info:
-        run(0.1, 40, method="fast", dt_min=3e-4)
+        run(0.1, 40, method="fast", tol=1e-8, dt_min=3e-4)  # (its steps near the snap fall below 3e-4)
     a = info.value.dataset.attrs
     assert a["status"] == "failed" and a["snap_reached"] == 0 and math.isnan(a["t_snap_v"])
     assert "failed at t=" in a["snap_note"]
@@ -524,7 +525,7 @@ def test_cli_snapshot_times_need_an_output_file(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "without -o RUN.nc" in err and err.count("\n") == 1
     assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "nan"]) == 2
-    assert "--snapshot-times=nan" in capsys.readouterr().err  # a bad time is named first
+    assert "--snapshot-times=nan" in capsys.readouterr().err  # a bad time is named first, as typed
     path = tmp_path / "r.nc"
     assert main(["simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.2", "--snapshot-times", "0.1",
                  "-o", str(path), "--no-progress"]) == 0

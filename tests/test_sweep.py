@@ -136,7 +136,7 @@ def test_sweep_in_ensembles_matches_single_runs(tmp_path):
 
 
 def test_ensemble_sweep_bad_options(tmp_path):
-    grid = S.Grid(chi=[0.3, 0.4], N=[10], options={"tol": 1e-6})
+    grid = S.Grid(chi=[0.3, 0.4], N=[10], options={"tol": 1e-6, "method": "euler-richardson"})
     with pytest.raises(SnappingInputError, match="ensemble=2 needs an angle-form method"):
         S.run_sweep(grid, tmp_path, ensemble=2, progress=False)
     grid = S.Grid(chi=[0.3, 0.4], N=[10], options={"method": "fast", "checkpoint_every": 10.0})
@@ -148,7 +148,7 @@ def test_ensemble_sweep_bad_options(tmp_path):
 
 def test_ensemble_sweep_with_a_failing_member_keeps_the_other(tmp_path):
     # chi = 0.1 needs steps below dt_min = 3e-4 at N = 40, chi = 0.5 does not
-    grid = S.Grid(chi=[0.1, 0.5], N=[40], options={"method": "fast", "dt_min": 3e-4})
+    grid = S.Grid(chi=[0.1, 0.5], N=[40], options={"method": "fast", "tol": 1e-8, "dt_min": 3e-4})
     with pytest.raises(RuntimeError, match=r"1 of 2 runs failed \(chi=0.1 N=40: step_size: time-step underflow") as info:
         S.run_sweep(grid, tmp_path, workers=1, ensemble=2, progress=False)
     _check_one_step_size_failure(info.value, grid, tmp_path)  # each member named, with its own failure
@@ -156,7 +156,7 @@ def test_ensemble_sweep_with_a_failing_member_keeps_the_other(tmp_path):
 
 
 # ---------------------------------------------------------------- failed runs, killed sweeps, combine
-FAILING = {"method": "fast", "dt_min": 3e-4}  # chi = 0.1 needs steps below 3e-4 at N = 40, chi = 0.5 does not
+FAILING = {"method": "fast", "tol": 1e-8, "dt_min": 3e-4}  # chi = 0.1 needs steps below 3e-4 at N = 40 (tol 1e-8), chi = 0.5 does not
 
 
 def _check_one_step_size_failure(exc, grid, out):
@@ -217,7 +217,8 @@ def test_cli_sweep_with_a_failed_run_prints_the_table_and_exits_1(tmp_path, caps
 
     real = S._run_one
     monkeypatch.setattr(S, "_run_one", lambda params, path: real({**params, "dt_min": 3e-4}, path))
-    argv = ["sweep", "--chi", "0.1,0.5", "--N", "40", "--method", "fast", "--workers", "1", "-o", str(tmp_path)]
+    argv = ["sweep", "--chi", "0.1,0.5", "--N", "40", "--method", "fast", "--tol", "1e-8", "--workers", "1", "-o",
+            str(tmp_path)]
     assert main(argv) == 1
     cap = capsys.readouterr()
     assert "Traceback" not in cap.err and "1 of 2 runs failed" in cap.err
@@ -339,10 +340,12 @@ def test_combine_refuses_what_is_not_a_run(tmp_path):
 
 
 def test_combine_refuses_runs_of_different_methods_or_tolerances(tmp_path):
-    a = S.run_sweep(S.Grid(chi=[0.5], N=[6], options={"tol": 1e-7}), tmp_path, workers=1, progress=False)
+    a = S.run_sweep(S.Grid(chi=[0.5], N=[6], options={"tol": 1e-7, "method": "euler-richardson"}), tmp_path, workers=1,
+                    progress=False)
     b = S.run_sweep(S.Grid(chi=[0.4], N=[6], options={"tol": 1e-7, "method": "fast"}), tmp_path, workers=1,
                     progress=False)
-    c = S.run_sweep(S.Grid(chi=[0.5], N=[8], options={"tol": 1e-6}), tmp_path, workers=1, progress=False)
+    c = S.run_sweep(S.Grid(chi=[0.5], N=[8], options={"tol": 1e-6, "method": "euler-richardson"}), tmp_path,
+                    workers=1, progress=False)
     with pytest.raises(SnappingInputError, match=r"different method.*'euler-richardson'.*'dop853'"):
         S.combine(a + b)
     with pytest.raises(SnappingInputError, match=r"different tol"):

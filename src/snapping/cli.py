@@ -223,7 +223,8 @@ def _add_estimate(sub) -> None:
     g.add_argument("--separation", type=float, help="end separation in metres (needs --length)")
     g.add_argument("--curvature", type=float, help="initial maximum curvature in 1/m (needs --length)")
     p.add_argument("--length", type=float, default=None, metavar="METERS",
-                   help="chain length in m (default: the paper's 1.022)")
+                   help="chain length in m (needed with --separation and --curvature; with --chi the default "
+                        "is the paper's 1.022)")
     p.add_argument("--mass", type=float, default=None, metavar="KG",
                    help="chain mass in kg (default: the paper's 0.0208)")
     _add_g_option(p)
@@ -234,7 +235,12 @@ def _add_estimate(sub) -> None:
 
 def _cmd_estimate(args) -> int:
     from . import estimates
+    from ._validate import SnappingInputError
 
+    for opt, v, unit in (("--separation", args.separation, "m"), ("--curvature", args.curvature, "1/m")):
+        if v is not None and args.length is None:
+            raise SnappingInputError(f"{opt} {v:g} {unit} needs --length (the chain's length in m): chi follows "
+                                     f"from both; give --length, or --chi for a fraction of the length")
     chain = estimates.Chain(
         **{k: v for k, v in (("length", args.length), ("mass", args.mass), ("g", args.g)) if v is not None}
     )
@@ -263,9 +269,12 @@ def _add_simulate(sub) -> None:
         help="simulate the falling chain from the catenary to the snap (netCDF4 run file)",
         formatter_class=_formatter,
         description=(
-            "Simulate the N-link chain released from the catenary of end separation --chi with the\n"
-            "paper's Euler-Richardson scheme, to shortly after the snap (or to --t-end), and print\n"
-            "peaks, snapping times, invariant drifts and cost. -o writes the run as netCDF4."
+            "Simulate the N-link chain released from the catenary of end separation --chi, to shortly\n"
+            "after the snap (or to --t-end), and print peaks, snapping times, invariant drifts and cost.\n"
+            "Default: the fast exact method (--method fast, links exact to round-off) from the catenary\n"
+            "with exact chords 1/N (--chords exact); the paper's computation is --method\n"
+            "euler-richardson --chords arclength (what snapping reproduce runs). Units: nondimensional\n"
+            "(length L, mass M, time sqrt(L/g), force M g). -o writes the run as netCDF4."
         ),
         epilog=(
             "methods (--method):\n"
@@ -273,12 +282,12 @@ def _add_simulate(sub) -> None:
             "  euler-richardson-fixed  the same step at the fixed dt = --dt0 (order studies)\n"
             "  dop853                  link-angle form (links exact to round-off), compiled 8th-order\n"
             "                          Dormand-Prince with dense output: 20-40x fewer evaluations\n"
-            "  fast                    always the project's best exact method (now dop853)\n"
+            "  fast                    always the project's best exact method (now dop853; the default)\n"
             "\n"
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
-            "  snapping simulate --chi 0.1 --N 5000 --method fast --chords exact\n"
-            "  snapping simulate --chi 0.25 --N 2000 --tol 1e-8 --json\n"
+            "  snapping simulate --chi 0.1 --N 5000 --tol 1e-8\n"
+            "  snapping simulate --chi 0.25 --N 2000 --method euler-richardson --chords arclength --json  # the paper's\n"
             "  snapping simulate --chi 0.5 --N 100 --t-end 0.5 --snapshot-times 0.1,0.2 -o run.nc\n"
             "  snapping simulate --resume run.nc      # continue an interrupted or checkpointed run\n"
             "  snapping simulate --chi 0.25 --N 229 --length 1.022 --mass 0.0208   # results in SI too\n"
@@ -308,10 +317,11 @@ def _add_simulate(sub) -> None:
     )
     p.add_argument("--chi", type=float, default=None, help="end separation / length, in (0, 1)")
     p.add_argument("--N", type=int, default=None, help="number of links (>= 1)")
-    p.add_argument("--tol", type=float, default=1e-8, help="stepper tolerance (default 1e-8, the paper's)")
-    p.add_argument("--method", default="euler-richardson",
-                   choices=["euler-richardson", "euler-richardson-fixed", "dop853", "fast"],
-                   help="time stepper (default: euler-richardson; every method is listed below)")
+    p.add_argument("--tol", type=float, default=None,
+                   help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson the paper's 1e-8)")
+    p.add_argument("--method", default="fast",
+                   choices=["fast", "dop853", "euler-richardson", "euler-richardson-fixed"],
+                   help="time stepper (default: fast; every method is listed below)")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")
     p.add_argument("--stop-fraction", type=float, default=0.5,
@@ -319,8 +329,8 @@ def _add_simulate(sub) -> None:
     p.add_argument("--snapshot-times", default="", help="comma-separated extra snapshot times")
     p.add_argument("--record-thin", type=float, default=0.0,
                    help="record a step only if a maximum changed by more than this fraction (default 0: all)")
-    p.add_argument("--chords", default="arclength", choices=["arclength", "exact"],
-                   help="initial nodes at equal arclength (the paper's) or with exact chords 1/N")
+    p.add_argument("--chords", default="exact", choices=["exact", "arclength"],
+                   help="initial nodes with exact chords 1/N (default) or at equal arclength (the paper's)")
     p.add_argument("--tip-mass", type=float, default=0.0, metavar="RATIO",
                    help="point mass at the free end, as a ratio to the chain's mass (default 0)")
     p.add_argument("--taper", default=None, metavar="RATIO[:POWER]",
@@ -401,7 +411,7 @@ def _cmd_simulate(args) -> int:
             result = simulate.run(
                 problem if problem is not None else args.chi, None if problem is not None else args.N, tol=args.tol, method=args.method, dt0=args.dt0, t_end=args.t_end,
                 stop_fraction=args.stop_fraction, snapshot_times=times, record_thin=args.record_thin,
-                chords=args.chords if problem is None else "arclength", output=args.output, progress=progress, max_link_error=args.max_link_error,
+                chords=args.chords if problem is None else None, output=args.output, progress=progress, max_link_error=args.max_link_error,
                 max_energy_drift=args.max_energy_drift, dt_min=args.dt_min, max_rejections=args.max_rejections,
                 checkpoint_every=args.checkpoint_every, overwrite=args.overwrite,
             )
@@ -486,19 +496,33 @@ def _add_fit(sub) -> None:
         description=(
             "Scaling analysis of run files: t*_chi from the peaks of v_max, a_max, sigma_max;\n"
             "exponents of y ~ A (t* - t)^beta (with t* = t*_chi and with t* fitted) against the\n"
-            "folded-string -1/3, -4/3, -2/3 and the paper's -5/6, -1/6, each with its uncertainty\n"
-            "(least squares, window choice, t* choice, slope drift), window and verdict; the scale\n"
-            "delta_kappa_m and the whirling-rod predictions of delta_kappa0, delta_kappa_m, delta_c.\n"
+            "folded-string -1/3, -4/3, -2/3 and the paper's -5/6, -1/6 (a_max: one fit, judged\n"
+            "against -4/3 and -5/6), each with its uncertainty, window and a verdict in plain words\n"
+            "(\"agrees with -1/3\", \"differs from -1/3 (z = -3.0)\", \"inconclusive: ...\"; z is\n"
+            "(beta - ref) / uncertainty, agreement means |z| <= 2), also against the exact folded\n"
+            "string on the same window; the scale delta_kappa_m and the whirling-rod predictions of\n"
+            "delta_kappa0, delta_kappa_m, delta_c. Units: nondimensional (time sqrt(L/g)).\n"
             "Several files (or a sweep file) print one row per run; --plot then shows the collapse.\n"
             "--plot out.png also writes out_slopes.png (local slopes) and out_delta.png (Fig. 4)."
         ),
         epilog=(
             "examples:\n"
+            "  snapping simulate --chi 0.25 --N 1000 -o run.nc     # a run to fit (~1 s)\n"
             "  snapping fit run.nc\n"
             "  snapping fit run.nc --json\n"
             "  snapping fit run.nc --length 1.022 --mass 0.0208   # snapping time, peaks, scales in SI too\n"
-            "  snapping fit run.nc --plot fig3.png --window v_max=1e-4,1e-2\n"
-            "  snapping fit run_chi0.1.nc run_chi0.25.nc run_chi0.5.nc --plot collapse.pdf"
+            "  snapping fit run.nc --window v_max=1e-3,3e-2 --plot fig3.png   # v_max: agrees with -1/3\n"
+            "  snapping fit run_chi0.1.nc run_chi0.25.nc run_chi0.5.nc --plot collapse.pdf\n"
+            "\n"
+            "the uncertainty of an exponent (in quadrature, four parts):\n"
+            "  least squares  the standard error of the slope on log-log axes in the window\n"
+            "  window choice  how far the slope moves when either window end moves by a quarter of\n"
+            "                 a decade (x 10^(+-1/4))\n"
+            "  t* choice      how far it moves when t* moves by its own uncertainty (t* = t*_chi), or\n"
+            "                 its profile interval (t* fitted)\n"
+            "  slope drift    half the change of the local slope across the window: the data are\n"
+            "                 not a pure power law by that much\n"
+            "--json gives each part (beta_err_stat, beta_err_window, beta_err_t_star, beta_err_drift)."
         ),
     )
     p.add_argument("files", nargs="+", metavar="RUN.nc", help="run files or a sweep file")
@@ -555,6 +579,11 @@ def _cmd_fit(args) -> int:
             )
         except SnappingInputError as exc:
             raise SnappingInputError(f"{name}: {exc}") from None
+    def run_line(ds) -> str:
+        a = ds.attrs
+        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')}; "
+                f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
+
     if args.json:
         if len(results) == 1:
             d = results[0].to_dict()
@@ -563,6 +592,7 @@ def _cmd_fit(args) -> int:
             ds_ = [r.to_dict() for r in results]
             print_json(_with_si({"runs": ds_}, scales, lambda: {"runs": [units.fit_to_si(d, scales) for d in ds_]}))
     elif len(results) == 1:
+        print(f"{names[0]}: {run_line(runs[0])}\n")
         res = results[0]
         s = res.snap
         print_table(
@@ -581,6 +611,9 @@ def _cmd_fit(args) -> int:
         print(f"\n  curvature amplification max kappa_max / kappa_max(0) = {res.kappa_amplification:.4g}")
         _print_si(scales, units.fit_rows(res.to_dict(), scales) if scales else [])
     else:
+        for line in dict.fromkeys(run_line(r) for r in runs):  # (each distinct one once)
+            print(f"runs: {line}")
+        print()
         print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
         if scales is None:
             _print_si(None, [])
@@ -637,20 +670,28 @@ def _add_sweep(sub) -> None:
         description=(
             "Run every (chi, N) of the grid, each saved atomically to DIR as it finishes;\n"
             "a rerun skips finished runs. Runs go to local processes, or to a Dask cluster\n"
-            "with --scheduler. Finally the runs are combined into DIR/sweep.nc."
+            "with --scheduler. Finally the runs are combined into DIR/sweep.nc.\n"
+            "Default: the fast exact method (--method fast) from the catenary with exact chords\n"
+            "(--chords exact); the paper's is --method euler-richardson --chords arclength.\n"
+            "Units: nondimensional (length L, mass M, time sqrt(L/g), force M g)."
         ),
         epilog=(
             "examples:\n"
-            "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_out\n"
-            "  snapping sweep --chi 0.25,0.5 --N 50 -o sweep_out --length 1.022 --mass 0.0208   # SI too\n"
-            "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --method fast --ensemble 4 -o sweep_out\n"
-            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_out"
+            "  snapping sweep --chi 0.25,0.5 --N 50,100 --tol 1e-7 -o sweep_small\n"
+            "  snapping sweep --chi 0.25,0.5 --N 50 -o sweep_si --length 1.022 --mass 0.0208   # SI too\n"
+            "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --ensemble 4 -o sweep_ensemble\n"
+            "  snapping sweep --chi 0.25,0.5 --N 200 --method euler-richardson --chords arclength -o sweep_paper\n"
+            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_cluster"
         ),
     )
     p.add_argument("--chi", type=_floats, required=True, help="comma-separated end separations in (0, 1)")
     p.add_argument("--N", type=_ints, required=True, help="comma-separated numbers of links")
-    p.add_argument("--tol", type=float, default=None, help="stepper tolerance (default: the simulator's, 1e-8)")
-    p.add_argument("--method", default=None, help="time-stepping method (default: euler-richardson)")
+    p.add_argument("--tol", type=float, default=None,
+                   help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson 1e-8)")
+    p.add_argument("--method", default=None,
+                   help="time-stepping method: fast (default), dop853, euler-richardson, euler-richardson-fixed")
+    p.add_argument("--chords", default=None, choices=["exact", "arclength"],
+                   help="initial nodes with exact chords 1/N (default) or at equal arclength (the paper's)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     p.add_argument("--ensemble", type=int, default=None, metavar="K",
@@ -669,7 +710,8 @@ def _cmd_sweep(args) -> int:
     from . import sweep, units
 
     scales = _si_scales(args)
-    options = {k: v for k, v in (("tol", args.tol), ("method", args.method)) if v is not None}
+    options = {k: v for k, v in (("tol", args.tol), ("method", args.method), ("chords", args.chords))
+               if v is not None}
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
     failed = None
@@ -714,6 +756,9 @@ def _cmd_sweep(args) -> int:
         n_done = len(paths)
         if out is not None:
             print(f"{n_done} runs in {args.output}; combined: {out}")
+            ca = combined.attrs
+            print(f"  method {ca.get('method', '?')}, chords {ca.get('chords', '?')}, tol {ca.get('tol', '?')}; "
+                  f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
             print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
             for r in rows:
                 t_snap = "no snap" if r["t_snap_v"] is None else f"{r['t_snap_v']:.6g}"

@@ -337,7 +337,8 @@ class DesignEstimate:
 
     ``nondim`` holds the geometry (chi, a, kappa_m0, P, t_star); ``scales`` the
     lengths delta; ``predictions[scale]`` the whirling-rod peaks {v, a, sigma};
-    ``si`` the same in SI units for ``chain``.
+    ``si`` the same in SI units for ``chain``; ``warnings`` what makes a prediction
+    doubtful (a scale delta longer than the chain).
     """
 
     chain: Chain
@@ -345,6 +346,7 @@ class DesignEstimate:
     scales: dict[str, float]
     predictions: dict[str, dict[str, float]]
     si: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """One JSON-serialisable dict whose keys name the quantities (with units in SI keys)."""
@@ -354,6 +356,7 @@ class DesignEstimate:
             "scales": dict(self.scales),
             "predictions": {k: dict(v) for k, v in self.predictions.items()},
             "si": self.si,
+            "warnings": list(self.warnings),
         }
 
 
@@ -413,6 +416,9 @@ def design_estimate(
     if N is not None:
         scales["delta_N"] = delta_N(N)
     predictions = {name: whirling_rod(P, d) for name, d in scales.items()}
+    warnings = [f"{name} = {d:.3g} is longer than the chain (length 1): the whirling-rod estimate needs a "
+                f"regularising length much shorter than the chain, so its predicted peaks are not meaningful"
+                for name, d in scales.items() if d > 1.0]
     si = {
         "separation_m": chain.distance(chi),
         "kappa_m0_per_m": 1.0 / chain.distance(a),
@@ -428,7 +434,8 @@ def design_estimate(
             for name, p in predictions.items()
         },
     }
-    return DesignEstimate(chain=chain, nondim=nondim, scales=scales, predictions=predictions, si=si)
+    return DesignEstimate(chain=chain, nondim=nondim, scales=scales, predictions=predictions, si=si,
+                          warnings=warnings)
 
 
 def print_estimate(est: DesignEstimate, file=None) -> None:
@@ -465,6 +472,8 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
             f"  {name:<14} {p['v']:>10.4g} {p['a']:>12.4g} {p['sigma']:>10.4g} | "
             f"{q['v_m_per_s']:>10.4g} {q['a_m_per_s2']:>12.4g} {q['sigma_N']:>10.4g}"
         )
+    for w in est.warnings:
+        line(f"  warning: {w}")
     line()
     line("Against simulations (paper Fig. 4; snapping reproduce): delta_kappa0 underestimates the peak")
     line("acceleration by one to two orders of magnitude; delta_c, from the initial geometry alone, is")

@@ -14,8 +14,8 @@ a ``dask.distributed.Client``) to run the same sweep on an existing cluster.
 Example
 -------
 >>> from snapping.sweep import Grid
->>> grid = Grid(chi=[0.25, 0.5], N=[50], options={"tol": 1e-6})
->>> [p.name for p in grid.paths("out")]
+>>> grid = Grid(chi=[0.25, 0.5], N=[50])       # run()'s defaults: method fast, chords exact
+>>> [p.name for p in grid.paths("out")]         # (options, when given, add their hash to the names)
 ['run_chi0.25_N50.nc', 'run_chi0.5_N50.nc']
 """
 
@@ -91,7 +91,9 @@ def _check_values(name: str, values, check) -> list:
 @dataclass
 class Grid:
     """A grid of runs: every combination of ``chi`` and ``N``, with the same ``options``
-    (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``).
+    (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``); what
+    ``options`` leaves out takes :func:`snapping.simulate.run`'s default (method ``fast``,
+    chords ``exact``, the method's tol).
     """
 
     chi: list
@@ -164,7 +166,9 @@ def _check_ensemble(grid: Grid, ensemble) -> int:
         return 0
     from .simulate.methods.dop853 import NAMES as HIGH_ORDER_METHODS
 
-    method = grid.options.get("method", "euler-richardson")
+    from .simulate.driver import DEFAULT_METHOD
+
+    method = grid.options.get("method", DEFAULT_METHOD)
     if method not in HIGH_ORDER_METHODS:
         raise V.SnappingInputError(f"ensemble={size} needs an angle-form method {HIGH_ORDER_METHODS} in the grid "
                                    f"options (method={method!r})")

@@ -340,7 +340,7 @@ def plot_maxima(runs, results, path, *, show_fits: bool = True) -> Path:
     # guides for the observed laws, anchored on the first run's fit where there is one
     r0 = results[0] if results else None
     for ax, name, expo, txt in (
-        (ax_a, "a_max (intermediate)", -5.0 / 6.0, r"$\tau^{-5/6}$ (paper, intermediate)"),
+        (ax_a, "a_max", -5.0 / 6.0, r"$\tau^{-5/6}$ (paper, intermediate)"),
         (ax_k, "kappa_max", -1.0 / 6.0, r"$\tau^{-1/6}$ (paper, anomalous)"),
     ):
         A = None

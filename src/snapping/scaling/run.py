@@ -114,8 +114,9 @@ def report_specs() -> list[RowSpec]:
     ====================  ==========  =============================================
     v_max                 -1/3        free-end speed 2 s0' of the folded string
     a_end                 -4/3        free-end acceleration 2 s0''
-    a_max (late)          -4/3        the maximum moves to the free end late
-    a_max (intermediate)  -5/6        paper's observation, maximum near the fold
+    a_max                 -4/3, -5/6  one fit, judged against both: -4/3 once the
+                                      maximum is at the free end (late), -5/6 the
+                                      paper's observation (maximum near the fold)
     sigma_max             -2/3        tether tension s0 + s0'^2
     kappa_max             -1/6        paper's anomalous late-time observation
                                       (-2/3 inferred from kappa' ~ v kappa^2)
@@ -129,13 +130,9 @@ def report_specs() -> list[RowSpec]:
         RowSpec("v_max", "v_max", r["v"][0], "folded string 2 s0'", r["v"][1], ideal="free_end_speed"),
         RowSpec("a_end", "a_end", r["a_end"][0], "folded string 2 s0''", r["a_end"][1], ideal="free_end_acceleration"),
         RowSpec(
-            "a_max (late)", "a_max", r["a_end"][0], "free end, late", r["a_end"][1],
-            alt=r["a_intermediate"][0], alt_label="paper, intermediate", fit_kw={"prefer": "latest"},
+            "a_max", "a_max", r["a_end"][0], "free end, late", r["a_end"][1],
+            alt=r["a_intermediate"][0], alt_label="paper, near the fold", fit_kw={"prefer": "latest"},
             ideal="free_end_acceleration",
-        ),
-        RowSpec(
-            "a_max (intermediate)", "a_max", r["a_intermediate"][0], "paper, near the fold", None,
-            alt=r["a_end"][0], alt_label="free end", fit_kw={"prefer": "earliest", "slope_range": (-1.1, -0.55)},
         ),
         RowSpec("sigma_max", "sigma_max", r["sigma"][0], "tether tension s0 + s0'^2", r["sigma"][1],
                 ideal="tether_tension"),
@@ -486,6 +483,9 @@ class ExponentRow:
     z : float
         (beta - ref) / beta_err of ``fit``.
     verdict : str
+        In plain words, against each reference: "agrees with -1/3", "differs from
+        -1/3 (z = -3.0)", "inconclusive: ..." (first clause: ``spec.ref``; then
+        ``spec.alt``; then the exact folded string on the fit's window).
     error : str
         Why a fit failed.
     ideal_window_beta : float
@@ -500,6 +500,15 @@ class ExponentRow:
     verdict: str
     error: str = ""
     ideal_window_beta: float = math.nan
+    z_alt: float = math.nan
+    notes: str = ""
+
+    def word(self, ref: float) -> str:
+        """``agrees``, ``differs`` or ``inconclusive`` against ``ref`` (the row's reference
+        or its alternative), or ``no fit``."""
+        if self.fit is None:
+            return "no fit"
+        return _judge(self.fit, ref, self.spec)[1]
 
     def to_dict(self) -> dict:
         return {
@@ -512,7 +521,9 @@ class ExponentRow:
             "fit": None if self.fit is None else self.fit.to_dict(),
             "fit_joint": None if self.fit_joint is None else self.fit_joint.to_dict(),
             "z": self.z,
+            "z_alt": self.z_alt,
             "verdict": self.verdict,
+            "notes": self.notes,
             "error": self.error,
             "ideal_window_beta": self.ideal_window_beta,
         }
@@ -618,25 +629,52 @@ def _judge(fit: PowerLawFit, ref: float, spec: RowSpec) -> tuple[float, str]:
     return z, "agrees" if abs(z) <= 2.0 else "differs"
 
 
-def _verdict(fit: PowerLawFit, spec: RowSpec) -> tuple[float, str]:
-    """``agrees`` (within 2 uncertainties of the reference), ``differs`` or
-    ``inconclusive`` (uncertainty above :func:`inconclusive_err`), with remarks: closer
-    to the alternative exponent, a window that is not flat, a window chosen inside a
-    slope range (which leans the fit towards that range)."""
+def exponent_text(x: float) -> str:
+    """An exponent as the fraction it is (denominator <= 12): -1/3, -4/3, -5/6; else a decimal."""
+    from fractions import Fraction
+
+    f = Fraction(x).limit_denominator(12)
+    if abs(float(f) - x) >= 1e-9:
+        return f"{x:+.4g}"
+    return f"{f.numerator}/{f.denominator}" if f.denominator > 1 else str(f.numerator)
+
+
+def _clause(word: str, ref: float, z: float, label: str = "") -> str:
+    name = exponent_text(ref) + (f" ({label})" if label else "")
+    return f"agrees with {name}" if word == "agrees" else f"differs from {name} (z = {z:+.1f})"
+
+
+def _verdict(fit: PowerLawFit, spec: RowSpec, ideal_beta: float = math.nan) -> tuple[float, str, str, float]:
+    """``(z, verdict, notes, z_alt)``: the verdict in plain words against the row's
+    reference (``agrees with -1/3`` within 2 uncertainties, ``differs from -1/3 (z = ...)``),
+    then against its alternative and the exact folded string on this window, or
+    ``inconclusive: ...`` when the uncertainty is above :func:`inconclusive_err`; notes: a
+    window that is not flat, a window chosen inside a slope range (which leans the fit)."""
     z, v = _judge(fit, spec.ref, spec)
+    z_alt = math.nan
+    if spec.alt is not None:
+        z_alt = (fit.beta - spec.alt) / fit.beta_err if fit.beta_err > 0 else math.inf
     if v == "inconclusive":
-        v += f" (uncertainty {fit.beta_err:.2g} > {inconclusive_err(spec):.3g})"
-    extra = []
-    if spec.alt is not None and fit.beta_err > 0:
-        za = (fit.beta - spec.alt) / fit.beta_err
-        if abs(za) < abs(z):
-            extra.append(f"closer to {spec.alt:+.3f} ({spec.alt_label})")
+        other = (exponent_text(spec.alt) if spec.alt is not None
+                 else f"{exponent_text(spec.ref - EXPONENT_SPACING)} or {exponent_text(spec.ref + EXPONENT_SPACING)}")
+        verdict = (f"inconclusive: uncertainty {fit.beta_err:.2g} > {inconclusive_err(spec):.2g}, too large to tell "
+                   f"{exponent_text(spec.ref)} from {other} (a wider or flatter window is needed)")
+    else:
+        clauses = [_clause(v, spec.ref, z)]
+        if spec.alt is not None:
+            clauses.append(_clause(_judge(fit, spec.alt, spec)[1], spec.alt, z_alt, spec.alt_label))
+        if math.isfinite(ideal_beta):
+            zi, vi = _judge(fit, ideal_beta, spec)
+            clauses.append(("agrees with" if vi == "agrees" else f"differs (z = {zi:+.1f}) from")
+                           + f" the exact folded string on this window ({ideal_beta:+.3f})")
+        verdict = "; ".join(clauses)
+    notes = []
     if not fit.flat:
-        extra.append("window not flat")
+        notes.append("window not flat")
     sr = spec.fit_kw.get("slope_range")
     if sr is not None:
-        extra.append(f"window constrained to local slopes in [{sr[0]:g}, {sr[1]:g}]")
-    return float(z), v + (f" ({'; '.join(extra)})" if extra else "")
+        notes.append(f"window constrained to local slopes in [{sr[0]:g}, {sr[1]:g}]")
+    return float(z), verdict, "; ".join(notes), float(z_alt)
 
 
 def fit_run(
@@ -650,14 +688,14 @@ def fit_run(
 ) -> RunFit:
     """Fit every exponent of a run: the paper's Fig. 3 as numbers.
 
-    For each row of :func:`report_specs` (v_max, a_end, a_max late and intermediate,
-    sigma_max, kappa_max) the law y ~ A (t*_chi - t)^beta is fitted
+    For each row of :func:`report_specs` (v_max, a_end, a_max, sigma_max, kappa_max) the law y ~ A (t*_chi - t)^beta is fitted
     (:func:`~snapping.scaling.fit.fit_power_law`) with t*_chi the mean snapping
     time from the three peaks and its uncertainty propagated, and again with
-    t* fitted jointly; each gets a verdict against the paper's exponent
-    (eq. asymptoticscalings, -5/6, -1/6): "agrees" when within two of its
-    uncertainties, "inconclusive" when that uncertainty is too large to exclude
-    the nearest other candidate exponent (:func:`inconclusive_err`).
+    t* fitted jointly; each gets a verdict in plain words against the paper's exponent
+    (eq. asymptoticscalings, -5/6, -1/6), its alternative and the exact folded string on
+    the same window: "agrees with -1/3" when within two of its uncertainties, "differs
+    from -1/3 (z = ...)", "inconclusive: ..." when that uncertainty is too large to
+    exclude the nearest other candidate exponent (:func:`inconclusive_err`).
 
     Parameters
     ----------
@@ -671,7 +709,7 @@ def fit_run(
         Also measure delta_kappa_m and the Fig. 4 predictions.
     windows : dict, optional
         Windows ``(tau_lo, tau_hi)`` overriding the automatic choice, keyed by row
-        name (``"a_max (late)"``) or variable (``"v_max"``, applies to its rows).
+        name or variable (``"v_max"``).
     **fit_kw
         Passed to every fit (e.g. ``tol``, ``min_width``).
 
@@ -711,7 +749,7 @@ def fit_run(
         except V.SnappingInputError as exc:
             if "window" in kw:  # a window the user chose: say so, do not hide it in a row
                 raise V.SnappingInputError(f"{spec.name}: {exc}") from None
-            rows.append(ExponentRow(spec, None, None, math.nan, "no fit", str(exc)))
+            rows.append(ExponentRow(spec, None, None, math.nan, "inconclusive: no fit", str(exc)))
             continue
         fj = None
         if joint:
@@ -719,12 +757,11 @@ def fit_run(
                 fj = fit_power_law(t, y, None, t_star_guess=snap.t_star, name=spec.var, **kw)
             except V.SnappingInputError:
                 fj = None
-        z, verdict = _verdict(f, spec)
         bw = math.nan
         if spec.ideal is not None:
             bw = ideal_window_exponent(spec.ideal, max(f.tau_lo, TAU_MIN), f.tau_hi)
-            verdict += f"; {_judge(f, bw, spec)[1]} with the exact folded string in this window"
-        rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw))
+        z, verdict, notes, z_alt = _verdict(f, spec, bw)
+        rows.append(ExponentRow(spec, f, fj, z, verdict, ideal_window_beta=bw, z_alt=z_alt, notes=notes))
     if "min_width" in fit_kw and rows and all(r.fit is None for r in rows):  # the user's window width fits nothing
         raise V.SnappingInputError(f"min_width={fit_kw['min_width']!r}: no row could be fitted ({rows[0].error})")
     dc = None
@@ -743,13 +780,15 @@ def fit_run(
     return RunFit(chi, N, snap, rows, dc, k0, amp, tuple(notes))
 
 
-def _pad(rows: list[tuple]) -> list[tuple]:
-    """Pad every column to its width (the first column left-, the rest right-aligned)."""
+def _pad(rows: list[tuple], left: tuple = (0, -1)) -> list[tuple]:
+    """Pad every column to its width (the columns ``left``, by default the first and the
+    last, left-aligned; the rest right-aligned)."""
     rows = [tuple(str(c) for c in r) for r in rows]
     n = max(len(r) for r in rows)
     rows = [r + ("",) * (n - len(r)) for r in rows]
     w = [max(len(r[i]) for r in rows) for i in range(n)]
-    return [tuple(c.ljust(w[i]) if i in (0, n - 1) else c.rjust(w[i]) for i, c in enumerate(r)) for r in rows]
+    lefts = {i % n for i in left}
+    return [tuple(c.ljust(w[i]) if i in lefts else c.rjust(w[i]) for i, c in enumerate(r)) for r in rows]
 
 
 def _pm(x: float, e: float) -> str:
@@ -766,19 +805,20 @@ def report_rows(res: RunFit) -> list[tuple]:
     one, verdict.
     """
     out = [("quantity", "beta (t*=t*_chi)", "ref", "ideal in window", "window t*-t", "beta (t* fitted)",
-            "A / A_ideal", "verdict")]
+            "A / A_ideal", "verdict", "notes")]
     for r in res.rows:
         s = r.spec
+        refs = exponent_text(s.ref) + ("" if s.alt is None else f", {exponent_text(s.alt)}")
         if r.fit is None:
-            out.append((s.name, "-", f"{s.ref:+.4f}", "-", "-", "-", "-", f"{r.verdict}: {r.error}"))
+            out.append((s.name, "-", refs, "-", "-", "-", "-", f"{r.verdict}: {r.error}", ""))
             continue
         f = r.fit
         win = f"[{f.tau_lo:.2e}, {f.tau_hi:.2e}]"
         bj = "-" if r.fit_joint is None else _pm(r.fit_joint.beta, r.fit_joint.beta_err)
         ratio = "-" if s.prefactor is None else f"{f.A / s.prefactor:.3f}"
         bw = "-" if not math.isfinite(r.ideal_window_beta) else f"{r.ideal_window_beta:+.4f}"
-        out.append((s.name, _pm(f.beta, f.beta_err), f"{s.ref:+.4f}", bw, win, bj, ratio, r.verdict))
-    return _pad(out)
+        out.append((s.name, _pm(f.beta, f.beta_err), refs, bw, win, bj, ratio, r.verdict, r.notes))
+    return _pad(out, left=(0, -2, -1))
 
 
 def delta_rows(dc: DeltaComparison) -> list[tuple]:

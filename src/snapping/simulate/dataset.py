@@ -48,8 +48,11 @@ class Run:
         return self.path
 
 
+#: the units of every number of a run (file, summary, CLI table)
+UNITS = "nondimensional (length L, mass M, time sqrt(L/g), force M g)"
+
 SUMMARY_KEYS = (
-    "chi", "N", "method", "tol", "dt0", "status", "stop_reason", "snap_reached", "snap_note",
+    "chi", "N", "method", "chords", "tol", "dt0", "status", "stop_reason", "snap_reached", "snap_note",
     "t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_max_0",
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
@@ -78,6 +81,8 @@ def summary(ds: xr.Dataset) -> dict:
         if k in ds.attrs:
             v = ds.attrs[k]
             out[k] = v.item() if isinstance(v, np.generic) else v
+    if "method" in out:
+        out["units"] = str(ds.attrs.get("units", UNITS))
     if isinstance(out.get("chi"), float) and np.isnan(out["chi"]):
         out["chi"] = None  # a general problem's start is not a catenary of some chi ('start' says what it is)
     if "snap_reached" in out:
@@ -197,7 +202,7 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
         "s_link": (schema.LINK_DIM, link_arclength(N), dict(schema.COORDS["s_link"])),
     }
     attrs = {"title": "snapping: falling-chain run (nondimensional: length l, g, rho = 1)",
-             "Conventions": "CF-1.8"}
+             "Conventions": "CF-1.8", "units": UNITS}
     results = snap_results(records, inputs, results)
     for k, v in {**inputs, **results}.items():
         attrs[k] = _attr_value(v)
@@ -419,7 +424,7 @@ def _inputs_from_attrs(ds: xr.Dataset) -> dict:
     if str(a.get("initial", "catenary")) == "problem":
         out["problem"] = problem_from_dataset(ds)
         out["chi"] = None
-        out["chords"] = "arclength"  # (the default: the problem's start holds its own)
+        out["chords"] = None  # (the default: the problem's start holds its own)
     return out
 
 

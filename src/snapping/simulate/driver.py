@@ -33,10 +33,18 @@ from .errors import FAILURES, RET_SIGNAL, RunInterrupted, SimulationError
 from .options import RunOptions, check_checkpoint_every, check_memory, check_progress
 
 __all__ = ["run", "rerun", "resume", "ResumeMismatch", "is_resumable", "check_inputs", "integrate_fixed", "METHODS",
-           "CHECKPOINT_EVERY"]
+           "CHECKPOINT_EVERY", "DEFAULT_METHOD", "DEFAULT_CHORDS",
+           "default_tol"]
 
 #: the method names :func:`run` takes (the table: :data:`snapping.simulate.methods.METHODS`)
 METHODS = M.NAMES
+#: the default method of :func:`run` (and of ``snapping simulate``/``sweep``): the project's
+#: fast exact method (link angles, links exact to round-off); the paper's Euler-Richardson
+#: scheme is ``method="euler-richardson"`` (what ``snapping reproduce`` uses)
+DEFAULT_METHOD = "fast"
+#: the default initial chain of :func:`run`: nodes on the catenary with chords exactly 1/N
+#: (the paper's chain, nodes at equal arclength, is ``chords="arclength"``)
+DEFAULT_CHORDS = "exact"
 #: default wall-clock seconds between checkpoints of a run with an output file
 CHECKPOINT_EVERY = 300.0
 #: layout version of the checkpoint variables (schema.CHECKPOINT_VARS); 2: the control array
@@ -59,14 +67,14 @@ def _resolve_problem(chi, N, chords, initial, problem, method):
             raise V.SnappingInputError("a Problem was given twice (as chi and as problem=)")
         chi, problem = None, chi
     if problem is None:
-        return chi, N, chords, initial, None
+        return chi, N, DEFAULT_CHORDS if chords is None else chords, initial, None
     if not isinstance(problem, Problem):
         raise V.SnappingInputError(f"problem={type(problem).__name__} is not a snapping.simulate.Problem")
     if chi is not None:
         raise V.SnappingInputError(f"chi={chi!r} given with a Problem: the problem's start sets the shape")
     if initial is not None:
         raise V.SnappingInputError("initial= given with a Problem: the problem's start is the initial state")
-    if chords != "arclength":
+    if chords is not None:
         raise V.SnappingInputError(f"chords={chords!r} given with a Problem: use Problem.catenary(chi, N, "
                                    f"chords={chords!r})")
     if N is not None and V.integer("N", N, 1) != problem.N:
@@ -85,8 +93,20 @@ def _resolve_problem(chi, N, chords, initial, problem, method):
         if why:
             raise V.SnappingInputError(f"method={method!r} takes only the paper's chain with a fixed held end and "
                                        f"g = 1; this problem has {', '.join(why)}: use method='fast' (dop853)")
-        return None, problem.N, chords, ChainState(problem.x, problem.y, problem.vx, problem.vy, 0.0), None
-    return None, problem.N, chords, None, problem
+        return (None, problem.N, problem.chords or DEFAULT_CHORDS,
+                ChainState(problem.x, problem.y, problem.vx, problem.vy, 0.0), None)
+    return None, problem.N, problem.chords or DEFAULT_CHORDS, None, problem
+
+
+def default_tol(method: str) -> float:
+    """The stepper tolerance a run of ``method`` takes when none is given: the method's
+    ``DEFAULT_TOL`` (Euler-Richardson: the paper's 1e-8; ``fast``/dop853: chosen by
+    ``benchmarks/bench_default_tol.py``, see ``docs/benchmarks/bench_default_tol.txt``).
+
+    >>> default_tol("euler-richardson")
+    1e-08
+    """
+    return float(M.method(method).DEFAULT_TOL)
 
 
 def _validate_start(chi, N, method, chords, initial, problem):
@@ -106,6 +126,8 @@ def _validate_start(chi, N, method, chords, initial, problem):
         chi = float("nan") if chi is None else check_chi(chi)
     if not isinstance(method, str) or method not in METHODS:
         raise V.SnappingInputError(f"method={method!r} is not one of {METHODS}")
+    if chords is None and problem is not None:  # (a general problem's start holds its own nodes)
+        return chi, N
     if not isinstance(chords, str) or chords not in ("arclength", "exact"):
         raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")
     return chi, N
@@ -115,8 +137,8 @@ def run(
     chi: float | None = None,
     N: int | None = None,
     *,
-    tol: float = 1e-8,
-    method: str = "euler-richardson",
+    tol: float | None = None,
+    method: str = DEFAULT_METHOD,
     dt0: float | None = None,
     t_end: float | None = None,
     stop_fraction: float = 0.5,
@@ -124,7 +146,7 @@ def run(
     snapshot_times=(),
     record_thin: float = 0.0,
     max_link_error: float = 1e-2,
-    chords: str = "arclength",
+    chords: str | None = None,
     initial: ChainState | None = None,
     output=None,
     progress: bool | None = False,
@@ -138,10 +160,17 @@ def run(
     """Simulate the falling chain released from the paper's catenary, to the snap and a bit after.
 
     The N-pendulum of the paper's appendix (eqs. (discretemo) and the tension
-    system) integrated with its Euler-Richardson scheme: half step, full step,
-    error estimate eq. (error), dt_new = 0.9 dt (tol/eps)^(1/2) (eq. (dtau)).
+    system). By default (``method="fast"``, ``chords="exact"``) it is integrated in
+    link angles, every link exactly 1/N to round-off, with the compiled Dormand-Prince
+    8(5,3) method (:mod:`snapping.simulate.methods.dop853`), from the catenary sampled
+    with chords exactly 1/N. The paper's own computation is
+    ``run(chi, N, method="euler-richardson", chords="arclength")`` (what
+    ``snapping reproduce`` runs): its Euler-Richardson scheme, half step, full step,
+    error estimate eq. (error), dt_new = 0.9 dt (tol/eps)^(1/2) (eq. (dtau)), from nodes
+    at equal arclength. Everything is nondimensional (length L, mass M, time
+    sqrt(L/g), force M g).
 
-    Step rejection: a step is accepted when eps <= tol; otherwise it is retried
+    Euler-Richardson step rejection: a step is accepted when eps <= tol; otherwise it is retried
     from the same state with dt = 0.9 dt (tol/eps)^(1/2) (the same rule). The
     half-step evaluation alone decides, so a rejected step costs one evaluation
     and an accepted step two (the accelerations at the end of a step are those
@@ -178,10 +207,14 @@ def run(
         gravity. ``run(Problem.catenary(chi, N))`` is ``run(chi, N)``, bit for bit.
         Methods ``dop853``/``fast`` take every problem; ``euler-richardson`` only the
         paper's chain (N equal links and masses) with a fixed held end and g = 1.
-    tol : float
-        Stepper tolerance eps_tol (paper: 1e-8).
-    method : {"euler-richardson", "euler-richardson-fixed"}
-        The paper's adaptive scheme, or the same step with fixed dt = dt0.
+    tol : float, optional
+        Stepper tolerance (default: the method's ``DEFAULT_TOL``, :func:`default_tol`:
+        Euler-Richardson the paper's eps_tol 1e-8; fast/dop853 1e-6, whose peaks agree
+        with tol 1e-11 to 3e-8, measured by ``benchmarks/bench_default_tol.py``).
+    method : {"fast", "dop853", "euler-richardson", "euler-richardson-fixed"}
+        ``fast`` (default): the project's best exact method (now ``dop853``, link
+        angles); ``euler-richardson``: the paper's adaptive scheme (reference);
+        ``euler-richardson-fixed``: the same step with fixed dt = dt0.
     dt0 : float, optional
         Initial (fixed-mode: constant) time step.
     t_end : float, optional
@@ -197,8 +230,10 @@ def run(
     max_link_error : float
         The run fails when a link length is off from 1/N by more than this fraction
         plus the initial chord error ``link_error_initial``.
-    chords : {"arclength", "exact"}
-        Initial node placement (see :func:`initial_state`).
+    chords : {"exact", "arclength"}, optional
+        Initial node placement (see :func:`initial_state`): ``exact`` (default) chords
+        exactly 1/N; ``arclength`` nodes at equal arclength (the paper's chain). Not
+        with a Problem (``Problem.catenary(chi, N, chords=...)`` holds its own).
     initial : ChainState, optional
         Start from this state instead of the catenary (``chi`` then optional).
     output : path, optional
@@ -246,19 +281,22 @@ def run(
 
     Examples
     --------
-    >>> r = run(0.5, 8, t_end=0.05, chords="exact")
+    >>> r = run(0.5, 8, t_end=0.05)                       # fast (dop853), exact chords
     >>> ds = r.dataset
-    >>> ds.attrs["status"], int(ds.attrs["N"]), float(ds.t[-1])
-    ('completed', 8, 0.05)
+    >>> ds.attrs["status"], ds.attrs["method"], ds.attrs["chords"], int(ds.attrs["N"]), float(ds.t[-1])
+    ('completed', 'dop853', 'exact', 8, 0.05)
     >>> bool(ds.attrs["energy_drift"] < 1e-9), bool(ds.attrs["link_drift"] < 1e-9)
     (True, True)
     >>> snap = run(0.5, 50).dataset.attrs                 # to shortly after the snap
-    >>> round(snap["t_snap_v"], 3), snap["stop_reason"]
+    >>> round(snap["t_snap_v"], 3), snap["stop_reason"]   # (below the folded string's t* = 1.19814)
     (1.144, 'snap detected: v_max fell below 0.5 of its peak')
+    >>> paper = run(0.5, 50, method="euler-richardson", chords="arclength").dataset.attrs  # the paper's
+    >>> round(paper["t_snap_v"], 3)
+    1.144
     """
     chi, N, chords, initial, problem = _resolve_problem(chi, N, chords, initial, problem, method)
     chi, N = _validate_start(chi, N, method, chords, initial, problem)
-    opts = RunOptions(tol=tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
+    opts = RunOptions(tol=default_tol(method) if tol is None else tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
@@ -296,6 +334,8 @@ def check_inputs(chi=None, N=None, **options) -> dict:
     chi, N, chords, initial, problem = _resolve_problem(chi, N, kw["chords"], kw["initial"], kw["problem"],
                                                         kw["method"])
     chi, N = _validate_start(chi, N, kw["method"], chords, initial, problem)
+    if kw["tol"] is None:
+        kw["tol"] = default_tol(kw["method"])
     opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])
     check_checkpoint_every(kw["checkpoint_every"])
     check_progress(kw["progress"])
@@ -340,6 +380,27 @@ def _drive(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before
                              wall_before=wall_before)
 
 
+def expected_snap_time(inputs: dict) -> float | None:
+    """A rough estimate of the snapping time of an automatic run (the progress bar's total,
+    shown as an estimate): the folded string's t* = 2E(pi/4|2) = 1.19814
+    (:data:`snapping.ideal.T_STAR`), which t*_chi approaches from below as chi -> 0 (1.194 at
+    chi = 0.1, 1.175 at 0.25, 1.144 at 0.5), less a small correction for larger chi,
+    t* - 0.25 chi^2 (within 1% at those three chi), floored at 0.5 t*. None for a start
+    that is not the paper's catenary (a general problem or a given state): no estimate.
+
+    >>> round(expected_snap_time({"chi": 0.1, "initial": "catenary"}), 3)
+    1.196
+    >>> expected_snap_time({"chi": float("nan"), "initial": "problem"}) is None
+    True
+    """
+    from ..ideal import T_STAR
+
+    chi = inputs.get("chi")
+    if str(inputs.get("initial", "catenary")) != "catenary" or chi is None or not np.isfinite(chi):
+        return None
+    return float(max(T_STAR - 0.25 * chi ** 2, 0.5 * T_STAR))
+
+
 def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
     """:func:`_drive` once the output (if any) is locked and checked.
 
@@ -356,10 +417,22 @@ def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall
 
         desc = f"chain N={N}" if M.method(inputs["method"]) is M.euler_richardson else \
             f"chain N={N} ({inputs['method']})"
-        bar = tqdm(total=t_end, initial=eng.t, file=sys.stderr, disable=None if progress is None else False,
-                   unit="t", desc=desc, dynamic_ncols=True,
-                   bar_format=("{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}" if t_end
-                               else "{desc}: t={n:.5f} [{elapsed}]{postfix}"))
+        expected = None if t_end else expected_snap_time(inputs)
+        if t_end:
+            fmt = "{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}"
+        elif expected:
+            fmt = "{desc}: t={n:.5f}/~{total:.4f} (estimated snap) {bar} [{elapsed}<{remaining}]{postfix}"
+        else:
+            fmt = "{desc}: t={n:.5f} [{elapsed}]{postfix}"
+        class _Bar(tqdm):  # an estimated total is raised when t passes it (no bar beyond 100%)
+            def update(self, n=1):
+                if expected and self.total is not None and self.n + n > self.total:
+                    self.total = self.n + n
+                return super().update(n)
+
+        bar = _Bar(total=t_end or expected, initial=eng.t, file=sys.stderr,
+                   disable=None if progress is None else False, unit="t", desc=desc, dynamic_ncols=True,
+                   bar_format=fmt)
     got = {"signum": None, "last": time.monotonic()}
     wall0 = time.perf_counter()
 

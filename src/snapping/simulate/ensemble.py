@@ -415,9 +415,9 @@ class _Lanes:
                       self.hx, self.tolx, self.codes, self.engines[0].mdl)
 
 
-def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end: float | None = None,
+def run_ensemble(chis, N: int, *, tol: float | None = None, method: str = "fast", t_end: float | None = None,
                  stop_fraction: float = 0.5, t_end_max: float = 10.0, snapshot_times=(), record_thin: float = 0.0,
-                 max_link_error: float = 1e-2, chords: str = "arclength", outputs=None, progress: bool = False,
+                 max_link_error: float = 1e-2, chords: str = "exact", outputs=None, progress: bool = False,
                  dt_min: float = 1e-14, overwrite: bool = False):
     """Run several chains of N links (one per ``chis`` value) together, one vectorised
     kernel advancing all of them, each with its own adaptive DOP853 step.
@@ -435,7 +435,8 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     N : int
         Number of links of every member.
     tol, t_end, stop_fraction, t_end_max, snapshot_times, record_thin, max_link_error, chords
-        As in :func:`snapping.simulate.run`, for every member.
+        As in :func:`snapping.simulate.run`, for every member (defaults too: tol the
+        fast method's, chords ``exact``).
     method : {"fast", "dop853"}
         The angle-form method (the only one with an ensemble kernel).
     outputs : sequence of paths, optional
@@ -478,7 +479,7 @@ def run_ensemble(chis, N: int, *, tol: float = 1e-8, method: str = "fast", t_end
     N = V.integer("N", N, 1)
     if not isinstance(chords, str) or chords not in ("arclength", "exact"):
         raise V.SnappingInputError(f"chords={chords!r} is not one of ('arclength', 'exact')")
-    opts = RunOptions(tol=tol, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
+    opts = RunOptions(tol=DOP.DEFAULT_TOL if tol is None else tol, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       dt_min=dt_min)
     if outputs is not None:

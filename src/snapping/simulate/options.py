@@ -182,7 +182,7 @@ def _available_memory() -> int | None:
 _MAX_COUNT = 1e30
 
 
-def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: str = "euler-richardson",
+def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: str = "fast",
                 dt0: float | None = None, t_end: float | None = None, t_end_max: float = 10.0,
                 snapshot_times=(), record_thin: float = 0.0) -> dict:
     """Estimated peak memory of a run: per-step record, snapshots and state buffers.
@@ -249,7 +249,7 @@ def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: 
             "state_bytes": state_bytes}
 
 
-def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "euler-richardson") -> dict:
+def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "fast") -> dict:
     """Raise SnappingInputError when the run's record and snapshots would not fit in memory;
     else return the estimate (:func:`memory_need`, with ``file_bytes``: the run file's size)."""
     dt0 = math.sqrt(opts.tol) if opts.dt0 is None else opts.dt0

@@ -336,7 +336,7 @@ class Problem:
 
     # -- constructors
     @classmethod
-    def catenary(cls, chi: float, N: int | None = None, *, chords: str = "arclength", links: Links | None = None,
+    def catenary(cls, chi: float, N: int | None = None, *, chords: str = "exact", links: Links | None = None,
                  pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
         """The paper's start: the level catenary of end separation ``chi``, at rest. With the
         paper's links (default: ``Links.uniform(N)``) the nodes are those of
@@ -522,10 +522,10 @@ class Problem:
         (:func:`snapping.shape_estimates.shape_estimate`): P, kappa_m(0), the delta scales and
         the whirling-rod peaks.
 
-        >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared")).estimate()
+        >>> shared = Problem.catenary(0.25, links=Links.uniform(2000, lumping="shared"), chords="arclength").estimate()
         >>> round(shared["P"], 5), round(shared["kappa_m0"], 2)     # the closed forms: 0.254055, 26.11
         (0.25405, 26.11)
-        >>> round(Problem.catenary(0.25, 2000).estimate()["P"], 5)   # the paper's lumping: O(1/N) off
+        >>> round(Problem.catenary(0.25, 2000, chords="arclength").estimate()["P"], 5)  # the paper's lumping: O(1/N) off
         0.2543
         """
         from ..shape_estimates import shape_estimate
@@ -580,7 +580,7 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
     return x - x[0], y - y[0]
 
 
-def from_options(*, chi=None, N=None, chords: str = "arclength", supports=None, shape=None, tip_mass: float = 0.0,
+def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shape=None, tip_mass: float = 0.0,
                  taper=None, lumping: str | None = None, pin_motion=None, gravity: float = 1.0) -> Problem | None:
     """The problem the command-line options describe (``snapping simulate``), or None when
     they describe the paper's problem (then ``run(chi, N)``).

@@ -30,7 +30,8 @@ METHODS: dict[str, ModuleType] = {
     "euler-richardson-fixed": euler_richardson,
     "dop853": dop853,
 }
-#: names that stand for another: ``fast`` is always the project's best exact method
+#: names that stand for another: ``fast`` is always the project's best exact method (the
+#: default of :func:`snapping.simulate.run`, ``snapping simulate`` and ``snapping sweep``)
 ALIASES = {"fast": "dop853"}
 #: every name :func:`snapping.simulate.run` takes
 NAMES = (*METHODS, *ALIASES)

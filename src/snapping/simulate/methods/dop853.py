@@ -14,7 +14,7 @@ Euler-Richardson runs (:func:`snapping.simulate.run`), with three differences:
   the ``peak`` snapshot exactly at ``t_snap_v``;
 * the initial chain has links of length exactly 1/N in the directions of the chosen
   sampling of the catenary: with ``chords="exact"`` this is the Euler-Richardson
-  initial state itself; with ``chords="arclength"`` (the default) the chords of the
+  initial state itself (the default of :func:`snapping.simulate.run`); with ``chords="arclength"`` the chords of the
   sampled catenary, slightly shorter than 1/N, are lengthened to 1/N. Compare with
   Euler-Richardson runs at ``chords="exact"``.
 
@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ... import _validate as V
 from .. import angles as AG
 from .. import general as G
 from .. import kernels as K
@@ -46,10 +47,16 @@ from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0,
                               checkpoint_getter)
 from ..chain import ChainState, initial_state
 
-__all__ = ["Engine", "setup", "complete", "resolve_method", "NAMES", "CHECKPOINT_VARS"]
+__all__ = ["Engine", "setup", "complete", "resolve_method", "NAMES", "CHECKPOINT_VARS", "DEFAULT_TOL"]
 
 #: the names this method answers to; ``fast`` always names the project's best exact method
 NAMES = ("dop853", "fast")
+#: tolerance of a run that gives none (the default method's): the largest tol of 1e-6 ... 1e-11
+#: whose peak speed, acceleration and tension agree with tol 1e-11 to within 1e-7 (relative) at
+#: chi 0.1, 0.25, 0.5 and N 200, 1000 (worst: 3.0e-8, a_peak at chi 0.25, N 200; below
+#: tol 1e-7 the errors stay at ~5e-9, the peak location's floor; 1e-6 takes 1.7-2.2x fewer
+#: evaluations than 1e-8): benchmarks/bench_default_tol.py, docs/benchmarks/bench_default_tol.txt
+DEFAULT_TOL = 1e-6
 FAST = "dop853"
 
 
@@ -293,10 +300,12 @@ class Engine(CheckpointMixin):
             bar.set_postfix_str(f"v_max={self.meas[K.M_VMAX]:.4g} dt={c[R.Q_H]:.3g} steps={int(c[R.Q_NSTEPS])}",
                                 refresh=False)
         t = self.t
-        if code == K.RET_T_RETURN:
-            while self.requested and self.requested[0] <= t:
+        if code < K.RET_FAIL_NAN:  # every requested time the last step passed (the step that ends the run,
+            while self.requested and self.requested[0] <= t:  # or meets a speed level, may pass one too)
                 tr = self.requested.pop(0)
                 self.snapshots.append((tr, "requested", self.Z_at(tr)[0]))
+        if code == K.RET_T_RETURN:
+            pass
         elif code == K.RET_V_UP:
             self.snapshots.append((t, "speed_level", self.Z.copy()))
             while c[R.Q_VUP] <= self.meas[K.M_VMAX]:
@@ -493,7 +502,23 @@ def complete(opts, method: str):
     return opts
 
 
-def setup(chi, N, method: str, opts, *, chords: str = "arclength", initial=None, problem=None):
+def _check_initial(state) -> None:
+    """A given start state must have links close to 1/N (they are mapped to exactly 1/N
+    in the same directions) and a finite energy: else SnappingInputError."""
+    N = state.N
+    l0 = state.link_lengths()
+    err = float(np.max(np.abs(N * l0 - 1.0)))
+    if not (np.all(l0 > 0.0) and err < 0.5):
+        raise V.SnappingInputError(f"initial state: link lengths must be close to 1/N={1.0 / N:.6g} (largest relative "
+                                   f"error {err:.3g}, at most 0.5 allowed)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        ke = 0.5 * float(np.sum(state.vx ** 2 + state.vy ** 2)) / N
+    if not np.isfinite(ke):
+        raise V.SnappingInputError("initial state: non-finite accelerations, tension or energy "
+                                   "(positions or velocities far too large)")
+
+
+def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, problem=None):
     """The input attributes and the engine of an angle-form run (``opts``: a validated
     :class:`RunOptions`). ``problem``: a general :class:`snapping.simulate.problem.Problem`
     (then ``chi``, ``chords`` and ``initial`` are not used)."""
@@ -504,6 +529,8 @@ def setup(chi, N, method: str, opts, *, chords: str = "arclength", initial=None,
         t0 = 0.0
     else:
         state0 = initial_state(chi, N, chords) if initial is None else initial.copy()
+        if initial is not None:  # a given state: the checks of the Euler-Richardson engine
+            _check_initial(state0)
         y0 = AG.state_to_angles(state0)
         mdl = None
         t0 = state0.t

@@ -21,10 +21,12 @@ from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0,
                               checkpoint_getter)
 from ..chain import ChainState, initial_state
 
-__all__ = ["Engine", "setup", "complete", "NAMES", "CHECKPOINT_VARS"]
+__all__ = ["Engine", "setup", "complete", "NAMES", "CHECKPOINT_VARS", "DEFAULT_TOL"]
 
 #: the names this method answers to (``-fixed``: the same step at a fixed dt = dt0)
 NAMES = ("euler-richardson", "euler-richardson-fixed")
+#: tolerance of a run that gives none: the paper's eps_tol
+DEFAULT_TOL = 1e-8
 #: node-steps per call into the compiled loop (sets how often the progress bar moves,
 #: and how soon a signal or a due checkpoint is acted on: ~0.1-0.2 s)
 NODE_STEPS_PER_CALL = 10_000_000
