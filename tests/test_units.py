@@ -270,7 +270,7 @@ def test_cli_simulate_json_si_part(capsys):
     assert d["v_peak"] < 10  # the nondimensional summary itself is unchanged
     code, out, _ = _cli(SIM + ["--json"], capsys)
     d = json.loads(out)
-    assert "si" not in d and d["units"].startswith("units: nondimensional")
+    assert "si" not in d and d["units_note"].startswith("units: nondimensional")
 
 
 def test_cli_fit_si(run_file, capsys):

@@ -139,11 +139,12 @@ def _si_scales(args):
 
 def _with_si(obj: dict, scales, si) -> dict:
     """``obj`` (a --json answer) with its ``"si"`` part (``si()`` computes it), or, without
-    --length/--mass, a ``"units"`` line saying the numbers are nondimensional."""
+    --length/--mass, a ``"units_note"`` line saying the numbers are nondimensional and how to
+    get SI (a run's own ``"units"`` field, its unit system, is kept)."""
     from . import units
 
     if scales is None:
-        return {**obj, "units": units.NONDIMENSIONAL_NOTE}
+        return {**obj, "units_note": units.NONDIMENSIONAL_NOTE}
     return {**obj, "si": {"system": "SI", "scales": units._scale_inputs(scales), **si()}}
 
 
