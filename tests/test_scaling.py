@@ -522,6 +522,6 @@ def test_single_run_fits_have_distinct_colours(captured):
     scaling.plot_maxima([ds], [res], "f3.png")
     ax_a = captured[0].axes[1]
     fits = [l for l in ax_a.lines if l.get_label().startswith("fit")]
-    assert len(fits) == 3  # a_end, a_max (late), a_max (intermediate)
-    assert len({to_rgba(l.get_color()) for l in fits}) == 3
+    assert len(fits) == 2  # a_end, a_max (one row, judged against -4/3 and -5/6)
+    assert len({to_rgba(l.get_color()) for l in fits}) == 2
     assert to_rgba("C0") not in {to_rgba(l.get_color()) for l in fits}  # none is the data's colour

@@ -239,8 +239,7 @@ FIT_COLOURS = ("tab:red", "tab:orange", "tab:purple", "tab:green", "tab:brown", 
 _ROW_TEX = {
     "v_max": r"$v_{\max}$",
     "a_end": r"$a_{\mathrm{end}}$",
-    "a_max (late)": r"$a_{\max}$ (late)",
-    "a_max (intermediate)": r"$a_{\max}$ (intermediate)",
+    "a_max": r"$a_{\max}$",
     "sigma_max": r"$\sigma_{\max}$",
     "kappa_max": r"$\kappa_{\max}$",
 }
