@@ -6,8 +6,8 @@ quantitative claims and figures need, redraws Fig. 1(b)-(e), Fig. 2(a)-(d),
 Fig. 3 and Fig. 4 as PNG and PDF, and writes ``REPORT.md``: one row per claim
 with the value measured here, the paper's statement and a verdict.
 
-``quick`` does it all at small N in a few minutes on two cores; ``full`` is the
-paper's resolution (N = 2000 and 5000).
+``quick`` does it all at small N in under two minutes on two cores (40 MB written);
+``full`` is the paper's resolution (N = 2000 and 5000; about 30 minutes on two cores).
 
 Example
 -------
@@ -115,7 +115,21 @@ PLANS = {
 }
 
 #: Rough cost model: right-hand-side evaluations of a run to its snap at tol 1e-8, and ns per node-evaluation.
-_NS_PER_NODE_EVAL = 10.0
+_NS_PER_NODE_EVAL = 18.0
+#: seconds per run beyond its evaluations (starting workers, loading the compiled kernels, writing
+#: the file), and for the fits and figures (calibrated on the quick plan: 17 runs in 70 s, fits and
+#: figures 20 s, on a 2-core VM under load 2)
+_SECONDS_PER_RUN = 4.5
+_SECONDS_AFTER_RUNS = 20.0
+
+
+def _continuum_seconds(plan: Plan) -> float:
+    """The continuum studies: 16 s for 5 levels at chi = 0.25 (docs/benchmarks/bench_continuum.txt:
+    117 s at chi = 0.1, 744 s at 0.05, i.e. ~chi^-2.4), 2.5x less per level fewer; the smallest
+    chi's study is also run with the paper's lumping."""
+    one = {c: 16.0 * (0.25 / c) ** 2.4 * 2.5 ** (plan.continuum_levels - 5) for c in plan.continuum_chi}
+    chi0 = 0.25 if 0.25 in one else min(one)
+    return sum(one.values()) + one[chi0]
 
 
 def _rhs_evaluations(chi: float, N: int, tol: float) -> float:
@@ -125,7 +139,8 @@ def _rhs_evaluations(chi: float, N: int, tol: float) -> float:
 def expected_seconds(plan: Plan, workers: int = 2) -> float:
     """A rough wall-time estimate of a plan's runs on ``workers`` cores (printed before a run starts)."""
     total = sum(_rhs_evaluations(c, n, t) * n * _NS_PER_NODE_EVAL * 1e-9 for c, n, t in plan.points())
-    return total / max(workers, 1) + 3.0 * len(plan.points())
+    return ((total + _SECONDS_PER_RUN * len(plan.points())) / max(workers, 1) + _SECONDS_AFTER_RUNS
+            + _continuum_seconds(plan))
 
 
 def _path(out: Path, plan: Plan, chi: float, N: int, tol: float) -> Path:
