@@ -174,3 +174,29 @@ def file_path(name: str, value) -> str:
     if not isinstance(p, str) or not p:
         raise SnappingInputError(f"{name}={_short(value)} is not a file path")
     return p
+
+
+#: range of a chain's length [m], mass [kg] and g [m/s^2]: beyond, its SI values leave the doubles
+SI_SCALE_RANGE = (1e-30, 1e30)
+
+
+def si_scales(length, mass, g) -> tuple[float, float, float]:
+    """``(length, mass, g)`` of a chain in SI as floats, each positive and within
+    :data:`SI_SCALE_RANGE`, or raise naming the one that is not.
+
+    >>> si_scales(1.022, 0.0208, 9.81)
+    (1.022, 0.0208, 9.81)
+    >>> si_scales(1.0, -1.0, 9.81)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: mass=-1.0 is out of range: must be > 0
+    """
+    lo, hi = SI_SCALE_RANGE
+    out = []
+    for name, unit, value in (("length", "m", length), ("mass", "kg", mass), ("g", "m/s^2", g)):
+        x = positive(name, value)
+        if not lo <= x <= hi:
+            raise SnappingInputError(f"{name}={x!r} {unit} is out of range: must lie in [{lo:g}, {hi:g}] "
+                                     f"(beyond, the SI values leave the doubles)")
+        out.append(x)
+    return tuple(out)

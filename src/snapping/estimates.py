@@ -264,7 +264,7 @@ def _t_star() -> float:
 
 
 #: range of a chain's length, mass and gravity in SI
-CHAIN_RANGE = (1e-30, 1e30)
+CHAIN_RANGE = V.SI_SCALE_RANGE
 
 
 @dataclass(frozen=True)
@@ -290,12 +290,7 @@ class Chain:
     g: float = 9.81
 
     def __post_init__(self):
-        lo, hi = CHAIN_RANGE
-        for name, unit in (("length", "m"), ("mass", "kg"), ("g", "m/s^2")):
-            x = V.positive(name, getattr(self, name))
-            if not lo <= x <= hi:
-                raise V.SnappingInputError(f"{name}={x!r} {unit} is out of range: must lie in [{lo:g}, {hi:g}] "
-                                           f"(beyond, the SI values leave the doubles)")
+        V.si_scales(self.length, self.mass, self.g)
 
     def velocity(self, v):
         """Nondimensional speed -> m/s."""

@@ -54,7 +54,7 @@ __all__ = ["Scales", "KIND_UNITS", "VARIABLE_KINDS", "VALUE_KINDS", "G_STANDARD"
 G_STANDARD = 9.81
 #: range of a length, mass or g in SI (as :data:`snapping.estimates.CHAIN_RANGE`): beyond, SI
 #: values of the library's numbers leave the doubles
-SCALE_RANGE = (1e-30, 1e30)
+SCALE_RANGE = V.SI_SCALE_RANGE
 
 #: The SI unit (CF string) of each kind of quantity.
 KIND_UNITS: dict[str, str] = {
@@ -198,12 +198,7 @@ class Scales:
     _factors: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        lo, hi = SCALE_RANGE
-        for name, unit in (("length", "m"), ("mass", "kg"), ("g", "m s-2")):
-            x = V.positive(name, getattr(self, name))
-            if not lo <= x <= hi:
-                raise V.SnappingInputError(f"{name}={x!r} {unit} is out of range: must lie in [{lo:g}, {hi:g}] "
-                                           f"(beyond, the SI values leave the doubles)")
+        for name, x in zip(("length", "mass", "g"), V.si_scales(self.length, self.mass, self.g)):
             object.__setattr__(self, name, x)
         object.__setattr__(self, "_factors", {k: self._derive(k) for k in KIND_UNITS})
 
