@@ -102,6 +102,15 @@ def test_converge_small_study_keeps_its_invariants(tmp_path):
     assert np.array_equal(again.dataset.v_peak.values, ds.v_peak.values)
     assert again.dataset.attrs["wall_time_total"] < ds.attrs["wall_time_total"] + 1.0
     assert "converged" in ds.attrs["verdict"]
+    # the figure of a study alone (no uniform chains beside it), as `snapping converge --plot` draws it
+    png = tmp_path / "conv.png"
+    c.plot(png)
+    assert png.stat().st_size > 5000
+    from snapping.cli import main
+
+    assert main(["converge", "--chi", "0.5", "--levels", "3", "--first", "-2", "-o", str(tmp_path / "conv"),
+                 "--plot", str(tmp_path / "cli.png"), "--json"]) == 0
+    assert (tmp_path / "cli.png").stat().st_size > 5000
 
 
 def test_level_parameters_and_bad_input():

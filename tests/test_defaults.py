@@ -143,7 +143,9 @@ def test_estimate_separation_or_curvature_without_length_is_refused(capsys):
         assert main(["estimate", opt, "0.3"]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "--length" in err and opt in err
-    assert main(["estimate", "--separation", "0.3", "--length", "1.0", "--json"]) == 0
+    assert main(["estimate", "--separation", "0.3", "--length", "1.0", "--json"]) == 2  # the mass is needed too
+    assert "without --mass" in capsys.readouterr().err
+    assert main(["estimate", "--separation", "0.3", "--length", "1.0", "--mass", "0.05", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["chi"] == pytest.approx(0.3)
 
 

@@ -242,6 +242,11 @@ def _cmd_estimate(args) -> int:
         if v is not None and args.length is None:
             raise SnappingInputError(f"{opt} {v:g} {unit} needs --length (the chain's length in m): chi follows "
                                      f"from both; give --length, or --chi for a fraction of the length")
+    if (args.length is None) != (args.mass is None):
+        given, missing = ("--length", "--mass") if args.mass is None else ("--mass", "--length")
+        raise SnappingInputError(f"{given} {args.length if args.mass is None else args.mass:g} without {missing}: "
+                                 f"the peaks in SI need both the chain's length and its mass (give both, or "
+                                 f"neither for the paper's chain, 1.022 m and 0.0208 kg)")
     chain = estimates.Chain(
         **{k: v for k, v in (("length", args.length), ("mass", args.mass), ("g", args.g)) if v is not None}
     )
@@ -990,7 +995,7 @@ def _as_typed(parser, command: str, msg: str) -> str:
     for a in sub._actions:
         longs = [o for o in a.option_strings if o.startswith("--")]
         si_own = command in _SI_COMMANDS and a.dest in _SI_DESTS  # (their messages name the options)
-        if longs and a.dest not in ("help", "json") and not si_own:
+        if longs and a.dest not in ("help", "json", "overwrite") and not si_own:  # (overwrite: named both ways)
             names[a.dest] = longs[0]
     after = r"(?=[=\[]| contains| grid)"
     for dest, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):

@@ -244,7 +244,7 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
             ax2.loglog(fo[do > 0], do[do > 0], "^:", color=c,
                        label=f"{label}, {lump} lumping: order {float(other.attrs[q + '_order']):.2f}")
     ax1.set_xscale("log")
-    ax1.set_xlim(frac.min() / 1.5, max(frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or [])))
+    ax1.set_xlim(frac.min() / 1.5, max([frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or []))])
                  * 1.5)
     ax1.axhline(1.0, color="k", lw=0.6)
     ax1.set_xlabel("link length on the fold / its radius of curvature")

@@ -329,8 +329,11 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
         f"{plan.describe()}")
 
     t0 = time.perf_counter()
-    for g in plan.grids():
-        sweep.run_sweep(g, out / "runs", workers=workers, progress=progress, log=None if progress else log)
+    grids = plan.grids()
+    for k, g in enumerate(grids):
+        label = f"sweep {k + 1}/{len(grids)} (chi {', '.join(f'{c:g}' for c in g.chi)}; N {', '.join(map(str, g.N))})"
+        sweep.run_sweep(g, out / "runs", workers=workers, progress=progress,
+                        log=None if progress else (lambda m, label=label: log(f"{label}:{m}")))
     timings["runs"] = time.perf_counter() - t0
 
     rows: list[tuple[str, str, str, str]] = []  # claim, measured, paper, verdict

@@ -214,7 +214,11 @@ def _failure_of(exc: BaseException, path: str) -> dict:
         ds = exc.dataset
         msg = ds.attrs.get("stop_reason") if ds is not None and ds.attrs.get("stop_reason") else str(exc)
         return {"kind": exc.kind or "simulation", "message": _one_line(msg), "file": _existing(exc.path or path)}
-    return {"kind": type(exc).__name__, "message": _one_line(exc) or type(exc).__name__, "file": _existing(path)}
+    msg = _one_line(exc) or type(exc).__name__
+    if type(exc).__name__ == "BrokenProcessPool":
+        msg = ("a worker process died (killed, out of memory, or, in a script, a sweep not started under "
+               "`if __name__ == \"__main__\":`, whose workers re-run the script)")
+    return {"kind": type(exc).__name__, "message": msg, "file": _existing(path)}
 
 
 def _run_task(task: list) -> list:
@@ -459,8 +463,14 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
     --------
     >>> paths = run_sweep(Grid(chi=[0.5], N=[8], options={"tol": 1e-6}), "/tmp/sw", progress=False)  # doctest: +SKIP
     """
+    import multiprocessing as mp
+
     from ._files import locked
 
+    if getattr(mp.current_process(), "_inheriting", False):  # a spawned worker importing the main script
+        raise V.SnappingInputError("run_sweep was called inside one of its own worker processes: a script that runs "
+                                   "a sweep must start it under `if __name__ == \"__main__\":` (the workers import "
+                                   "the script)")
     out = _check_out_dir(out_dir)
     with locked(out / "sweep.nc", name="out_dir"):  # one sweep at a time in a directory
         return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, ensemble=ensemble,
