@@ -1023,6 +1023,11 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"snapping {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away (`snapping ... | head`): stop quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # (no second error at exit)
+        return 141
     except OSError as exc:  # an I/O fault while working (a full disk, a vanished path): one line, exit 1
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
