@@ -271,6 +271,25 @@ def _children(pid: int) -> list[int]:
     return out
 
 
+def _worker_env(pid_file):
+    """The environment of a sweep subprocess: this checkout's snapping, worker pids written to ``pid_file``."""
+    import snapping
+
+    return {**os.environ, S._workers.WORKER_PID_FILE_ENV: str(pid_file),
+            "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+
+
+def _wait_for_workers(proc, pid_file, deadline, n=2) -> list[int]:
+    """The pids of the sweep's ``n`` local workers once they have started (fewer if the deadline passes)."""
+    import time
+
+    pids = []
+    while len(pids) < n and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.1)
+        pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+    return pids
+
+
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
 def test_a_killed_sweep_leaves_no_worker_processes(tmp_path):
     """SIGKILL the sweep's process while 2 workers run: the workers notice and end."""
@@ -279,22 +298,16 @@ def test_a_killed_sweep_leaves_no_worker_processes(tmp_path):
     import sys
     import time
 
-    import snapping
-
     pid_file = tmp_path / "pids"
     out = tmp_path / "out"
     script = ("from snapping import sweep as S\n"
               "g = S.Grid(chi=[0.3, 0.4, 0.5, 0.6], N=[200], options={'method': 'fast', 't_end': 60.0})\n"
               f"S.run_sweep(g, {str(out)!r}, workers=2, progress=False)\n")
-    env = {**os.environ, S._workers.WORKER_PID_FILE_ENV: str(pid_file),
-           "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    proc = subprocess.Popen([sys.executable, "-c", script], env=env)
+    proc = subprocess.Popen([sys.executable, "-c", script], env=_worker_env(pid_file))
     pids = []
     try:
         deadline = time.monotonic() + 120
-        while len(pids) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)
-            pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+        pids = _wait_for_workers(proc, pid_file, deadline)
         assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
         time.sleep(3.0)  # the runs are under way
         assert proc.poll() is None, "the sweep ended before it could be killed"
@@ -371,11 +384,8 @@ def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_pat
     import sys
     import time
 
-    import snapping
-
     pid_file, out = tmp_path / "pids", tmp_path / "out"
-    env = {**os.environ, S._workers.WORKER_PID_FILE_ENV: str(pid_file),
-           "PYTHONPATH": os.pathsep.join([str(Path(snapping.__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    env = _worker_env(pid_file)
     # the CLI's sweep, with runs that checkpoint every 0.5 s (to see them under way) and last ~1 min
     script = ("import sys\nfrom snapping import sweep as S\nfrom snapping.cli import main\nG = S.Grid\n"
               "S.Grid = lambda chi, N, options: G(chi, N, {**options, 't_end': 60.0, 'checkpoint_every': 0.5})\n"
@@ -387,9 +397,7 @@ def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_pat
     pids = []
     try:
         deadline = time.monotonic() + 120
-        while len(pids) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)
-            pids = [int(x) for x in pid_file.read_text().split()] if pid_file.exists() else []
+        pids = _wait_for_workers(proc, pid_file, deadline)
         assert len(pids) == 2, f"the workers did not start ({pids})"
         while len(list(out.glob("run_*.nc"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.1)  # until both runs are under way (their first checkpoints)

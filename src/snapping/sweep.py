@@ -481,7 +481,7 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble, l
     """:func:`run_sweep` once its directory is checked and locked."""
     from tqdm.auto import tqdm
 
-    out = _check_out_dir(out_dir)
+    out = Path(out_dir)
     if workers is not None:
         workers = V.integer("workers", workers, 1)
     size = _check_ensemble(grid, ensemble)
