@@ -1,57 +1,18 @@
-"""Design-rule estimates of the snap from the initial geometry alone.
-
-The initial shape is the paper's catenary of unit length hanging from the pin at
-the origin with its free end at (chi, 0) (gravity along +e2, so ``y`` grows
-downward). From it follow the initial maximum curvature kappa_m(0) = 1/a, the
-available energy P (catenary minus the vertically hanging string), the
-regularising length scales delta and, through the rigid whirling-rod model of
-the paper's eq. (estimates), predictions of the peak speed, acceleration and
-tension. :class:`Chain` carries these to SI units.
-
-Nondimensional units: length l, velocity sqrt(g l), acceleration g, force
-rho g l = M g, time sqrt(l/g).
-
-Example
--------
->>> import math
->>> from snapping import estimates
->>> a = estimates.catenary_parameter(0.25)
->>> round(a, 6), round(2 * a * math.sinh(0.25 / (2 * a)), 12)   # 1 = 2 a sinh(chi/2a)
-(0.038299, 1.0)
->>> est = estimates.design_estimate(estimates.Chain(), chi=0.25)   # the paper's chain
->>> round(est.nondim["kappa_m0"], 2), round(est.si["kappa_m0_per_m"], 2)   # 1/l and 1/m
-(26.11, 25.55)
->>> {k: round(v) for k, v in est.predictions["delta_c"].items()}
-{'v': 7, 'a': 1728, 'sigma': 26}
-"""
+"""The catenary start and the paper's scales: geometry, available energy, the regularising
+lengths delta and the whirling-rod peaks (no SI, no simulation); delta_kappa_m from a run."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import brentq
 
-from . import _validate as V
+from .. import _validate as V
 
-__all__ = [
-    "catenary_parameter",
-    "catenary_shape",
-    "chi_from_parameter",
-    "kappa_m0",
-    "available_energy",
-    "delta_kappa0",
-    "delta_crude",
-    "delta_N",
-    "whirling_rod",
-    "Chain",
-    "DesignEstimate",
-    "design_estimate",
-    "print_estimate",
-    "PAPER_CHAIN",
-]
-
+__all__ = ["check_chi", "catenary_parameter", "chi_from_parameter", "catenary_shape", "kappa_m0",
+           "available_energy", "delta_kappa0", "delta_crude", "delta_N", "whirling_rod", "delta_kappa_m",
+           "CHI_MIN", "N_MAX"]
 
 # ----------------------------------------------------------------------- catenary
 #: smallest end separation accepted: below it the scales of the catenary (delta_c ~ chi^(4/3))
@@ -255,226 +216,6 @@ def whirling_rod(P: float, delta: float) -> dict[str, float]:
     return out
 
 
-# ------------------------------------------------------------------ SI design rules
-def _t_star() -> float:
-    """Ideal snapping time of the folded string (see :mod:`snapping.ideal`)."""
-    from .ideal import t_star
-
-    return float(t_star())
-
-
-#: range of a chain's length, mass and gravity in SI
-CHAIN_RANGE = V.SI_SCALE_RANGE
-
-
-@dataclass(frozen=True)
-class Chain:
-    """A real chain or tether: length [m], mass [kg] and gravity [m/s^2].
-
-    Converts the nondimensional quantities of the library (length l, velocity
-    sqrt(g l), acceleration g, force M g, time sqrt(l/g)) to SI. The defaults
-    are the paper's chain (Tomaszewski et al.; Geminard & Vanel): 1.022 m,
-    0.0208 kg, 229 links.
-
-    Examples
-    --------
-    >>> c = Chain()
-    >>> round(c.velocity(1.0), 4)   # sqrt(g l) in m/s
-    3.1664
-    >>> round(c.force(1.0), 6)      # M g in N
-    0.204048
-    """
-
-    length: float = 1.022
-    mass: float = 0.0208
-    g: float = 9.81
-
-    def __post_init__(self):
-        V.si_scales(self.length, self.mass, self.g)
-
-    def velocity(self, v):
-        """Nondimensional speed -> m/s."""
-        return v * math.sqrt(self.g * self.length)
-
-    def acceleration(self, a):
-        """Nondimensional acceleration -> m/s^2."""
-        return a * self.g
-
-    def force(self, sigma):
-        """Nondimensional tension -> N (rho g l = M g)."""
-        return sigma * self.mass * self.g
-
-    def time(self, t):
-        """Nondimensional time -> s."""
-        return t * math.sqrt(self.length / self.g)
-
-    def distance(self, x):
-        """Nondimensional length -> m."""
-        return x * self.length
-
-    def energy(self, e):
-        """Nondimensional energy -> J (rho g l^2 = M g l)."""
-        return e * self.mass * self.g * self.length
-
-
-PAPER_CHAIN = Chain()
-
-_SCALE_LABELS = {
-    "delta_kappa0": "delta_kappa0 = (pi/2)/kappa_m(0)",
-    "delta_c": "delta_c = (1/2)(pi/kappa_m(0))^(4/3)",
-    "delta_N": "delta_N = 1/N",
-}
-
-
-@dataclass
-class DesignEstimate:
-    """Everything :func:`design_estimate` predicts, nondimensional and SI.
-
-    ``nondim`` holds the geometry (chi, a, kappa_m0, P, t_star); ``scales`` the
-    lengths delta; ``predictions[scale]`` the whirling-rod peaks {v, a, sigma};
-    ``si`` the same in SI units for ``chain``; ``warnings`` what makes a prediction
-    doubtful (a scale delta longer than the chain).
-    """
-
-    chain: Chain
-    nondim: dict[str, float]
-    scales: dict[str, float]
-    predictions: dict[str, dict[str, float]]
-    si: dict = field(default_factory=dict)
-    warnings: list = field(default_factory=list)
-
-    def to_dict(self) -> dict:
-        """One JSON-serialisable dict whose keys name the quantities (with units in SI keys)."""
-        return {
-            "chain": {"length_m": self.chain.length, "mass_kg": self.chain.mass, "g_m_per_s2": self.chain.g},
-            **self.nondim,
-            "scales": dict(self.scales),
-            "predictions": {k: dict(v) for k, v in self.predictions.items()},
-            "si": self.si,
-            "warnings": list(self.warnings),
-        }
-
-
-def design_estimate(
-    chain: Chain = PAPER_CHAIN,
-    *,
-    chi: float | None = None,
-    separation: float | None = None,
-    curvature: float | None = None,
-    N: int | None = None,
-) -> DesignEstimate:
-    """Predict the snap of ``chain`` from its initial catenary alone.
-
-    Give exactly one of ``chi`` (end separation / length), ``separation`` (end
-    separation in m) or ``curvature`` (initial maximum curvature in 1/m). The
-    scales delta_kappa0 and delta_c (and delta_N if ``N`` is given) each give
-    the whirling-rod peaks of the paper's eq. (estimates),
-    v = (6P/delta)^(1/2), a = v^2/delta, sigma = v^2/2, which are also
-    converted to SI together with the ideal snapping time t* sqrt(l/g).
-
-    Examples
-    --------
-    >>> est = design_estimate(Chain(length=1.022, mass=0.0208), chi=0.25)
-    >>> round(est.si["t_star_s"], 4)   # 2E(pi/4|2) sqrt(l/g) in s
-    0.3867
-    """
-    if not isinstance(chain, Chain):
-        raise V.SnappingInputError(f"chain={chain!r} is not a snapping.estimates.Chain")
-    given = [name for name, v in (("chi", chi), ("separation", separation), ("curvature", curvature)) if v is not None]
-    if len(given) != 1:
-        raise V.SnappingInputError(
-            f"give exactly one of chi, separation, curvature (got {', '.join(given) or 'none'})"
-        )
-    if separation is not None:
-        sep = V.open_interval("separation", separation, 0.0, chain.length)
-        chi = sep / chain.length
-        if chi < CHI_MIN:
-            raise V.SnappingInputError(f"separation={sep!r} m is out of range: must lie in "
-                                       f"[{CHI_MIN * chain.length:.3g}, {chain.length:g}) m for length "
-                                       f"{chain.length:g} m (chi >= {CHI_MIN:g})")
-    elif curvature is not None:
-        kappa = V.positive("curvature", curvature)
-        lo, hi = 1.0 / (_A_MAX * chain.length), 1.0 / (_A_MIN * chain.length)
-        if not lo <= kappa <= hi:  # curvature so small or large that chi rounds to 1 or leaves [CHI_MIN, 1)
-            raise V.SnappingInputError(f"curvature={kappa!r} 1/m is out of range: must lie in [{lo:.3g}, {hi:.3g}] "
-                                       f"1/m for length {chain.length:g} m (chi in [{CHI_MIN:g}, 1))")
-        chi = chi_from_parameter(1.0 / (kappa * chain.length))
-    chi = check_chi(chi)
-    if N is not None:
-        N = V.integer("N", N, 1)
-        delta_N(N)
-    a = catenary_parameter(chi)
-    P = available_energy(chi)
-    t_star = _t_star()
-    nondim = {"chi": chi, "a": a, "kappa_m0": 1.0 / a, "P": P, "t_star": t_star}
-    scales = {"delta_kappa0": delta_kappa0(chi), "delta_c": delta_crude(chi)}
-    if N is not None:
-        scales["delta_N"] = delta_N(N)
-    predictions = {name: whirling_rod(P, d) for name, d in scales.items()}
-    warnings = [f"{name} = {d:.3g} is longer than the chain (length 1): the whirling-rod estimate needs a "
-                f"regularising length much shorter than the chain, so its predicted peaks are not meaningful"
-                for name, d in scales.items() if d > 1.0]
-    si = {
-        "separation_m": chain.distance(chi),
-        "kappa_m0_per_m": 1.0 / chain.distance(a),
-        "P_J": chain.energy(P),
-        "t_star_s": chain.time(t_star),
-        "scales_m": {name: chain.distance(d) for name, d in scales.items()},
-        "predictions": {
-            name: {
-                "v_m_per_s": chain.velocity(p["v"]),
-                "a_m_per_s2": chain.acceleration(p["a"]),
-                "sigma_N": chain.force(p["sigma"]),
-            }
-            for name, p in predictions.items()
-        },
-    }
-    return DesignEstimate(chain=chain, nondim=nondim, scales=scales, predictions=predictions, si=si,
-                          warnings=warnings)
-
-
-def print_estimate(est: DesignEstimate, file=None) -> None:
-    """Print a :class:`DesignEstimate` as a readable table (what ``snapping estimate`` shows)."""
-    import sys
-
-    out = file or sys.stdout
-    c, nd, si = est.chain, est.nondim, est.si
-
-    def line(s=""):
-        print(s, file=out)
-
-    line(f"Snap estimate for a catenary with chi = {nd['chi']:.6g}")
-    line(f"chain: length {c.length:g} m, mass {c.mass:g} kg, g {c.g:g} m/s^2")
-    line()
-    line(f"  {'quantity':<34} {'nondimensional':>15} {'SI':>15}")
-    rows = [
-        ("end separation chi", nd["chi"], si["separation_m"], "m"),
-        ("catenary parameter a", nd["a"], c.distance(nd["a"]), "m"),
-        ("initial max curvature kappa_m(0)", nd["kappa_m0"], si["kappa_m0_per_m"], "1/m"),
-        ("available energy P", nd["P"], si["P_J"], "J"),
-        ("ideal snapping time t*", nd["t_star"], si["t_star_s"], "s"),
-    ]
-    for name, d in est.scales.items():
-        rows.append((_SCALE_LABELS[name], d, si["scales_m"][name], "m"))
-    for name, nd_v, si_v, unit in rows:
-        line(f"  {name:<34} {nd_v:>15.6g} {si_v:>15.6g} {unit}")
-    line()
-    line("Predicted peaks (whirling rod, eq. estimates: v = (6P/delta)^1/2, a = v^2/delta, sigma = v^2/2)")
-    line(f"  {'scale':<14} {'v':>10} {'a':>12} {'sigma':>10} | {'v [m/s]':>10} {'a [m/s^2]':>12} {'sigma [N]':>10}")
-    for name, p in est.predictions.items():
-        q = si["predictions"][name]
-        line(
-            f"  {name:<14} {p['v']:>10.4g} {p['a']:>12.4g} {p['sigma']:>10.4g} | "
-            f"{q['v_m_per_s']:>10.4g} {q['a_m_per_s2']:>12.4g} {q['sigma_N']:>10.4g}"
-        )
-    for w in est.warnings:
-        line(f"  warning: {w}")
-    line()
-    line("Against simulations (paper Fig. 4; snapping reproduce): delta_kappa0 underestimates the peak")
-    line("acceleration by one to two orders of magnitude; delta_c, from the initial geometry alone, is")
-    line("within an order of magnitude; delta_kappa_m (needs a run: snapping fit) is the most accurate.")
-
-
 # =============================================================================
 # delta_kappa_m: the regularising scale measured on a run (snapping.scaling, issue #4).
 # Appended section; takes arrays extracted from a run, never a Dataset.
@@ -560,6 +301,3 @@ def delta_kappa_m(t, kappa_max, s_kappa_max, *, return_time: bool = False):
     t_c = t[i] + f * (t[j] - t[i])
     delta = d_curv[i] + f * (d_curv[j] - d_curv[i])
     return (float(delta), float(t_c)) if return_time else float(delta)
-
-
-__all__ += ["delta_kappa_m"]

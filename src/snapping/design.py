@@ -1,0 +1,276 @@
+"""Inverse design: the end separations (and tip masses) that keep the snap's peaks under limits.
+
+An engineer has a chain or tether (length, mass, number of links) and limits: the
+tension its attachment takes, the speed or acceleration its payload may see. The
+peaks of the snap against the end separation chi come from the shipped table of
+fast exact runs (:mod:`snapping.table`, interpolated with an error bound);
+:func:`design` finds the separations whose peaks stay under every limit, for the
+given tip mass or for every tip mass of the table. A separation is *admissible*
+when the computed peak plus its error bound is under the limit (``nominal``: the
+computed peak alone). :func:`simulate_estimate` computes one case with the fast
+method instead (a point outside the table, or a check).
+
+>>> from snapping.estimates import Chain
+>>> res = design(Chain(length=2.0, mass=0.05), links=100, max_tension=20.0, tip_mass=0.0)
+>>> lo, hi = res.rows[0].admissible[0]
+>>> 0.3 < lo < 0.5, hi                              # far enough apart: the chain's ends
+(True, 0.9)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _validate as V
+from . import table as T
+from .estimates import Chain, DesignEstimate, attach_computed, check_tip_mass, design_estimate
+
+__all__ = ["LIMITS", "DesignRow", "DesignResult", "NoAdmissibleSeparation", "design", "print_design",
+           "plot_design", "simulate_estimate"]
+
+#: the limits: keyword -> (table quantity, Chain converter, unit, what)
+LIMITS = {
+    "max_tension": ("sigma_peak", "force", "N", "tension"),
+    "max_speed": ("v_peak", "velocity", "m/s", "speed"),
+    "max_acceleration": ("a_peak", "acceleration", "m/s^2", "acceleration"),
+}
+
+#: points of the chi scan (log-spaced over the table's range) between which the boundaries are refined
+N_SCAN = 400
+
+
+class NoAdmissibleSeparation(V.SnappingInputError):
+    """No separation (and tip mass) of the table keeps the peaks under the limits."""
+
+
+@dataclass
+class DesignRow:
+    """The admissible separations for one tip mass: lists of (chi_lo, chi_hi) intervals,
+    with the error bound (``admissible``) and without (``nominal``), and per limit the
+    smallest peak over the table's chi range (SI) and where it is."""
+
+    tip_mass: float
+    admissible: list = field(default_factory=list)
+    nominal: list = field(default_factory=list)
+    minimum: dict = field(default_factory=dict)
+
+
+@dataclass
+class DesignResult:
+    """What :func:`design` found: the chain, links, limits (SI, by keyword), one
+    :class:`DesignRow` per tip mass, and the scanned curves for :func:`plot_design`
+    (``curves[tip][keyword] = (chi, peak in SI, relative error bound)``)."""
+
+    chain: Chain
+    links: int
+    limits: dict
+    rows: list
+    curves: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        L = self.chain.length
+        return {
+            "chain": {"length_m": L, "mass_kg": self.chain.mass, "g_m_per_s2": self.chain.g},
+            "links": self.links, "limits": dict(self.limits),
+            "rows": [{"tip_mass": r.tip_mass,
+                      "admissible_chi": [list(i) for i in r.admissible],
+                      "admissible_separation_m": [[a * L, b * L] for a, b in r.admissible],
+                      "nominal_chi": [list(i) for i in r.nominal],
+                      "minimum": dict(r.minimum)} for r in self.rows],
+        }
+
+
+def _intervals(chi: np.ndarray, g, g_vals: np.ndarray) -> list:
+    """The chi intervals where g <= 0 (g sampled as ``g_vals`` on ``chi``), ends refined by bisection."""
+    ok = g_vals <= 0.0
+    out = []
+    i = 0
+    n = chi.size
+
+    def edge(a, b):  # g changes sign between chi a and b: bisect in log chi
+        ga = g(a) <= 0.0
+        for _ in range(50):
+            m = math.sqrt(a * b)
+            if (g(m) <= 0.0) == ga:
+                a = m
+            else:
+                b = m
+        return a if ga else b
+
+    while i < n:
+        if not ok[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and ok[j + 1]:
+            j += 1
+        lo = float(chi[i]) if i == 0 else edge(float(chi[i]), float(chi[i - 1]))
+        hi = float(chi[j]) if j == n - 1 else edge(float(chi[j]), float(chi[j + 1]))
+        out.append((lo, hi))
+        i = j + 1
+    return out
+
+
+def design(chain: Chain, links: int, *, max_tension: float | None = None, max_speed: float | None = None,
+           max_acceleration: float | None = None, tip_mass: float | None = None, table=None) -> DesignResult:
+    """The end separations (as chi = separation / length) that keep every given peak
+    under its limit (SI: N, m/s, m/s^2) for ``chain`` with ``links`` links, for the given
+    ``tip_mass`` (ratio to the chain's mass) or, when None, for every tip mass of the
+    table (only 0 when ``links`` is above its ``n_tip_max``).
+
+    Raises :class:`NoAdmissibleSeparation` (naming the smallest peak reachable, and
+    where) when no separation of the table's range meets the limits, and
+    :class:`snapping.table.OutsideTable` for links or a tip mass outside the table.
+    """
+    if not isinstance(chain, Chain):
+        raise V.SnappingInputError(f"chain={chain!r} is not a snapping.estimates.Chain")
+    limits = {k: V.positive(k, v) for k, v in (("max_tension", max_tension), ("max_speed", max_speed),
+                                               ("max_acceleration", max_acceleration)) if v is not None}
+    if not limits:
+        raise V.SnappingInputError("give at least one limit: max_tension [N], max_speed [m/s] or "
+                                   "max_acceleration [m/s^2]")
+    links = V.integer("links", links, 1)
+    tab = T.load_table(table)
+    r = tab.ranges
+    if tip_mass is None:
+        tips = [float(t) for t in tab.tip] if links <= tab.n_tip_max else [0.0]
+    else:
+        tips = [check_tip_mass(tip_mass)]
+    tab.check(r["chi"][0], links, tips[-1])
+    chi = np.geomspace(r["chi"][0], r["chi"][1], N_SCAN)
+    rows, curves = [], {}
+    for tip in tips:
+        curves[tip] = {}
+
+        def peak_si(c, key, *, bound):
+            q, conv, _, _ = LIMITS[key]
+            v, e = tab.values(q, c, links, tip, with_error=True)
+            return getattr(chain, conv)(v) * ((1.0 + e) if bound else 1.0)
+
+        def g_of(bound):
+            def g(c):
+                return max(peak_si(c, k, bound=bound) / lim - 1.0 for k, lim in limits.items())
+            return g
+
+        g_vals = {b: np.max([peak_si(chi, k, bound=b) / lim - 1.0 for k, lim in limits.items()], axis=0)
+                  for b in (True, False)}
+        row = DesignRow(tip_mass=tip, admissible=_intervals(chi, g_of(True), g_vals[True]),
+                        nominal=_intervals(chi, g_of(False), g_vals[False]))
+        for key in limits:
+            q, conv, _, _ = LIMITS[key]
+            v, e = tab.values(q, chi, links, tip, with_error=True)
+            si = getattr(chain, conv)(v)
+            curves[tip][key] = (chi, si, e)
+            i = int(np.argmin(si))
+            row.minimum[key] = {"peak": float(si[i]), "error": float(e[i]), "chi": float(chi[i])}
+        rows.append(row)
+    if not any(row.admissible for row in rows):
+        key = next(iter(limits))
+        best = min(rows, key=lambda row: row.minimum[key]["peak"])
+        m = best.minimum[key]
+        unit, what = LIMITS[key][2], LIMITS[key][3]
+        tip_txt = f" (tip mass {best.tip_mass:g})" if best.tip_mass or len(tips) > 1 else ""
+        others = "" if len(limits) == 1 else " (and the other limits)"
+        raise NoAdmissibleSeparation(
+            f"no separation keeps the {what} under {limits[key]:g} {unit}{others} for this chain ({links} links, "
+            f"separations {r['chi'][0] * chain.length:.3g} to {r['chi'][1] * chain.length:.3g} m): the minimum is "
+            f"{m['peak']:.4g} {unit} (+-{100 * m['error']:.2g}%) at separation {m['chi'] * chain.length:.3g} m "
+            f"(chi = {m['chi']:.3g}){tip_txt}")
+    return DesignResult(chain=chain, links=links, limits=limits, rows=rows, curves=curves)
+
+
+def _fmt_intervals(iv: list, L: float) -> str:
+    if not iv:
+        return "none"
+    return ", ".join(f"{a * L:.3g}-{b * L:.3g} m (chi {a:.3g}-{b:.3g})" for a, b in iv)
+
+
+def print_design(res: DesignResult, file=None) -> None:
+    """Print a :class:`DesignResult` (what ``snapping design`` shows)."""
+    import sys
+
+    out = file or sys.stdout
+    c = res.chain
+    lim = ", ".join(f"{LIMITS[k][3]} <= {v:g} {LIMITS[k][2]}" for k, v in res.limits.items())
+    print(f"Separations that keep the snap's peaks under the limits ({lim})", file=out)
+    print(f"chain: length {c.length:g} m, mass {c.mass:g} kg, g {c.g:g} m/s^2, {res.links} links; peaks from the "
+          f"table of fast exact runs (snapping.table)", file=out)
+    print("admissible: computed peak + its error bound under every limit; nominal: the computed peak alone", file=out)
+    print(file=out)
+    for row in res.rows:
+        print(f"  tip mass {row.tip_mass:g} x the chain's mass:", file=out)
+        print(f"    admissible: {_fmt_intervals(row.admissible, c.length)}", file=out)
+        print(f"    nominal:    {_fmt_intervals(row.nominal, c.length)}", file=out)
+        for k, m in row.minimum.items():
+            print(f"    smallest {LIMITS[k][3]}: {m['peak']:.4g} {LIMITS[k][2]} (+-{100 * m['error']:.2g}%) at "
+                  f"{m['chi'] * c.length:.3g} m", file=out)
+
+
+def plot_design(res: DesignResult, path=None, *, overwrite: bool = False):
+    """The peaks against the separation (one panel per limit, one curve per tip mass,
+    the error band shaded), the limit, and the admissible separations; saved to
+    ``path`` if given. Returns the figure."""
+    import matplotlib
+
+    if path is not None:
+        from ._files import check_output
+
+        check_output(path, name="plot", overwrite=overwrite)
+        matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    keys = list(res.limits)
+    fig, axes = plt.subplots(1, len(keys), figsize=(5.2 * len(keys), 4.2), squeeze=False)
+    L = res.chain.length
+    cmap = plt.get_cmap("viridis")
+    tips = list(res.curves)
+    for ax, key in zip(axes[0], keys):
+        for n, tip in enumerate(tips):
+            chi, si, e = res.curves[tip][key]
+            color = cmap(n / max(len(tips) - 1, 1))
+            ax.plot(chi * L, si, color=color, label=f"tip mass {tip:g}" if len(tips) > 1 else "computed peak")
+            ax.fill_between(chi * L, si * (1 - e), si * (1 + e), color=color, alpha=0.2, lw=0)
+        ax.axhline(res.limits[key], color="C3", ls="--", label=f"limit {res.limits[key]:g} {LIMITS[key][2]}")
+        if len(tips) == 1:
+            for a, b in res.rows[0].admissible:
+                ax.axvspan(a * L, b * L, color="C2", alpha=0.12, label="admissible")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("end separation [m]")
+        ax.set_ylabel(f"peak {LIMITS[key][3]} [{LIMITS[key][2]}]")
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(f"{res.links}-link chain, {L:g} m, {res.chain.mass:g} kg: peaks of the snap (table of fast runs)",
+                 fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        from ._files import save_figure
+
+        save_figure(fig, path, overwrite=overwrite)
+    return fig
+
+
+def simulate_estimate(chain: Chain, *, chi: float | None = None, separation: float | None = None,
+                      curvature: float | None = None, links: int, tip_mass: float = 0.0,
+                      progress: bool | None = None) -> DesignEstimate:
+    """The design estimate of :func:`snapping.estimates.design_estimate`, led by one run of
+    the fast exact method for this chain (links, tip mass) instead of the table: for a
+    point outside the table, or to check it."""
+    from .table.build import peaks_of_run, run_case
+
+    est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, N=links)
+    links = V.integer("links", links, 1)
+    tip_mass = check_tip_mass(tip_mass)
+    chi = est.nondim["chi"]
+    ds = run_case(chi, links, tip_mass, progress=progress).dataset
+    if not int(ds.attrs["snap_reached"]):
+        raise V.SnappingInputError(f"the run for chi={chi:g}, links={links} did not reach the snap: "
+                                   f"{ds.attrs['snap_note']}")
+    p = peaks_of_run(ds)
+    computed = {"v": p["v_peak"], "a": p["a_peak"], "sigma": p["sigma_peak"], "t_snap": p["t_snap_v"],
+                "kappa": p["kappa_peak"], "delta_kappa_m": p["delta_kappa_m"]}
+    return attach_computed(est, computed, {k: float("nan") for k in ("v", "a", "sigma", "t_snap")},
+                           source="simulation", links=links, tip_mass=tip_mass)
