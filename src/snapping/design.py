@@ -38,8 +38,8 @@ LIMITS = {
     "max_acceleration": ("a_peak", "acceleration", "m/s^2", "acceleration"),
 }
 
-#: points of the chi scan (log-spaced over the table's range) between which the boundaries are refined
-N_SCAN = 400
+#: points of the chi scan (log-spaced over the table's range; boundaries interpolated between them)
+N_SCAN = 2000
 
 
 class NoAdmissibleSeparation(V.SnappingInputError):
@@ -83,23 +83,18 @@ class DesignResult:
         }
 
 
-def _intervals(chi: np.ndarray, g, g_vals: np.ndarray) -> list:
-    """The chi intervals where g <= 0 (g sampled as ``g_vals`` on ``chi``), ends refined by bisection."""
-    ok = g_vals <= 0.0
+def _intervals(chi: np.ndarray, g: np.ndarray) -> list:
+    """The chi intervals where g <= 0 (g sampled on ``chi``), their ends interpolated linearly
+    in log chi between the samples around each sign change."""
+    ok = g <= 0.0
     out = []
-    i = 0
     n = chi.size
 
-    def edge(a, b):  # g changes sign between chi a and b: bisect in log chi
-        ga = g(a) <= 0.0
-        for _ in range(50):
-            m = math.sqrt(a * b)
-            if (g(m) <= 0.0) == ga:
-                a = m
-            else:
-                b = m
-        return a if ga else b
+    def edge(i, j):  # g(chi[i]) <= 0 < g(chi[j]) (neighbours)
+        f = g[i] / (g[i] - g[j])
+        return float(math.exp(math.log(chi[i]) + f * (math.log(chi[j]) - math.log(chi[i]))))
 
+    i = 0
     while i < n:
         if not ok[i]:
             i += 1
@@ -107,8 +102,8 @@ def _intervals(chi: np.ndarray, g, g_vals: np.ndarray) -> list:
         j = i
         while j + 1 < n and ok[j + 1]:
             j += 1
-        lo = float(chi[i]) if i == 0 else edge(float(chi[i]), float(chi[i - 1]))
-        hi = float(chi[j]) if j == n - 1 else edge(float(chi[j]), float(chi[j + 1]))
+        lo = float(chi[i]) if i == 0 else edge(i, i - 1)
+        hi = float(chi[j]) if j == n - 1 else edge(j, j + 1)
         out.append((lo, hi))
         i = j + 1
     return out
@@ -143,29 +138,20 @@ def design(chain: Chain, links: int, *, max_tension: float | None = None, max_sp
     chi = np.geomspace(r["chi"][0], r["chi"][1], N_SCAN)
     rows, curves = [], {}
     for tip in tips:
+        values, errors = tab.evaluate(chi, links, tip)
         curves[tip] = {}
-
-        def peak_si(c, key, *, bound):
+        ratio = {True: [], False: []}
+        row = DesignRow(tip_mass=tip)
+        for key, lim in limits.items():
             q, conv, _, _ = LIMITS[key]
-            v, e = tab.values(q, c, links, tip, with_error=True)
-            return getattr(chain, conv)(v) * ((1.0 + e) if bound else 1.0)
-
-        def g_of(bound):
-            def g(c):
-                return max(peak_si(c, k, bound=bound) / lim - 1.0 for k, lim in limits.items())
-            return g
-
-        g_vals = {b: np.max([peak_si(chi, k, bound=b) / lim - 1.0 for k, lim in limits.items()], axis=0)
-                  for b in (True, False)}
-        row = DesignRow(tip_mass=tip, admissible=_intervals(chi, g_of(True), g_vals[True]),
-                        nominal=_intervals(chi, g_of(False), g_vals[False]))
-        for key in limits:
-            q, conv, _, _ = LIMITS[key]
-            v, e = tab.values(q, chi, links, tip, with_error=True)
-            si = getattr(chain, conv)(v)
+            si, e = getattr(chain, conv)(values[q]), errors[q]
             curves[tip][key] = (chi, si, e)
+            ratio[True].append(si * (1.0 + e) / lim - 1.0)
+            ratio[False].append(si / lim - 1.0)
             i = int(np.argmin(si))
             row.minimum[key] = {"peak": float(si[i]), "error": float(e[i]), "chi": float(chi[i])}
+        row.admissible = _intervals(chi, np.max(ratio[True], axis=0))
+        row.nominal = _intervals(chi, np.max(ratio[False], axis=0))
         rows.append(row)
     if not any(row.admissible for row in rows):
         key = next(iter(limits))
@@ -271,6 +257,6 @@ def simulate_estimate(chain: Chain, *, chi: float | None = None, separation: flo
                                    f"{ds.attrs['snap_note']}")
     p = peaks_of_run(ds)
     computed = {"v": p["v_peak"], "a": p["a_peak"], "sigma": p["sigma_peak"], "t_snap": p["t_snap_v"],
-                "kappa": p["kappa_peak"], "delta_kappa_m": p["delta_kappa_m"]}
+                "delta_kappa_m": p["delta_kappa_m"]}
     return attach_computed(est, computed, {k: float("nan") for k in ("v", "a", "sigma", "t_snap")},
                            source="simulation", links=links, tip_mass=tip_mass)

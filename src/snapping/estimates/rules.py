@@ -261,7 +261,7 @@ def design_estimate(
     if peaks is not None:
         v = peaks.values
         attach_computed(est, {"v": v["v_peak"], "a": v["a_peak"], "sigma": v["sigma_peak"], "t_snap": v["t_snap_v"],
-                              "kappa": v["kappa_peak"], "delta_kappa_m": v["delta_kappa_m"]},
+                              "delta_kappa_m": v["delta_kappa_m"]},
                         {"v": peaks.errors["v_peak"], "a": peaks.errors["a_peak"],
                          "sigma": peaks.errors["sigma_peak"], "t_snap": peaks.errors["t_snap_v"]},
                         source="table", links=links, tip_mass=tip_mass, table=table)

@@ -27,7 +27,6 @@ convert to SI.
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,7 +41,7 @@ __all__ = ["TABLE_FILE", "QUANTITIES", "ERROR_QUANTITIES", "OutsideTable", "Tabl
 TABLE_FILE = Path(__file__).resolve().parent.parent / "data" / "snap_table.nc"
 
 #: the interpolated quantities (all positive)
-QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v", "delta_kappa_m")
+QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v", "delta_kappa_m")
 #: the quantities with a stored error bound
 ERROR_QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v")
 
@@ -69,43 +68,80 @@ def _axes(ds, tip: bool):
 
 def _part(ds, q: str, tip: bool) -> np.ndarray:
     """log of quantity ``q`` on the grid of the tip-free (chi, N) or tip-mass (chi, N <= n_tip_max, tip) part."""
-    a = ds[q].values
+    a = np.asarray(ds[q].values, float)
     if not tip:
         return np.log(a[:, :, 0])
     keep = ds["N"].values <= int(ds.attrs["n_tip_max"])
     return np.log(a[:, keep, :])
 
 
-def _loo_axis(axis_x: np.ndarray, vals: np.ndarray, axis: int) -> np.ndarray:
-    """Relative error at each grid point of a cubic spline along ``axis`` through the other points
-    of its line (interior points; the ends take their neighbour's)."""
-    from scipy.interpolate import make_interp_spline
+def _lagrange(nodes: np.ndarray, x) -> np.ndarray:
+    """Weights of the Lagrange polynomial through ``nodes`` (..., 4) at ``x`` (broadcasting to
+    ``nodes[..., 0]``, or with a trailing axis of length 1)."""
+    x = np.asarray(x, float)
+    if x.ndim and x.shape[-1] == 1 and x.ndim == nodes.ndim:
+        x = x[..., 0]
+    w = np.ones(nodes.shape)
+    for j in range(nodes.shape[-1]):
+        for k in range(nodes.shape[-1]):
+            if k != j:
+                w[..., j] *= (x - nodes[..., k]) / (nodes[..., j] - nodes[..., k])
+    return w
 
-    v = np.moveaxis(vals, axis, -1)
+
+def _stencil(ax: np.ndarray, x: np.ndarray):
+    """The 4 nodes of ``ax`` around each ``x`` (one-sided at the ends) and their cubic Lagrange
+    weights; a point on a node gets that node alone (weight 1)."""
+    n = ax.size
+    i = np.clip(np.searchsorted(ax, x, side="right") - 1, 0, n - 2)
+    start = np.clip(i - 1, 0, n - 4)
+    idx = start[:, None] + np.arange(4)
+    w = _lagrange(ax[idx], x[:, None])
+    on = np.isclose(ax[idx], x[:, None], rtol=0.0, atol=1e-12)
+    hit = on.any(axis=1)
+    w[hit] = on[hit].astype(float)
+    return idx, w, i, hit
+
+
+def _interp(vals: np.ndarray, axes, pts: np.ndarray) -> np.ndarray:
+    """Tensor-product piecewise-cubic (4-point Lagrange) interpolation of ``vals`` (grid, k) at
+    ``pts`` (m, d): shape (m, k)."""
+    st = [_stencil(ax, pts[:, d]) for d, ax in enumerate(axes)]
+    out = np.zeros((pts.shape[0], vals.shape[-1]))
+    for corner in np.ndindex(*(4,) * len(axes)):
+        w = np.ones(pts.shape[0])
+        for d, c in enumerate(corner):
+            w = w * st[d][1][:, c]
+        out += w[:, None] * vals[tuple(st[d][0][:, c] for d, c in enumerate(corner))]
+    return out
+
+
+def _loo_axis(ax: np.ndarray, vals: np.ndarray, axis: int) -> np.ndarray:
+    """Relative error at each grid point of the 4-point interpolant along ``axis`` through the
+    nearest other points of its line (the interpolant at twice the spacing; the two end points
+    take their neighbour's)."""
+    v = np.moveaxis(vals, axis, 0)
+    n = ax.size
     out = np.full(v.shape, np.nan)
-    n = axis_x.size
-    for idx in np.ndindex(v.shape[:-1]):
-        line = v[idx]
-        if not np.all(np.isfinite(line)):
-            continue
-        for m in range(1, n - 1):
-            keep = np.arange(n) != m
-            k = min(3, keep.sum() - 1)
-            pred = make_interp_spline(axis_x[keep], line[keep], k=k)(axis_x[m])
-            out[idx + (m,)] = abs(math.expm1(float(pred - line[m])))
-        out[idx + (0,)] = out[idx + (1,)]
-        out[idx + (n - 1,)] = out[idx + (n - 2,)]
-    return np.moveaxis(out, -1, axis)
+    for m in range(1, n - 1):
+        others = [k for k in range(n) if k != m]
+        pos = min(max(m - 2, 0), len(others) - 4)  # the 4 others nearest to m
+        use = others[pos:pos + 4]
+        w = _lagrange(ax[use], np.float64(ax[m]))
+        pred = np.tensordot(w, v[use], axes=(0, 0))
+        out[m] = np.abs(np.expm1(pred - v[m]))
+    out[0], out[n - 1] = out[1], out[n - 2]
+    return np.moveaxis(out, 0, axis)
 
 
-def leave_one_out(ds, q: str, *, tip: bool) -> np.ndarray:
-    """The leave-one-out error bound of quantity ``q`` at every grid point of the
-    tip-free (``tip=False``: shape (chi, N)) or tip-mass part (shape (chi, N <= n_tip_max, tip)):
-    the sum over the axes of the relative error of the cubic spline along that axis
-    through the line's other points."""
+def leave_one_out(ds, q: str, *, tip: bool) -> list:
+    """The leave-one-out error of quantity ``q`` along each axis, at every grid point of the
+    tip-free (``tip=False``: arrays of shape (chi, N)) or tip-mass part (shape (chi, N <=
+    n_tip_max, tip)): the relative error, along that axis, of the interpolant through the
+    line's other points (NaN where a line has a hole)."""
     axes = _axes(ds, tip)
     vals = _part(ds, q, tip)
-    return sum(_loo_axis(ax, vals, i) for i, ax in enumerate(axes))
+    return [_loo_axis(ax, vals, i) for i, ax in enumerate(axes)]
 
 
 @dataclass
@@ -161,64 +197,74 @@ class Table:
                                f"masses only for links <= {self.n_tip_max} (tip_mass 0 for up to {r['N'][1]})")
 
     # -- interpolation
-    def _interpolator(self, q: str, tip: bool):
-        key = (q, tip)
-        if key not in self._interp:
-            from scipy.interpolate import RegularGridInterpolator
+    def _part(self, tip: bool):
+        """(axes, log values stacked over :data:`QUANTITIES` on a last axis, per-axis
+        leave-one-out errors of :data:`ERROR_QUANTITIES` stacked the same way), computed once."""
+        if tip not in self._interp:
+            axes = _axes(self.ds, tip)
+            vals = np.stack([_part(self.ds, q, tip) for q in QUANTITIES], axis=-1)
+            ie = [QUANTITIES.index(q) for q in ERROR_QUANTITIES]
+            errs = [_loo_axis(ax, vals[..., ie], i) for i, ax in enumerate(axes)]
+            self._interp[tip] = (axes, vals, errs)
+        return self._interp[tip]
 
-            self._interp[key] = RegularGridInterpolator(_axes(self.ds, tip), _part(self.ds, q, tip),
-                                                        method="cubic", bounds_error=False, fill_value=None)
-        return self._interp[key]
-
-    def _bound(self, q: str, tip: bool, pts: np.ndarray) -> np.ndarray:
-        """The largest node error bound over the corners of each point's cell."""
-        if tip:
-            err = self.ds[f"{q}_error"].values[:, self.N <= self.n_tip_max, :]
-        else:
-            err = self.ds[f"{q}_error_notip"].values
-        axes = _axes(self.ds, tip)
-        lo = [np.clip(np.searchsorted(ax, pts[:, d], side="right") - 1, 0, ax.size - 2) for d, ax in enumerate(axes)]
-        out = np.zeros(pts.shape[0])
+    @staticmethod
+    def _bound(axes, errs, pts: np.ndarray) -> np.ndarray:
+        """The error bound at each point (m, k): over the axes along which it is not on a node,
+        the sum of the largest leave-one-out error of that axis at the corners of its cell."""
+        st = [_stencil(ax, pts[:, d]) for d, ax in enumerate(axes)]
+        corners = []
         for corner in np.ndindex(*(2,) * len(axes)):
-            out = np.maximum(out, err[tuple(lo[d] + corner[d] for d in range(len(axes)))])
+            corners.append(tuple(np.where(st[k][3], np.argmax(st[k][1], axis=1) + st[k][0][:, 0], st[k][2] + corner[k])
+                                 for k in range(len(axes))))
+        out = np.zeros((pts.shape[0], errs[0].shape[-1]))
+        for d, err in enumerate(errs):
+            worst = np.max([err[idx] for idx in corners], axis=0)
+            out += np.where(st[d][3][:, None], 0.0, worst)
         return out
 
-    def values(self, q: str, chi, N, tip_mass=0.0, *, with_error: bool = False):
-        """Quantity ``q`` interpolated at (chi, N, tip_mass) (arrays broadcast), and its
-        relative error bound if ``with_error``. Checked to lie inside the table."""
-        if q not in QUANTITIES:
-            raise V.SnappingInputError(f"quantity={q!r} is not one of {QUANTITIES}")
+    def evaluate(self, chi, N, tip_mass=0.0):
+        """Every quantity at the points (chi, N, tip_mass) (arrays broadcast, checked to lie
+        inside the table): ``(values, errors)``, dicts of arrays by quantity (errors: relative
+        bounds of :data:`ERROR_QUANTITIES`)."""
         self.check(chi, N, tip_mass)
         chi_b, N_b, tip_b = np.broadcast_arrays(*(np.asarray(v, float) for v in (chi, N, tip_mass)))
         shape = chi_b.shape
         x, y, z = (c.ravel() for c in _coords(chi_b, N_b, tip_b))
-        out = np.empty(x.size)
-        err = np.full(x.size, np.nan)
+        out = np.full((x.size, len(QUANTITIES)), np.nan)
+        err = np.full((x.size, len(ERROR_QUANTITIES)), np.nan)
         for tip in (False, True):
             sel = (z > 0) if tip else (z == 0)
             if not sel.any():
                 continue
             pts = np.column_stack((x[sel], y[sel], z[sel]) if tip else (x[sel], y[sel]))
-            out[sel] = np.exp(self._interpolator(q, tip)(pts))
-            if with_error and q in ERROR_QUANTITIES:
-                err[sel] = self._bound(q, tip, pts)
-        out, err = out.reshape(shape), err.reshape(shape)
-        if not shape:
-            out, err = float(out), float(err)
-        return (out, err) if with_error else out
+            axes, vals, errs = self._part(tip)
+            out[sel] = np.exp(_interp(vals, axes, pts))
+            err[sel] = self._bound(axes, errs, pts)
+        values = {q: out[:, i].reshape(shape) for i, q in enumerate(QUANTITIES)}
+        errors = {q: err[:, i].reshape(shape) for i, q in enumerate(ERROR_QUANTITIES)}
+        return values, errors
+
+    def values(self, q: str, chi, N, tip_mass=0.0, *, with_error: bool = False):
+        """Quantity ``q`` interpolated at (chi, N, tip_mass) (arrays broadcast), and its
+        relative error bound if ``with_error`` (NaN for a quantity without one)."""
+        if q not in QUANTITIES:
+            raise V.SnappingInputError(f"quantity={q!r} is not one of {QUANTITIES}")
+        values, errors = self.evaluate(chi, N, tip_mass)
+        v = values[q]
+        e = errors.get(q, np.full(v.shape, np.nan))
+        if not v.shape:
+            v, e = float(v), float(e)
+        return (v, e) if with_error else v
 
     def lookup(self, chi: float, N: int, tip_mass: float = 0.0) -> TablePeaks:
         """Every quantity at one point, with the error bounds."""
         chi = V.real("chi", chi)
         N = V.integer("links", N, 1)
         tip_mass = V.real("tip_mass", tip_mass)
-        peaks = TablePeaks(chi=chi, N=N, tip_mass=tip_mass)
-        for q in QUANTITIES:
-            v, e = self.values(q, chi, N, tip_mass, with_error=True)
-            peaks.values[q] = v
-            if q in ERROR_QUANTITIES:
-                peaks.errors[q] = e
-        return peaks
+        values, errors = self.evaluate(chi, N, tip_mass)
+        return TablePeaks(chi=chi, N=N, tip_mass=tip_mass, values={q: float(v) for q, v in values.items()},
+                          errors={q: float(e) for q, e in errors.items()})
 
 
 @functools.lru_cache(maxsize=4)
