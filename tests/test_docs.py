@@ -45,9 +45,12 @@ def _text(site: Path, page: str) -> str:
 
 
 @pytest.mark.parametrize("page, needles", [
-    ("index.html", ["snapping estimate --chi 0.25 --length 1.022 --mass 0.0208", "pip install -e",
+    ("index.html", ["snapping estimate --chi 0.25 --links 229 --length 1.022 --mass 0.0208", "pip install -e",
                     "arXiv:2206.07864"]),
-    ("guide/estimate.html", ["design_estimate", "sigma_N", "--separation"]),
+    ("guide/estimate.html", ["design_estimate", "sigma_N", "--separation", "--links"]),
+    ("guide/design.html", ["snapping design --max-tension", "admissible", "bench_table.py", "computed_estimate"]),
+    ("api/table.html", ['id="snapping.table.lookup"', 'id="snapping.table.build.build"']),
+    ("api/design.html", ['id="snapping.design.design"', 'id="snapping.design.computed_estimate"']),
     ("guide/simulate.html", ["snapping simulate --chi 0.25 --N 200 --method fast -o run.nc", "figures.profiles",
                              "PinMotion.flick"]),
     ("guide/fit.html", ["snapping fit run.nc", "fit_run", "--plot"]),
@@ -89,7 +92,7 @@ def test_cli_page_is_the_parsers_help(site):
     finally:
         sys.path.remove(str(DOCS / "_ext"))
     text = html.unescape(re.sub(r"<[^>]+>", "", _text(site, "cli.html")))
-    for command in (None, "ideal", "estimate", "simulate", "sweep", "fit", "converge", "reproduce"):
+    for command in (None, "ideal", "estimate", "design", "simulate", "sweep", "fit", "converge", "reproduce"):
         assert help_text(command).strip() in text, command
 
 

@@ -34,7 +34,7 @@ from contextlib import contextmanager
 import numpy as np
 import pytest
 
-from snapping import SnappingInputError, continuum, estimates, ideal, scaling, shape_estimates, simulate
+from snapping import SnappingInputError, continuum, design, estimates, ideal, scaling, shape_estimates, simulate, table
 from snapping.cli import main
 from snapping.simulate.problem import Links, PinMotion, Problem
 
@@ -184,6 +184,14 @@ SPECS = {
                                               {"separation": 0.3}, ["separation"], []),
     "estimates.design_estimate(curvature)": (lambda F, **k: estimates.design_estimate(**k),
                                              {"curvature": 20.0}, ["curvature"], []),
+    "estimates.design_estimate(links)": (lambda F, **k: estimates.design_estimate(**k),
+                                         {"chi": 0.3, "links": 100, "tip_mass": 0.05}, ["chi", "links", "tip_mass"],
+                                         []),
+    "table.lookup": (lambda F, **k: table.lookup(**k), {"chi": 0.3, "links": 100, "tip_mass": 0.05},
+                     ["chi", "links", "tip_mass"], []),
+    "design.design": (lambda F, **k: design.design(**k),
+                      {"chain": estimates.Chain(length=2.0, mass=0.05), "links": 100, "max_tension": 20.0,
+                       "tip_mass": 0.0}, ["links", "max_tension", "tip_mass"], []),
     "estimates.delta_kappa_m": (lambda F, **k: estimates.delta_kappa_m(**k),
                                 {"t": [0.0, 0.5, 1.0, 1.1], "kappa_max": [1.0, 2.0, 8.0, 30.0],
                                  "s_kappa_max": [0.5, 0.6, 0.8, 0.95]}, [], ["t", "kappa_max", "s_kappa_max"]),
@@ -286,6 +294,9 @@ VALID = {
                           "s0=empty", "s0_dot=empty"},
     "estimates.catenary_shape": {"s=zero", "s=tiny", "s=empty"},
     "estimates.design_estimate(chi)": {"N=none"},
+    "estimates.design_estimate(links)": {"tip_mass=zero", "tip_mass=tiny"},
+    "table.lookup": {"tip_mass=zero", "tip_mass=tiny"},
+    "design.design": {"tip_mass=zero", "tip_mass=tiny", "tip_mass=none", "max_tension=huge"},
     "estimates.delta_kappa_m": _data("t", "kappa_max") | {"s_kappa_max=" + t for t in ("nan", "inf", "-inf", "zero",
                                                                                         "tiny")},
     # a shape is any finite curve: its first node moved
@@ -437,6 +448,10 @@ CLI_SPECS = {
     "estimate": (["estimate", "--chi", "0.3", "--json"], ["--chi", "--length", "--mass", "--g", "--N"]),
     "estimate(separation)": (["estimate", "--json"], ["--separation"]),
     "estimate(curvature)": (["estimate", "--json"], ["--curvature"]),
+    "estimate(links)": (["estimate", "--chi", "0.3", "--links", "100", "--json"], ["--links", "--tip-mass"]),
+    "design": (["design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--tip-mass",
+                "0", "--json"], ["--max-tension", "--max-speed", "--max-acceleration", "--length", "--mass", "--g",
+                                 "--links", "--tip-mass"]),
     "simulate": (_SIM, ["--chi", "--N", "--tol", "--dt0", "--t-end", "--stop-fraction", "--snapshot-times",
                         "--record-thin", "--checkpoint-every", "--max-link-error", "--max-energy-drift", "--dt-min",
                         "--max-rejections"]),
@@ -464,6 +479,9 @@ CLI_VALID = {
     ("simulate(fast)", "--pin-motion=pull:{},0", "0"), ("simulate(fast)", "--pin-motion=pull:{},0", "5e-324"),
     ("simulate(fast)", "--pin-motion=pull:{},0", "-1"), ("simulate(fast)", "--pin-motion=flick:1,0,{}", "1e308"),
     ("fit", "--tol", "5e-324"), ("fit", "--tol", "1e308"),
+    ("estimate(links)", "--tip-mass", "0"), ("estimate(links)", "--tip-mass", "5e-324"),
+    ("design", "--tip-mass", "0"), ("design", "--tip-mass", "5e-324"), ("design", "--max-tension", "1e308"),
+    ("design", "--max-speed", "1e308"), ("design", "--max-acceleration", "1e308"),
     ("fit", "--window=v_max={},1e-2", "5e-324"), ("fit", "--window=v_max=1e-4,{}", "1e308"),
 }
 #: a bound that cannot be met: the run fails by design (exit 1, one line on stderr)

@@ -29,7 +29,15 @@ from . import table as T
 from .estimates import Chain, DesignEstimate, attach_computed, check_tip_mass, design_estimate
 
 __all__ = ["LIMITS", "DesignRow", "DesignResult", "NoAdmissibleSeparation", "design", "print_design",
-           "plot_design", "simulate_estimate"]
+           "plot_design", "simulate_estimate", "computed_estimate", "TARGETS", "MAX_SECONDS"]
+
+#: the accuracy a computed estimate should have (relative): above it, a cheap run replaces the table
+TARGETS = {"v": 0.01, "a": 0.03, "sigma": 0.01}
+#: the longest run (CPU seconds, as the table measured its neighbours) that replaces the table by itself
+MAX_SECONDS = 10.0
+#: chains of at most this many links are always run (their peaks jump with chi between the table's
+#: points, where the leave-one-out bound cannot see it; a run costs milliseconds)
+FEW_LINKS = 48
 
 #: the limits: keyword -> (table quantity, Chain converter, unit, what)
 LIMITS = {
@@ -260,3 +268,38 @@ def simulate_estimate(chain: Chain, *, chi: float | None = None, separation: flo
                 "delta_kappa_m": p["delta_kappa_m"]}
     return attach_computed(est, computed, {k: float("nan") for k in ("v", "a", "sigma", "t_snap")},
                            source="simulation", links=links, tip_mass=tip_mass)
+
+
+def computed_estimate(chain: Chain, *, chi: float | None = None, separation: float | None = None,
+                      curvature: float | None = None, links: int, tip_mass: float = 0.0,
+                      max_seconds: float = MAX_SECONDS, progress: bool | None = None) -> DesignEstimate:
+    """The most accurate design estimate within ``max_seconds``: the table's interpolated peaks
+    (:func:`snapping.estimates.design_estimate` with ``links``) when their error bounds meet
+    :data:`TARGETS` (1% speed and tension, 3% acceleration), else one run of the fast method
+    (:func:`simulate_estimate`) when the table says such a run costs at most ``max_seconds``
+    (heavy tip masses, whose peaks jump between the table's points, cost a second or so), and
+    always for chains of at most :data:`FEW_LINKS` links (milliseconds), else the table's answer with a warning naming its bound.
+    Outside the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
+    max_seconds = V.real("max_seconds", max_seconds)
+    est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
+                          tip_mass=tip_mass)
+    over = {q: e for q, e in est.computed_errors.items() if q in TARGETS and not e <= TARGETS[q]}
+    few = est.links <= FEW_LINKS
+    if not over and not few:
+        return est
+    cost = float(T.load_table().values("cpu_s", est.nondim["chi"], est.links, est.tip_mass))
+    why = ", ".join(f"{q} +-{100 * e:.2g}%" for q, e in over.items())
+    if cost <= max_seconds:
+        sim = simulate_estimate(chain, chi=est.nondim["chi"], links=est.links, tip_mass=est.tip_mass,
+                                progress=progress)
+        reason = (f"a chain of {est.links} links snaps erratically between the table's separations" if few else
+                  f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
+                  f"acceleration)")
+        sim.warnings.insert(0, f"{reason}: the peaks are those of one run of the fast method (about {cost:.2g} "
+                               f"CPU s)")
+        return sim
+    if not over:
+        return est
+    est.warnings.insert(0, f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
+                           f"acceleration); one run of the fast method (--simulate) would take about {cost:.0f} s")
+    return est

@@ -40,7 +40,9 @@ def _add_estimate(sub) -> None:
         description=(
             "How big will the spike be? With --links (the chain's number of links) the answer\n"
             "leads with the computed peaks: the fast exact method's, interpolated from the table of\n"
-            "simulations shipped with snapping (milliseconds), with their error bound; then the\n"
+            "simulations shipped with snapping (milliseconds), with their error bound (where the\n"
+            "bound is above 1% speed and tension or 3% acceleration and a run costs under 10 s, as\n"
+            "for few-link chains and heavy tip masses, one run of the fast method instead); then the\n"
             "paper's design-rule estimators from the initial catenary alone, each with its error\n"
             "factor measured on the table. Give the end separation as a fraction --chi of the\n"
             "length, or in metres with --separation, or the initial maximum curvature in 1/m with\n"
@@ -52,6 +54,7 @@ def _add_estimate(sub) -> None:
             "  snapping estimate --separation 0.3 --links 100 --length 2 --mass 0.05\n"
             "  snapping estimate --separation 0.3 --links 100 --length 2 --mass 0.05 --tip-mass 0.1\n"
             "  snapping estimate --chi 0.03 --links 229 --simulate           # outside the table: run it\n"
+            "  snapping estimate --chi 0.3 --links 20 --table                # the table alone, never a run\n"
             "  snapping estimate --curvature 20 --length 1.022 --mass 0.0208 --json   # estimators only"
         ),
     )
@@ -70,9 +73,14 @@ def _add_estimate(sub) -> None:
     p.add_argument("--tip-mass", type=float, default=0.0, metavar="RATIO",
                    help="a point mass at the free end, as a ratio to the chain's mass (needs --links; table: 0 "
                         "to 1, for up to 1800 links)")
-    p.add_argument("--simulate", action="store_true",
-                   help="compute the peaks with one run of the fast method instead of the table (any chi, links, "
-                        "tip mass; seconds to minutes)")
+    how = p.add_mutually_exclusive_group()
+    how.add_argument("--simulate", action="store_true",
+                     help="compute the peaks with one run of the fast method instead of the table (any chi, "
+                          "links, tip mass; seconds to minutes)")
+    how.add_argument("--table", action="store_true",
+                     help="the table's interpolated peaks only, whatever their error bound (default: where the "
+                          "bound is above 1%% speed and tension or 3%% acceleration and a run costs under 10 s, "
+                          "one run of the fast method replaces them)")
     p.add_argument("--N", type=int, default=None, help="number of links for the delta_N = 1/N estimator only "
                                                        "(no computed peaks; use --links)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -118,7 +126,12 @@ def _cmd_estimate(args) -> int:
         est = simulate_estimate(chain, **where, links=args.links, tip_mass=args.tip_mass)
     else:
         try:
-            est = estimates.design_estimate(chain, **where, N=args.N, links=args.links, tip_mass=args.tip_mass)
+            if args.links is not None and not args.table:
+                from ..design import computed_estimate
+
+                est = computed_estimate(chain, **where, links=args.links, tip_mass=args.tip_mass)
+            else:
+                est = estimates.design_estimate(chain, **where, N=args.N, links=args.links, tip_mass=args.tip_mass)
         except table.OutsideTable as exc:
             raise table.OutsideTable(f"{exc}; add --simulate to compute this chain with one run of the fast "
                                      f"method instead") from None

@@ -8,6 +8,8 @@ import functools
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from .. import _validate as V
 from .catenary import (CHI_MIN, _A_MAX, _A_MIN, available_energy, catenary_parameter, check_chi,
                        chi_from_parameter, delta_crude, delta_kappa0, delta_N, whirling_rod)
@@ -345,29 +347,24 @@ def estimator_factors(table_path: str) -> dict:
     from .. import table as T
 
     ds = T.load_table(table_path).ds.isel(tip_mass=0)
-    names = {"v": "v_peak", "a": "a_peak", "sigma": "sigma_peak"}
-    ratios: dict = {s: {q: [] for q in names} for s in ("delta_kappa0", "delta_c", "delta_N", "delta_kappa_m")}
-    for chi in ds["chi"].values:
-        P = available_energy(float(chi))
-        fixed = {"delta_kappa0": delta_kappa0(float(chi)), "delta_c": delta_crude(float(chi))}
-        for N in ds["N"].values:
-            row = ds.sel(chi=chi, N=N)
-            scales = {**fixed, "delta_N": 1.0 / float(N), "delta_kappa_m": float(row["delta_kappa_m"])}
-            for s, d in scales.items():
-                if not (math.isfinite(d) and d > 0):
-                    continue
-                pred = whirling_rod(P, d)
-                for q, var in names.items():
-                    c = float(row[var])
-                    if math.isfinite(c) and c > 0:
-                        ratios[s][q].append(pred[q] / c)
+    chis = [float(c) for c in ds["chi"].values]
+    N = ds["N"].values.astype(float)
+    P = np.array([available_energy(c) for c in chis])[:, None]
+    scales = {"delta_kappa0": np.array([delta_kappa0(c) for c in chis])[:, None] + 0.0 * N,
+              "delta_c": np.array([delta_crude(c) for c in chis])[:, None] + 0.0 * N,
+              "delta_N": 1.0 / N + 0.0 * P,
+              "delta_kappa_m": np.asarray(ds["delta_kappa_m"].values, float)}
     out = {}
-    for s, per in ratios.items():
-        out[s] = {}
-        for q, r in per.items():
-            if r:
-                lr = [math.log(x) for x in r]
-                out[s][q] = (math.exp(sum(lr) / len(lr)), min(r), max(r))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for s, d in scales.items():
+            v = np.sqrt(6.0 * P / d)  # the whirling rod (whirling_rod), on the whole grid at once
+            pred = {"v": v, "a": v * v / d, "sigma": 0.5 * v * v}
+            out[s] = {}
+            for q, var in (("v", "v_peak"), ("a", "a_peak"), ("sigma", "sigma_peak")):
+                r = pred[q] / np.asarray(ds[var].values, float)
+                r = r[np.isfinite(r) & (r > 0)]
+                if r.size:
+                    out[s][q] = (float(np.exp(np.mean(np.log(r)))), float(r.min()), float(r.max()))
     return out
 
 

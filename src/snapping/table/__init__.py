@@ -2,18 +2,21 @@
 
 The file ``snapping/data/snap_table.nc`` (built by :mod:`snapping.table.build`, whose
 command, CPU time and machine are in its attributes) holds, over a grid of end
-separations chi (0.05 to 0.9) x numbers of links N (10 to 10000, the paper's 229 among
-them) x tip-mass ratios (0 to 1, for N up to ``n_tip_max``), the peak speed,
-acceleration and tension of the free end's snap, the peak curvature, the snapping time
-and the regularising scale delta_kappa_m, each from one run of
-:func:`snapping.simulate.run` (method ``fast``: exactly inextensible, tol 1e-6).
+separations chi (0.05 to 0.9) x numbers of links N (every N from 10 to 48, then about
+2^(1/4) apart up to 1800 and sqrt(2) apart to 10000; the paper's 229 among them) x
+tip-mass ratios (0 to 1, for N up to ``n_tip_max``), the peak speed, acceleration and
+tension of the snap, the snapping time, the regularising scale delta_kappa_m and the
+run's CPU time, each from one run of :func:`snapping.simulate.run` (method ``fast``:
+exactly inextensible, tol 1e-6).
 
-:func:`lookup` interpolates them (cubic splines of the logarithm of each quantity in
-log chi, log N and asinh(tip_mass / 0.001)) in well under a millisecond, with an
-error bound: at each grid point, the sum over the axes of the relative error of a
-spline through the line's other points (leave one out, i.e. at twice the grid
-spacing: an overestimate for smooth data, the real size for data with wiggles);
-the bound of a query is the largest of the bounds at the corners of its cell.
+:func:`lookup` interpolates them (tensor-product piecewise cubics, 4-point Lagrange,
+of the logarithm of each quantity in log chi, log N and asinh(tip_mass / 0.001)) in a
+millisecond or so, with an error bound: along each axis where the query is not on a
+grid point, the largest leave-one-out error of that axis at the corners of its cell
+(the relative error, at a grid point, of the same interpolation through the line's
+other points: the interpolation at twice the spacing, an overestimate for smooth peaks
+and the real size of wiggles), summed over the axes, times :data:`BOUND_FACTOR`. A point
+on the grid is exact.
 
 Everything is nondimensional (length L, mass M, g: speed sqrt(g L), acceleration g,
 tension M g, time sqrt(L/g)); :mod:`snapping.estimates` and :mod:`snapping.design`
@@ -35,15 +38,20 @@ import numpy as np
 from .. import _validate as V
 
 __all__ = ["TABLE_FILE", "QUANTITIES", "ERROR_QUANTITIES", "OutsideTable", "Table", "TablePeaks", "load_table",
-           "lookup", "leave_one_out", "TIP_SCALE"]
+           "lookup", "leave_one_out", "TIP_SCALE", "BOUND_FACTOR"]
 
 #: the shipped table (package data)
 TABLE_FILE = Path(__file__).resolve().parent.parent / "data" / "snap_table.nc"
 
-#: the interpolated quantities (all positive)
-QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v", "delta_kappa_m")
-#: the quantities with a stored error bound
+#: the interpolated quantities (all positive; cpu_s: the CPU time of the run, what a simulation of the point costs)
+QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v", "delta_kappa_m", "cpu_s")
+#: the quantities with an error bound
 ERROR_QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v")
+
+#: the error bound is this many times the leave-one-out errors: the peaks of a discrete chain carry a
+#: wiggle of a link's period (the tension at small chi: +-1.5% from one N to the next), which a query
+#: between grid points can meet with either sign (calibrated with benchmarks/bench_table.py)
+BOUND_FACTOR = 2.0
 
 #: the tip-mass axis is interpolated in asinh(tip_mass / TIP_SCALE): log-like above 0.001, linear through 0
 TIP_SCALE = 1e-3
@@ -182,10 +190,10 @@ class Table:
         return {"chi": (float(self.chi[0]), float(self.chi[-1])), "N": (int(self.N[0]), int(self.N[-1])),
                 "tip_mass": (float(self.tip[0]), float(self.tip[-1])), "n_tip_max": self.n_tip_max}
 
-    def check(self, chi, N, tip_mass=0.0) -> None:
+    def check(self, chi, links, tip_mass=0.0) -> None:
         """Raise :class:`OutsideTable` (naming the input and the range) unless the point is inside."""
         r = self.ranges
-        chi_a, N_a, tip_a = (np.atleast_1d(np.asarray(v, float)) for v in (chi, N, tip_mass))
+        chi_a, N_a, tip_a = (np.atleast_1d(np.asarray(v, float)) for v in (chi, links, tip_mass))
         for name, a, (lo, hi) in (("chi", chi_a, r["chi"]), ("links", N_a, r["N"]),
                                   ("tip_mass", tip_a, r["tip_mass"])):
             bad = a[~((a >= lo) & (a <= hi))]
@@ -221,14 +229,14 @@ class Table:
         for d, err in enumerate(errs):
             worst = np.max([err[idx] for idx in corners], axis=0)
             out += np.where(st[d][3][:, None], 0.0, worst)
-        return out
+        return BOUND_FACTOR * out
 
-    def evaluate(self, chi, N, tip_mass=0.0):
-        """Every quantity at the points (chi, N, tip_mass) (arrays broadcast, checked to lie
+    def evaluate(self, chi, links, tip_mass=0.0):
+        """Every quantity at the points (chi, links, tip_mass) (arrays broadcast, checked to lie
         inside the table): ``(values, errors)``, dicts of arrays by quantity (errors: relative
         bounds of :data:`ERROR_QUANTITIES`)."""
-        self.check(chi, N, tip_mass)
-        chi_b, N_b, tip_b = np.broadcast_arrays(*(np.asarray(v, float) for v in (chi, N, tip_mass)))
+        self.check(chi, links, tip_mass)
+        chi_b, N_b, tip_b = np.broadcast_arrays(*(np.asarray(v, float) for v in (chi, links, tip_mass)))
         shape = chi_b.shape
         x, y, z = (c.ravel() for c in _coords(chi_b, N_b, tip_b))
         out = np.full((x.size, len(QUANTITIES)), np.nan)
@@ -245,22 +253,22 @@ class Table:
         errors = {q: err[:, i].reshape(shape) for i, q in enumerate(ERROR_QUANTITIES)}
         return values, errors
 
-    def values(self, q: str, chi, N, tip_mass=0.0, *, with_error: bool = False):
-        """Quantity ``q`` interpolated at (chi, N, tip_mass) (arrays broadcast), and its
+    def values(self, q: str, chi, links, tip_mass=0.0, *, with_error: bool = False):
+        """Quantity ``q`` interpolated at (chi, links, tip_mass) (arrays broadcast), and its
         relative error bound if ``with_error`` (NaN for a quantity without one)."""
         if q not in QUANTITIES:
             raise V.SnappingInputError(f"quantity={q!r} is not one of {QUANTITIES}")
-        values, errors = self.evaluate(chi, N, tip_mass)
+        values, errors = self.evaluate(chi, links, tip_mass)
         v = values[q]
         e = errors.get(q, np.full(v.shape, np.nan))
         if not v.shape:
             v, e = float(v), float(e)
         return (v, e) if with_error else v
 
-    def lookup(self, chi: float, N: int, tip_mass: float = 0.0) -> TablePeaks:
-        """Every quantity at one point, with the error bounds."""
+    def lookup(self, chi: float, links: int, tip_mass: float = 0.0) -> TablePeaks:
+        """Every quantity at one point (``links``: the number of links N), with the error bounds."""
         chi = V.real("chi", chi)
-        N = V.integer("links", N, 1)
+        N = V.integer("links", links, 1)
         tip_mass = V.real("tip_mass", tip_mass)
         values, errors = self.evaluate(chi, N, tip_mass)
         return TablePeaks(chi=chi, N=N, tip_mass=tip_mass, values={q: float(v) for q, v in values.items()},
@@ -283,7 +291,7 @@ def load_table(path=None) -> Table:
     return _load(str(TABLE_FILE if path is None else V.file_path("path", path)))
 
 
-def lookup(chi: float, N: int, tip_mass: float = 0.0) -> TablePeaks:
-    """The shipped table's peaks at (chi, N, tip_mass) with their error bounds
+def lookup(chi: float, links: int, tip_mass: float = 0.0) -> TablePeaks:
+    """The shipped table's peaks at (chi, links, tip_mass) with their error bounds
     (:meth:`Table.lookup`); :class:`OutsideTable` outside its range."""
-    return load_table().lookup(chi, N, tip_mass)
+    return load_table().lookup(chi, links, tip_mass)

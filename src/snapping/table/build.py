@@ -43,7 +43,7 @@ CHI = (0.05, 0.06, 0.07, 0.08, 0.09, 0.10, 0.115, 0.13, 0.15, 0.175, 0.20, 0.23,
 N_LINKS = (*range(10, 49), 57, 68, 80, 95, 113, 135, 160, 190, 229, 270, 320, 380, 450, 540, 640, 760, 900, 1070,
            1280, 1520, 1800, 2560, 3600, 5000, 7100, 10000)
 #: tip-mass ratios (point mass at the free end / chain mass)
-TIP_MASS = (0.0, 0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0)
+TIP_MASS = (0.0, 0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 0.7, 1.0)
 #: the tip-mass axis is computed for N up to this (a tip mass above 0 with more links is outside the table)
 N_TIP_MAX = 1800
 
