@@ -74,8 +74,16 @@ from . import angles as AG
 from . import kernels as K
 
 #: rows between power-of-two rescalings of the leading minors (node masses within a factor
-#: 1e12 of each other keep them far from overflow: |p_j/p_{j-1}| <= 2 max(1/m))
+#: 1e12 of each other keep them far from overflow: |p_j/p_{j-1}| <= 2 max(1/m), and a block
+#: stays inside the range of :func:`_pow2_near` while 2 max(1/m) < 2^60 and min(1/m) > 2^-63)
 BLOCK = 16
+#: 2^52 + 1: Veltkamp's splitting constant that keeps one significant bit (:func:`_pow2_near`)
+_SPLIT1 = 4503599627370497.0
+#: array indices in the hot loops of :func:`general_rhs` are cast to this unsigned type:
+#: numba indexes with a signed integer through a wraparound select (negative counts from the
+#: end), which costs integer work, a register for each array's length and spills in loops
+#: that touch ten arrays; an unsigned index is used as it is (the indices here are >= 0)
+_U = np.uint64
 
 __all__ = [
     "Work", "make_model", "general_rhs", "general_measure", "model_rhs", "model_measure", "pin_kinematics",
@@ -208,6 +216,15 @@ def pin_kinematics(t, par, tab):
     return x, y, vx, vy, axx, ayy
 
 
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def _pow2_near(x):
+    """The power of two nearest x, with x's sign (x rounded to one significant bit by
+    Veltkamp's splitting; exact in round-to-nearest for 2^-1022 <= |x| < 2^970): a few
+    inlined flops where ``math.frexp``/``math.ldexp`` are two calls into the runtime."""
+    v = x * _SPLIT1
+    return v - (v - x)
+
+
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab):
     """Derivative ``f = [theta', theta'', W']`` of the state ``y`` (length 2N + 1) at time t.
@@ -218,12 +235,14 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab
     pivots as ratios of leading minors, ``p_j = b_j p_{j-1} - e_{j-1}^2 p_{j-2}`` and
     ``q_j = r_j p_{j-1} - e_{j-1} q_{j-1}`` (no division in the recurrence, so that the
     divisions ``1/p_j`` pipeline; as :func:`snapping.simulate.angles.angle_rhs`), rescaled
-    by a power of two every ``BLOCK`` rows; pass 2: back substitution fused with the
-    angular accelerations.
+    by a power of two every ``BLOCK`` rows (any power of two: the recurrences are
+    homogeneous in (p, q), so the results do not depend on which, to the bit); pass 2:
+    back substitution fused with the angular accelerations. The loops index with unsigned
+    integers (``_U``), which numba uses without its wraparound select.
     """
     AG.sincos(N, y, c, s)
-    for j in range(N):
-        f[j] = y[N + j]
+    for jj in range(N):
+        f[_U(jj)] = y[_U(N + jj)]
     g = par[P_G]
     px, py, pvx, pvy, pax, pay = pin_kinematics(t, par, tab)
     ex = pax
@@ -245,28 +264,29 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab
     j0 = 0
     while j0 < N - 1:
         j1 = min(j0 + BLOCK, N - 1)
-        for j in range(j0, j1):
-            cj = c[j]
-            sj = s[j]
-            cn = c[j + 1]
-            sn = s[j + 1]
+        for jj in range(j0, j1):
+            i = _U(jj)  # (row j = jj)
+            i1 = _U(jj + 1)
+            cj = c[i]
+            sj = s[i]
+            cn = c[i1]
+            sn = s[i1]
             C = cn * cj + sn * sj
-            imn = invm[j + 1]
-            S[j] = (sn * cj - cn * sj) * imn
-            w = y[N + j]
-            r = -h[j] * (w * w)
+            imn = invm[i1]
+            S[i] = (sn * cj - cn * sj) * imn
+            w = y[_U(N + jj)]
+            r = -h[i] * (w * w)
             p = -(im + imn) * pm - (eprev * eprev) * pmm
             q = r * pm - eprev * q
             e = C * imn
             inv = 1.0 / p
-            cp[j] = e * pm * inv
-            dp[j] = q * inv
+            cp[i] = e * pm * inv
+            dp[i] = q * inv
             pmm = pm
             pm = p
             eprev = e
             im = imn
-        ex2 = math.frexp(pm)[1]
-        sc = math.ldexp(1.0, -ex2)
+        sc = 1.0 / _pow2_near(pm)  # (exact: the reciprocal of a power of two)
         pm *= sc
         pmm *= sc
         q *= sc
@@ -286,11 +306,12 @@ def general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab
     f[N + jl] = ((ey * c[jl] - ex * s[jl]) - S[j] * Tj) * invh[jl]
     Tnn = Tn  # T_{j+2}
     Tn = Tj
-    for j in range(N - 3, -1, -1):
-        Tj = dp[j] - cp[j] * Tn
-        sig[j] = Tj
-        k = j + 1
-        f[N + k] = (S[k] * Tnn - S[j] * Tj) * invh[k]
+    for jj in range(N - 3, -1, -1):
+        i = _U(jj)  # (row j = jj; link k = jj + 1)
+        i1 = _U(jj + 1)
+        Tj = dp[i] - cp[i] * Tn
+        sig[i] = Tj
+        f[_U(N + jj + 1)] = (S[i1] * Tnn - S[i] * Tj) * invh[i1]
         Tnn = Tn
         Tn = Tj
     f[N] = S[0] * Tnn * invh[0]
