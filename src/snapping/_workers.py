@@ -9,9 +9,9 @@ its checkpoint), and a watchdog thread that ends the worker when its parent is g
 from __future__ import annotations
 
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
-__all__ = ["local_pool", "stop_pool", "worker_init", "stopped", "WORKER_PID_FILE_ENV"]
+__all__ = ["local_pool", "stop_pool", "run_all", "worker_init", "stopped", "WORKER_PID_FILE_ENV"]
 
 #: test hook: a path to which each local worker process appends its pid when it starts
 WORKER_PID_FILE_ENV = "SNAPPING_SWEEP_WORKER_PID_FILE"
@@ -89,3 +89,22 @@ def stop_pool(stop, futures) -> None:
     stop.set()
     for fut in futures:
         fut.cancel()
+
+
+def run_all(n: int, fn, calls, collect) -> None:
+    """Call ``fn(*args)`` for every ``args`` of ``calls`` in ``n`` local workers
+    (:func:`local_pool`); ``collect(args, result)`` is called in this process as each
+    finishes (``result()`` returns its value or raises its exception). An interruption
+    (SIGINT) or an exception in ``collect`` stops the pool (:func:`stop_pool`: nothing
+    queued starts, runs in progress save their checkpoints) and propagates."""
+    pool, stop = local_pool(n)
+    futures = {}
+    try:
+        futures = {pool.submit(fn, *args): args for args in calls}
+        for fut in as_completed(futures):
+            collect(futures[fut], fut.result)
+    except BaseException:
+        stop_pool(stop, futures)
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)

@@ -265,22 +265,16 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
                 print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} ({rows[k]['n_links']} links) done in "
                       f"{rows[k]['wall_time']:.1f} s", file=sys.stderr, flush=True)
     else:
-        from concurrent.futures import as_completed
-
         from . import _workers
 
-        pool, stop = _workers.local_pool(min(workers, len(jobs)))  # workers leave with this process
-        with pool:
-            futs = {pool.submit(_run_level, job): k for k, job in enumerate(jobs)}
-            try:
-                for f in as_completed(futs):
-                    k = futs[f]
-                    rows[k], _ = f.result()
-                    if progress:
-                        print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} done", file=sys.stderr, flush=True)
-            except BaseException:
-                _workers.stop_pool(stop, futs)
-                raise
+        def collect(args, result):
+            k = jobs.index(args[0])
+            rows[k], _ = result()
+            if progress:
+                print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} done", file=sys.stderr, flush=True)
+
+        # (workers leave with this process)
+        _workers.run_all(min(workers, len(jobs)), _run_level, [(job,) for job in jobs], collect)
     ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
     if output is not None:
         from .simulate import save

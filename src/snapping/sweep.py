@@ -25,7 +25,6 @@ import hashlib
 import json
 import os
 import time
-from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -529,18 +528,8 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble, l
             if n == 1:
                 for task in tasks:
                     collect(task, lambda task=task: _run_task(task))
-            else:
-                pool, stop = _workers.local_pool(n)
-                futures = {}
-                try:
-                    futures = {pool.submit(_run_task, task): task for task in tasks}
-                    for fut in as_completed(futures):
-                        collect(futures[fut], fut.result)
-                except BaseException:  # SIGINT: stop promptly, the runs in progress saved
-                    _workers.stop_pool(stop, futures)
-                    raise
-                finally:
-                    pool.shutdown(wait=True, cancel_futures=True)
+            else:  # (SIGINT: stops promptly, the runs in progress saved)
+                _workers.run_all(n, _run_task, [(task,) for task in tasks], lambda args, res: collect(args[0], res))
     finally:
         bar.close()
     paths = grid.paths(out)

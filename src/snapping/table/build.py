@@ -24,7 +24,6 @@ import os
 import platform
 import sys
 import time
-from concurrent.futures import as_completed
 from pathlib import Path
 
 import numpy as np
@@ -153,17 +152,7 @@ def build(ledger, *, workers: int | None = None, progress: bool = True, log=None
                     for p in todo:
                         record(run_point(*p))
                 else:
-                    pool, stop = _workers.local_pool(n)
-                    futures = {}
-                    try:
-                        futures = {pool.submit(run_point, *p): p for p in todo}
-                        for fut in as_completed(futures):
-                            record(fut.result())
-                    except BaseException:
-                        _workers.stop_pool(stop, futures)
-                        raise
-                    finally:
-                        pool.shutdown(wait=True, cancel_futures=True)
+                    _workers.run_all(n, run_point, todo, lambda args, res: record(res()))
             finally:
                 bar.close()
     return done
