@@ -186,7 +186,7 @@ def test_sweep_resumes_checkpointed_runs_and_restarts_broken_ones(tmp_path, smal
     p_bad.write_bytes(b"\x89HDF\r\n\x1a\n truncated")
     assert is_resumable(p_int, chi=0.4, N=30, tol=1e-7) and not is_resumable(p_bad)
     calls = []
-    real_resume, real_run = stepper.resume, stepper.run
+    real_resume, real_run = resume, run  # (snapping.simulate's, the names the sweep calls)
     monkeypatch.setattr("snapping.simulate.resume", lambda *a, **k: calls.append("resume") or real_resume(*a, **k))
     monkeypatch.setattr("snapping.simulate.run", lambda *a, **k: calls.append("run") or real_run(*a, **k))
     paths = S.run_sweep(grid, tmp_path, workers=1, progress=False)

@@ -294,7 +294,8 @@ def test_cli_simulate_json_and_table(tmp_path, capsys):
 
 # ---------------------------------------------------------------- docstring examples
 @pytest.mark.parametrize(
-    "name", ["snapping.simulate", "snapping.simulate.chain", "snapping.simulate.driver", "snapping.simulate.dataset"]
+    "name", ["snapping.simulate", "snapping.simulate.chain", "snapping.simulate.driver", "snapping.simulate.resuming",
+             "snapping.simulate.dataset"]
 )
 def test_simulate_docstring_examples(name):
     import doctest

@@ -151,10 +151,10 @@ def _cmd_simulate(args) -> int:
                 result = simulate.resume(args.resume, output=args.output, progress=progress,
                                          checkpoint_every=args.checkpoint_every, overwrite=args.overwrite,
                                          expect=expect)
-            except simulate.driver.ResumeMismatch as exc:
+            except simulate.resuming.ResumeMismatch as exc:
                 opt = "--" + exc.key.replace("_", "-")
-                raise simulate.driver.ResumeMismatch(exc.key, _given_text(args, exc.key), exc.stored, exc.path,
-                                                     option=opt) from None
+                raise simulate.resuming.ResumeMismatch(exc.key, _given_text(args, exc.key), exc.stored, exc.path,
+                                                       option=opt) from None
             args.output = result.path
             args.chi, args.N = float(result.dataset.attrs["chi"]), int(result.dataset.attrs["N"])
             if str(result.dataset.attrs.get("initial")) == "problem":

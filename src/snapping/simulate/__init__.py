@@ -16,8 +16,9 @@ Layout (what is solved, how it is stepped, what is recorded, kept apart):
 * ``methods``: the table of methods, ``methods.euler_richardson`` and
   ``methods.dop853`` (with ``rk``, the compiled DOP853 loop): how a run is stepped;
 * ``options``: :class:`RunOptions`, the validated options every method shares;
-* ``driver``: the one loop for every method (:func:`run`, :func:`resume`, stop rules,
-  progress, signals, checkpoints); ``errors``: the failures;
+* ``driver``: the one loop for every method (:func:`run`, stop rules, progress, signals,
+  checkpoints); ``resuming``: continuing a run from its checkpoint (:func:`resume`,
+  :func:`is_resumable`); ``errors``: the failures;
 * ``dataset``: building, saving and loading the run Dataset; ``ensemble``: several
   chains in one vectorised kernel.
 
@@ -31,12 +32,13 @@ Example
 
 from .chain import ChainState, curvature_profile, evaluate, initial_state, link_arclength, node_arclength
 from .dataset import Run, build_dataset, initial_from_dataset, inputs_from_attrs, load_run, save, summary
-from .driver import METHODS, integrate_fixed, is_resumable, rerun, resume, run
+from .driver import METHODS, integrate_fixed, rerun, run
 from .ensemble import run_ensemble
 from .errors import (DriftError, EnergyDriftError, NonFiniteError, RejectionError, RunInterrupted, SimulationError,
                      StepSizeError)
 from .options import RunOptions, memory_need
 from .problem import Links, PinMotion, Problem
+from .resuming import is_resumable, resume
 
 __all__ = [
     "run",
