@@ -53,19 +53,6 @@ CHECKPOINT_VERSION = 2
 #: test hook: called with the engine after every return of the compiled loop; may
 #: return a signal number to act as if that signal had arrived
 _chunk_hook = None
-#: names that moved to :mod:`snapping.simulate.resuming` (which imports this module, so they
-#: are not imported here): ``driver.resume`` etc. still resolve, through :func:`__getattr__`
-_MOVED_TO_RESUMING = ("resume", "is_resumable", "ResumeMismatch")
-
-
-def __getattr__(name):
-    if name in _MOVED_TO_RESUMING:
-        from . import resuming
-
-        return getattr(resuming, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 def _resolve_problem(chi, N, chords, initial, problem, method):
     """(chi, N, chords, initial, problem) of a run given a Problem: the paper's problem
     becomes (chi, N, chords) (today's runs, bit for bit); a uniform chain with a fixed held
