@@ -295,11 +295,11 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
         reason = (f"a chain of {est.links} links snaps erratically between the table's separations" if few else
                   f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
                   f"acceleration)")
-        sim.warnings.insert(0, f"{reason}: the peaks are those of one run of the fast method (about {cost:.2g} "
-                               f"CPU s)")
+        sim.computed_note = f"{reason}: the peaks are those of one run of the fast method (about {cost:.2g} CPU s)"
         return sim
     if not over:
         return est
-    est.warnings.insert(0, f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
-                           f"acceleration); one run of the fast method (--simulate) would take about {cost:.0f} s")
+    est.computed_note = (f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
+                         f"acceleration); one run of the fast method (simulate_estimate, snapping estimate "
+                         f"--simulate) would take about {cost:.0f} s")
     return est

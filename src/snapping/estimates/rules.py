@@ -4,7 +4,6 @@ fast exact runs, :mod:`snapping.table`)."""
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 
@@ -126,6 +125,8 @@ class DesignEstimate:
     computed: dict | None = None
     computed_errors: dict = field(default_factory=dict)
     computed_source: str = ""
+    computed_note: str = ""
+    factor_span: str = ""
     factors: dict = field(default_factory=dict)
     factor_ranges: dict = field(default_factory=dict)
 
@@ -142,6 +143,7 @@ class DesignEstimate:
         if self.computed is not None:
             out.update(links=self.links, tip_mass=self.tip_mass, computed=dict(self.computed),
                        computed_errors=dict(self.computed_errors), computed_source=self.computed_source,
+                       computed_note=self.computed_note,
                        factors={k: dict(v) for k, v in self.factors.items()},
                        factor_ranges={k: {q: list(r) for q, r in v.items()} for k, v in self.factor_ranges.items()})
         return out
@@ -329,8 +331,10 @@ def attach_computed(est: DesignEstimate, computed: dict, errors: dict, *, source
     from .. import table as T
 
     try:
-        est.factor_ranges = estimator_factors(str(T.TABLE_FILE if table is None else table))
-    except (V.SnappingInputError, OSError):  # no table (a simulated estimate without one): no ranges
+        est.factor_ranges = estimator_factors(links, tip_mass, table)
+        lo, hi = T.load_table(table).ranges["chi"]
+        est.factor_span = f"{lo:g} to {hi:g}"
+    except (T.OutsideTable, OSError):  # a simulated chain outside the table: no ranges
         est.factor_ranges = {}
     if tip_mass:
         est.warnings.append(f"the paper's estimators below take no tip mass into account (tip mass "
@@ -338,30 +342,30 @@ def attach_computed(est: DesignEstimate, computed: dict, errors: dict, *, source
     return est
 
 
-@functools.lru_cache(maxsize=4)
-def estimator_factors(table_path: str) -> dict:
-    """(geometric mean, min, max) over the table (tip mass 0) of the ratio of each of
-    the paper's estimators' whirling-rod peak to the computed one, for v, a and sigma:
-    ``{scale: {q: (mean, lo, hi)}}`` (scales delta_kappa0, delta_c, delta_N and
-    delta_kappa_m, the last as measured on each run)."""
+def estimator_factors(links: int, tip_mass: float = 0.0, table=None) -> dict:
+    """(geometric mean, min, max), over the table's separations chi for a chain of ``links``
+    links and ``tip_mass``, of the ratio of each of the paper's estimators' whirling-rod
+    peak to the computed one, for v, a and sigma: ``{scale: {q: (mean, lo, hi)}}`` (scales
+    delta_kappa0, delta_c, delta_N and delta_kappa_m, the last as measured on the runs).
+    How far off each estimator is for this chain, whatever its separation."""
     from .. import table as T
 
-    ds = T.load_table(table_path).ds.isel(tip_mass=0)
-    chis = [float(c) for c in ds["chi"].values]
-    N = ds["N"].values.astype(float)
-    P = np.array([available_energy(c) for c in chis])[:, None]
-    scales = {"delta_kappa0": np.array([delta_kappa0(c) for c in chis])[:, None] + 0.0 * N,
-              "delta_c": np.array([delta_crude(c) for c in chis])[:, None] + 0.0 * N,
-              "delta_N": 1.0 / N + 0.0 * P,
-              "delta_kappa_m": np.asarray(ds["delta_kappa_m"].values, float)}
+    tab = T.load_table(table)
+    chis = [float(c) for c in tab.chi]
+    values, _ = tab.evaluate(np.array(chis), links, tip_mass)
+    P = np.array([available_energy(c) for c in chis])
+    scales = {"delta_kappa0": np.array([delta_kappa0(c) for c in chis]),
+              "delta_c": np.array([delta_crude(c) for c in chis]),
+              "delta_N": np.full(len(chis), 1.0 / links),
+              "delta_kappa_m": values["delta_kappa_m"]}
     out = {}
     with np.errstate(invalid="ignore", divide="ignore"):
         for s, d in scales.items():
-            v = np.sqrt(6.0 * P / d)  # the whirling rod (whirling_rod), on the whole grid at once
+            v = np.sqrt(6.0 * P / d)  # the whirling rod (whirling_rod), at every chi at once
             pred = {"v": v, "a": v * v / d, "sigma": 0.5 * v * v}
             out[s] = {}
             for q, var in (("v", "v_peak"), ("a", "a_peak"), ("sigma", "sigma_peak")):
-                r = pred[q] / np.asarray(ds[var].values, float)
+                r = pred[q] / values[var]
                 r = r[np.isfinite(r) & (r > 0)]
                 if r.size:
                     out[s][q] = (float(np.exp(np.mean(np.log(r)))), float(r.min()), float(r.max()))
@@ -389,13 +393,15 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
     line(chain)
     line()
     if est.computed is not None:
-        how = ("interpolated from the table of fast exact runs (snapping.table); error bound from held-out grid "
-               "points" if est.computed_source == "table" else "one run of the fast exact method (tol 1e-6)")
-        line(f"Computed peaks ({how})")
+        how = ("interpolated from the table of fast exact runs (snapping.table), error bound from held-out grid "
+               "points" if est.computed_source == "table" else "one run of the fast exact method, tol 1e-6")
+        line(f"Computed peaks: {how}")
         line(f"  {'quantity':<20} {'SI':>12} {'':<6} {'error':>9} {'nondimensional':>15}")
         for k, (_, sik, _conv, label, unit) in COMPUTED.items():
             line(f"  {label:<20} {si['computed'][sik]:>12.4g} {unit:<6} {_pct(est.computed_errors.get(k, math.nan)):>9} "
                  f"{est.computed[k]:>15.5g}")
+        if est.computed_note:
+            line(f"  note: {est.computed_note}")
         line()
     line(f"  {'quantity':<34} {'nondimensional':>15} {'SI':>15}")
     rows = [
@@ -427,9 +433,10 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
         line("within an order of magnitude; delta_kappa_m (needs a run: snapping fit) is the most accurate.")
         line("Give --links N (the chain's number of links) for the computed peaks.")
         return
-    line("Error factors: estimate / computed peak, here and (geometric mean [min, max]) over the table")
-    line(f"  {'scale':<14} {'v here':>7} {'a here':>8} {'sigma here':>10} | {'v over the table':>22} "
-         f"{'a over the table':>22} {'sigma over the table':>22}")
+    line(f"Error factors: estimate / computed peak, here and (geometric mean [min, max]) over the table's "
+         f"separations chi {est.factor_span} for this chain")
+    line(f"  {'scale':<14} {'v here':>7} {'a here':>8} {'sigma here':>10} | {'v over chi':>22} "
+         f"{'a over chi':>22} {'sigma over chi':>22}")
     for name, f in est.factors.items():
         rng = est.factor_ranges.get(name, {})
         cells = [f"{r[0]:.2g} [{r[1]:.2g}, {r[2]:.2g}]" if r else "-" for r in (rng.get(q) for q in ("v", "a", "sigma"))]
