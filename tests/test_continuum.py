@@ -101,6 +101,9 @@ def test_converge_small_study_keeps_its_invariants(tmp_path):
     again = converge(0.5, levels=3, first=-2, output=tmp_path / "conv")  # resumed: the same levels
     assert np.array_equal(again.dataset.v_peak.values, ds.v_peak.values)
     assert again.dataset.attrs["wall_time_total"] < ds.attrs["wall_time_total"] + 1.0
+    # each level's CPU time where it ran (NaN where it was resumed: not measured again)
+    assert np.all(ds.cpu_time.values > 0) and np.all(np.isnan(again.dataset.cpu_time.values))
+    assert "CPU s" in c.table()
     assert "converged" in ds.attrs["verdict"]
     # the figure of a study alone (no uniform chains beside it), as `snapping converge --plot` draws it
     png = tmp_path / "conv.png"

@@ -145,10 +145,11 @@ class Convergence:
         lines = [f"continuum limit, chi = {ds.attrs['chi']:g} ({ds.attrs['lumping']} lumping, "
                  f"free end {ds.attrs['free_end']}):",
                  f"{'level':>5} {'links':>7} {'frac':>8} {'h_min':>8} " + " ".join(f"{q:>13}" for q in QUANTITIES)
-                 + f" {'wall s':>7}"]
+                 + f" {'wall s':>7} {'CPU s':>7}"]
         for k in range(ds.sizes["level"]):
             lines.append(f"{k:5d} {int(ds.n_links[k]):7d} {float(ds.frac[k]):8.3g} {float(ds.h_min[k]):8.2g} "
-                         + " ".join(f"{float(ds[q][k]):13.8g}" for q in QUANTITIES) + f" {float(ds.wall_time[k]):7.2f}")
+                         + " ".join(f"{float(ds[q][k]):13.8g}" for q in QUANTITIES) + f" {float(ds.wall_time[k]):7.2f}"
+                         + f" {float(ds.cpu_time[k]):7.2f}")
         lines.append(f"{'limit':>32} " + " ".join(f"{ds.attrs[q + '_limit']:13.8g}" for q in QUANTITIES))
         lines.append(f"{'+-':>32} " + " ".join(f"{ds.attrs[q + '_error']:13.2g}" for q in QUANTITIES))
         lines.append(f"{'order':>32} " + " ".join(f"{ds.attrs[q + '_order']:13.3g}" for q in QUANTITIES))
@@ -176,17 +177,19 @@ def _run_level(args):
             if (ds.attrs.get("status") == "completed" and "link_length" in ds.variables
                     and np.array_equal(ds.link_length.values, h) and float(ds.attrs["tol"]) == tol
                     and np.array_equal(ds.node_mass.values[:-1], problem.links.m)):
-                return _level_row(ds, h), path  # resumed: this level is done
+                return _level_row(ds, h, float("nan")), path  # resumed: this level is done (its CPU time unknown)
         except V.SnappingInputError:
             pass
+    cpu = time.process_time()  # this process's CPU time (the runs are single-threaded): honest under load
     ds = run(problem, method="fast", tol=tol, progress=False, output=path, overwrite=True).dataset  # own files
-    return _level_row(ds, h), path
+    return _level_row(ds, h, time.process_time() - cpu), path
 
 
-def _level_row(ds, h) -> dict:
+def _level_row(ds, h, cpu_time) -> dict:
     a = ds.attrs
     row = {q: float(a[q]) for q in QUANTITIES}
-    row.update({"n_links": int(h.size), "wall_time": float(a["wall_time"]), "n_rhs": int(a["n_rhs"]),
+    row.update({"n_links": int(h.size), "wall_time": float(a["wall_time"]), "cpu_time": cpu_time,
+                "n_rhs": int(a["n_rhs"]),
                 "energy_drift": float(a["energy_drift"]), "link_drift": float(a["link_drift"])})
     return row
 
@@ -207,8 +210,18 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         from two extrapolations).
     ratio : float
         Factor of every length scale of the grading from one level to the next, in (0, 1).
+        The error bar compares the extrapolations of the last two triples of levels, so the
+        last four levels must all be in the asymptotic range; the cost is dominated by the
+        finest (~``ratio**-2`` times the one before). A ratio closer to 1 from a finer
+        ``first`` keeps four levels within a narrower, asymptotic range of resolutions for
+        less cost: at chi = 0.05, ``ratio=2**-0.5, first=3`` (fractions 0.0141 to 0.005,
+        33 759 links at the finest) reaches relative error bars <= 3.2e-4 in ~230 s of CPU,
+        where ``ratio=0.5`` from level 0 needs a fifth level (67 490 links, 744 s in all):
+        its coarsest level (fraction 0.04, order 1.5-1.8 there) inflates the 4-level error
+        bars to 3e-3 and 4e-3 (``benchmarks/bench_continuum.py``).
     first : int
-        Index of the coarsest level (0: ``frac0, h_min0, h_max0``).
+        Index of the coarsest level (0: ``frac0, h_min0, h_max0``; level k has every length
+        scale times ``ratio**k``).
     lumping, free_end
         Mass lumping of the graded chains (:meth:`snapping.simulate.Links.graded`).
     tol : float
@@ -292,6 +305,8 @@ def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Datas
         "h_min": (lev, np.array([p["h_min"] for p in params]), {"long_name": "link length at the free end", "units": "1"}),
         "h_max": (lev, np.array([p["h_max"] for p in params]), {"long_name": "largest link length", "units": "1"}),
         "wall_time": (lev, np.array([r["wall_time"] for r in rows]), {"long_name": "wall time of the run", "units": "s"}),
+        "cpu_time": (lev, np.array([r["cpu_time"] for r in rows]),
+                     {"long_name": "CPU time of the run (its process; NaN where the level was resumed)", "units": "s"}),
         "n_rhs": (lev, np.array([r["n_rhs"] for r in rows]), {"long_name": "right-hand-side evaluations", "units": "1"}),
         "energy_drift": (lev, np.array([r["energy_drift"] for r in rows]), {"long_name": "max |E(t) - E(0)|", "units": "1"}),
         "link_drift": (lev, np.array([r["link_drift"] for r in rows]), {"long_name": "max relative link error", "units": "1"}),
