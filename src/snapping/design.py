@@ -29,7 +29,8 @@ from . import table as T
 from .estimates import Chain, DesignEstimate, attach_computed, check_tip_mass, design_estimate
 
 __all__ = ["LIMITS", "DesignRow", "DesignResult", "NoAdmissibleSeparation", "design", "print_design",
-           "plot_design", "simulate_estimate", "computed_estimate", "TARGETS", "MAX_SECONDS"]
+           "plot_design", "simulate_estimate", "computed_estimate", "run_instead", "TARGETS", "MAX_SECONDS",
+           "FEW_LINKS"]
 
 #: the accuracy a computed estimate should have (relative): above it, a cheap run replaces the table
 TARGETS = {"v": 0.01, "a": 0.03, "sigma": 0.01}
@@ -270,6 +271,30 @@ def simulate_estimate(chain: Chain, *, chi: float | None = None, separation: flo
                            source="simulation", links=links, tip_mass=tip_mass)
 
 
+def run_instead(chi: float, links: int, tip_mass: float, errors: dict, *,
+                max_seconds: float = MAX_SECONDS) -> tuple[bool, str]:
+    """Whether a run of the fast method should replace the table's peaks at this point
+    (``errors``: the table's relative bounds by v, a, sigma): ``(run, why)``. A run replaces
+    them for chains of at most :data:`FEW_LINKS` links, and where a bound is above
+    :data:`TARGETS` and the table says such a run costs at most ``max_seconds``; ``why`` is
+    empty when the table's peaks meet the targets."""
+    over = {q: e for q, e in errors.items() if q in TARGETS and not e <= TARGETS[q]}
+    few = links <= FEW_LINKS
+    if not over and not few:
+        return False, ""
+    cost = float(T.load_table().values("cpu_s", chi, links, tip_mass))
+    bound = ", ".join(f"{q} +-{100 * e:.2g}%" for q, e in over.items())
+    target = "the target (1% speed and tension, 3% acceleration)"
+    if cost <= max_seconds:
+        reason = (f"a chain of {links} links snaps erratically between the table's separations" if few else
+                  f"the table's error bound here ({bound}) is above {target}")
+        return True, f"{reason}: the peaks are those of one run of the fast method (about {cost:.2g} CPU s)"
+    if not over:
+        return False, ""
+    return False, (f"the table's error bound here ({bound}) is above {target}; one run of the fast method "
+                   f"(simulate_estimate, snapping estimate --simulate) would take about {cost:.0f} s")
+
+
 def computed_estimate(chain: Chain, *, chi: float | None = None, separation: float | None = None,
                       curvature: float | None = None, links: int, tip_mass: float = 0.0,
                       max_seconds: float = MAX_SECONDS, progress: bool | None = None) -> DesignEstimate:
@@ -278,28 +303,15 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     :data:`TARGETS` (1% speed and tension, 3% acceleration), else one run of the fast method
     (:func:`simulate_estimate`) when the table says such a run costs at most ``max_seconds``
     (heavy tip masses, whose peaks jump between the table's points, cost a second or so), and
-    always for chains of at most :data:`FEW_LINKS` links (milliseconds), else the table's answer with a warning naming its bound.
-    Outside the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
+    always for chains of at most :data:`FEW_LINKS` links (milliseconds); else the table's
+    answer, with ``computed_note`` naming its bound (:func:`run_instead` decides). Outside
+    the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
     max_seconds = V.real("max_seconds", max_seconds)
     est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
                           tip_mass=tip_mass)
-    over = {q: e for q, e in est.computed_errors.items() if q in TARGETS and not e <= TARGETS[q]}
-    few = est.links <= FEW_LINKS
-    if not over and not few:
-        return est
-    cost = float(T.load_table().values("cpu_s", est.nondim["chi"], est.links, est.tip_mass))
-    why = ", ".join(f"{q} +-{100 * e:.2g}%" for q, e in over.items())
-    if cost <= max_seconds:
-        sim = simulate_estimate(chain, chi=est.nondim["chi"], links=est.links, tip_mass=est.tip_mass,
+    run, why = run_instead(est.nondim["chi"], est.links, est.tip_mass, est.computed_errors, max_seconds=max_seconds)
+    if run:
+        est = simulate_estimate(chain, chi=est.nondim["chi"], links=est.links, tip_mass=est.tip_mass,
                                 progress=progress)
-        reason = (f"a chain of {est.links} links snaps erratically between the table's separations" if few else
-                  f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
-                  f"acceleration)")
-        sim.computed_note = f"{reason}: the peaks are those of one run of the fast method (about {cost:.2g} CPU s)"
-        return sim
-    if not over:
-        return est
-    est.computed_note = (f"the table's error bound here ({why}) is above the target (1% speed and tension, 3% "
-                         f"acceleration); one run of the fast method (simulate_estimate, snapping estimate "
-                         f"--simulate) would take about {cost:.0f} s")
+    est.computed_note = why
     return est
