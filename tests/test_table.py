@@ -168,8 +168,17 @@ def test_design_boundary_against_a_fresh_run():
 def test_no_admissible_separation_says_the_minimum():
     chain = estimates.Chain(length=2.0, mass=0.05)
     with pytest.raises(design.NoAdmissibleSeparation,
-                       match=r"no separation keeps the tension under 0.1 N .*: the minimum is .* N"):
+                       match=r"max_tension=0.1 N: no separation keeps the tension under it .*: the minimum is .* N"):
         design.design(chain, 100, max_tension=0.1)
+    # each limit alone is met (tension at large chi, acceleration too), but not both: low tension
+    # needs wide ends, and there the speed limit below fails
+    res_v = design.design(chain, 100, max_speed=20.0, tip_mass=0.0)
+    res_s = design.design(chain, 100, max_tension=1.2, tip_mass=0.0)
+    assert res_v.rows[0].admissible and res_s.rows[0].admissible
+    if res_v.rows[0].admissible[-1][1] < res_s.rows[0].admissible[0][0] or \
+            res_s.rows[0].admissible[-1][1] < res_v.rows[0].admissible[0][0]:
+        with pytest.raises(design.NoAdmissibleSeparation, match="no separation meets them all"):
+            design.design(chain, 100, max_speed=20.0, max_tension=1.2, tip_mass=0.0)
     with pytest.raises(SnappingInputError, match="give at least one limit"):
         design.design(chain, 100)
     with pytest.raises(SnappingInputError, match="max_tension=-1"):
@@ -206,7 +215,8 @@ def test_cli_estimate_and_design(capsys, tmp_path):
                  "--plot", str(png)]) == 2
     assert "exists" in capsys.readouterr().err
     assert main(["design", "--max-tension", "0.1", "--length", "2", "--mass", "0.05", "--links", "100"]) == 2
-    assert "the minimum is" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--max-tension=0.1 N: no separation" in err and "the minimum is" in err
 
 
 def test_builder_ledger_resumes_and_survives_a_torn_line(tmp_path, monkeypatch):

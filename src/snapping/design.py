@@ -155,25 +155,34 @@ def design(chain: Chain, links: int, *, max_tension: float | None = None, max_sp
             q, conv, _, _ = LIMITS[key]
             si, e = getattr(chain, conv)(values[q]), errors[q]
             curves[tip][key] = (chi, si, e)
-            ratio[True].append(si * (1.0 + e) / lim - 1.0)
-            ratio[False].append(si / lim - 1.0)
+            with np.errstate(over="ignore"):  # (a limit of 5e-324 N: every peak is infinitely over it)
+                ratio[True].append(si * (1.0 + e) / lim - 1.0)
+                ratio[False].append(si / lim - 1.0)
             i = int(np.argmin(si))
             row.minimum[key] = {"peak": float(si[i]), "error": float(e[i]), "chi": float(chi[i])}
         row.admissible = _intervals(chi, np.max(ratio[True], axis=0))
         row.nominal = _intervals(chi, np.max(ratio[False], axis=0))
         rows.append(row)
     if not any(row.admissible for row in rows):
-        key = next(iter(limits))
-        best = min(rows, key=lambda row: row.minimum[key]["peak"])
-        m = best.minimum[key]
-        unit, what = LIMITS[key][2], LIMITS[key][3]
-        tip_txt = f" (tip mass {best.tip_mass:g})" if best.tip_mass or len(tips) > 1 else ""
-        others = "" if len(limits) == 1 else " (and the other limits)"
-        raise NoAdmissibleSeparation(
-            f"no separation keeps the {what} under {limits[key]:g} {unit}{others} for this chain ({links} links, "
-            f"separations {r['chi'][0] * chain.length:.3g} to {r['chi'][1] * chain.length:.3g} m): the minimum is "
-            f"{m['peak']:.4g} {unit} (+-{100 * m['error']:.2g}%) at separation {m['chi'] * chain.length:.3g} m "
-            f"(chi = {m['chi']:.3g}){tip_txt}")
+        span = f"{links} links, separations {r['chi'][0] * chain.length:.3g} to {r['chi'][1] * chain.length:.3g} m"
+
+        def smallest(key):  # the smallest peak of one quantity over chi and the tip masses, and where
+            best = min(rows, key=lambda row: row.minimum[key]["peak"])
+            m = best.minimum[key]
+            tip_txt = f", tip mass {best.tip_mass:g}" if best.tip_mass or len(tips) > 1 else ""
+            return m, (f"the minimum is {m['peak']:.4g} {LIMITS[key][2]} (+-{100 * m['error']:.2g}%) at separation "
+                       f"{m['chi'] * chain.length:.3g} m (chi = {m['chi']:.3g}{tip_txt})")
+
+        alone = [k for k in limits if smallest(k)[0]["peak"] * (1.0 + smallest(k)[0]["error"]) > limits[k]]
+        if alone:  # a limit that no separation meets by itself
+            key = alone[0]
+            raise NoAdmissibleSeparation(
+                f"{key}={limits[key]:g} {LIMITS[key][2]}: no separation keeps the {LIMITS[key][3]} under it for this "
+                f"chain ({span}): {smallest(key)[1]}")
+        given = " and ".join(f"{k}={v:g} {LIMITS[k][2]}" for k, v in limits.items())
+        raise NoAdmissibleSeparation(f"{given}: each is met at some separation, but no separation meets them all "
+                                     f"for this chain ({span}); " + "; ".join(
+                                         f"{LIMITS[k][3]}: {smallest(k)[1]}" for k in limits))
     return DesignResult(chain=chain, links=links, limits=limits, rows=rows, curves=curves)
 
 
