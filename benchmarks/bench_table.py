@@ -114,8 +114,8 @@ def main(argv=None) -> int:
           f"the targets, else one run of the fast method (exact here: it is the fresh run): {len(rows) - len(ran)} "
           f"points from the table, {len(ran)} by a run ({sum(r['answer'][1] for r in ran):.1f} CPU s in all); "
           f"speed, acceleration and tension within the targets at {ok}/{len(rows)} points"
-          + (f"; at {len(told)} more the answer says its bound is above the target and a run would take over "
-             f"{design.MAX_SECONDS:g} s ({', '.join(f'chi={c:g} N={n} tip={t:g}' for c, n, t in told)})" if told else ""))
+          + (f" (at {len(told)} of them the table answer says its bound is above the target and a run would take over "
+             f"{design.MAX_SECONDS:g} s: {', '.join(f'chi={c:g} N={n} tip={t:g}' for c, n, t in told)})" if told else ""))
     print(f"\nwall time {time.perf_counter() - t0:.0f} s")
     return 0
 
