@@ -88,9 +88,9 @@ def test_interpolant_reproduces_cubics_and_leave_one_out_finds_a_spike():
 
 
 def test_outside_the_table_names_the_input_and_the_range():
-    cases = [((0.03, 229, 0.0), "chi=0.03 is outside the table of computed snaps: it covers chi in [0.05, 0.9]"),
-             ((0.25, 5, 0.0), "links=5 is outside the table of computed snaps: it covers links in [10, 10000]"),
-             ((0.25, 229, 2.0), "tip_mass=2 is outside the table of computed snaps: it covers tip_mass in [0, 1]"),
+    cases = [((0.03, 229, 0.0), "chi=0.03 is outside the table of computed snaps, which covers [0.05, 0.9]"),
+             ((0.25, 5, 0.0), "links=5 is outside the table of computed snaps, which covers [10, 10000]"),
+             ((0.25, 229, 2.0), "tip_mass=2 is outside the table of computed snaps, which covers [0, 1]"),
              ((0.25, 5000, 0.1), "the table has tip masses only for links <= 1800")]
     for args, msg in cases:
         with pytest.raises(T.OutsideTable) as exc:
@@ -248,3 +248,46 @@ def test_computed_estimate_runs_where_the_table_is_not_accurate_enough():
     assert run.computed_source == "simulation" and "above the target" in run.computed_note
     slow = design.computed_estimate(chain, chi=0.5, links=119, tip_mass=0.65, max_seconds=0.0)
     assert slow.computed_source == "table" and "--simulate" in slow.computed_note
+
+
+def test_design_of_a_few_link_chain_runs_it():
+    """Few-link chains snap erratically between the table's separations: design runs them, and an
+    admissible separation is one where the sampled runs on both sides met the limit."""
+    chain = estimates.Chain(length=2.0, mass=0.05)
+    res = design.design(chain, 10, max_tension=20.0, tip_mass=0.0)
+    assert res.source == "runs" and "snaps erratically" in res.notes[0]
+    chi, si, e = res.curves[0.0]["max_tension"]
+    assert np.all(e[np.isfinite(si)] == 0.0)
+    for i in (0, len(chi) // 2, len(chi) - 1):  # the curve is the runs' peaks, in N
+        assert si[i] == pytest.approx(chain.force(build.run_point(float(chi[i]), 10, 0.0)["sigma_peak"]), rel=1e-12)
+    for lo, hi in res.rows[0].admissible:
+        inside = (chi >= lo * (1 - 1e-12)) & (chi <= hi * (1 + 1e-12))
+        assert inside.any() and np.all(si[inside] <= 20.0)
+
+
+def test_design_treats_a_wide_bound_as_unknown():
+    """A heavy tip mass: where the table's bound is above BOUND_TRUST the separation is neither
+    admissible nor nominal (a run at 0.9 m, inside such a stretch, exceeds the limit)."""
+    chain = estimates.Chain(length=2.0, mass=0.05)
+    res = design.design(chain, 100, max_tension=20.0, tip_mass=0.5)
+    chi, si, e = res.curves[0.5]["max_tension"]
+    assert np.isinf(e).any() and not np.isinf(e).all()
+    c = 0.45
+    _, err = TAB.values("sigma_peak", c, 100, 0.5, with_error=True)
+    assert err > design.BOUND_TRUST
+    for rows in (res.rows[0].admissible, res.rows[0].nominal):
+        assert not any(lo <= c <= hi for lo, hi in rows)
+    assert chain.force(build.run_point(c, 100, 0.5)["sigma_peak"]) > 20.0  # the table alone would have missed it
+    est = estimates.design_estimate(chain, chi=c, links=100, tip_mass=0.5)
+    assert "may fail" in est.computed_note
+
+
+def test_cli_refuses_a_plot_without_an_image_suffix_and_table_without_links(capsys, tmp_path):
+    assert main(["design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--tip-mass",
+                 "0", "--plot", str(tmp_path / "d5")]) == 2
+    err = capsys.readouterr().err
+    assert "--plot=" in err and "has no suffix" in err and ".png" in err and not list(tmp_path.iterdir())
+    assert main(["estimate", "--chi", "0.3", "--table"]) == 2
+    assert "--table needs --links" in capsys.readouterr().err
+    assert main(["estimate", "--chi", "0.02", "--links", "30", "--table"]) == 2
+    assert "drop --table and add --simulate" in capsys.readouterr().err

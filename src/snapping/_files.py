@@ -54,7 +54,7 @@ import threading
 from . import _validate as V
 
 __all__ = ["check_output", "check_output_dir", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
-           "OutputBusyError", "lock_path", "describe_kind"]
+           "OutputBusyError", "lock_path", "describe_kind", "figure_format"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
 FULL_MARGIN = 1 << 20
@@ -350,10 +350,28 @@ def write_atomic(path, write, *, name: str = "output", overwrite: bool = True, d
     return p
 
 
+def figure_format(path, *, name: str = "plot") -> str:
+    """The image format of a figure file, from its suffix; refused (naming ``name``, the path and
+    the formats) when it has none or matplotlib cannot write it. Checked before the work.
+
+    >>> figure_format("fit.png")
+    'png'
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = FigureCanvasBase.get_supported_filetypes()
+    fmt = os.path.splitext(os.fspath(path))[1].lstrip(".").lower()
+    if fmt not in formats:
+        what = "has no suffix" if not fmt else f"has the suffix .{fmt}, which is not an image format matplotlib writes"
+        raise V.SnappingInputError(f"{name}={os.fspath(path)!r} {what}: give a file name ending in one of "
+                                   f"{', '.join('.' + f for f in sorted(formats))}")
+    return fmt
+
+
 def save_figure(fig, path, *, overwrite: bool = True, **savefig_kw) -> str:
     """Write a matplotlib figure to ``path`` atomically (:func:`write_atomic`; the format
-    from the suffix). Figures replace an existing file by default: the command line
-    refuses one before the work unless ``--overwrite``."""
-    fmt = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or None
+    from the suffix, :func:`figure_format`). Figures replace an existing file by default: the
+    command line refuses one before the work unless ``--overwrite``."""
+    fmt = figure_format(path)
     return write_atomic(path, lambda tmp: fig.savefig(tmp, format=fmt, **savefig_kw), name="plot",
                         overwrite=overwrite)

@@ -78,17 +78,22 @@ class DesignResult:
     limits: dict
     rows: list
     curves: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+    source: str = "table"
 
     def to_dict(self) -> dict:
         L = self.chain.length
         return {
             "chain": {"length_m": L, "mass_kg": self.chain.mass, "g_m_per_s2": self.chain.g},
-            "links": self.links, "limits": dict(self.limits),
+            "links": self.links, "limits": dict(self.limits), "source": self.source, "notes": list(self.notes),
             "rows": [{"tip_mass": r.tip_mass,
                       "admissible_chi": [list(i) for i in r.admissible],
                       "admissible_separation_m": [[a * L, b * L] for a, b in r.admissible],
                       "nominal_chi": [list(i) for i in r.nominal],
-                      "minimum": dict(r.minimum)} for r in self.rows],
+                      "nominal_separation_m": [[a * L, b * L] for a, b in r.nominal],
+                      "minimum": {k: {**{a: b for a, b in m.items() if a != "upper"}, "separation_m": m["chi"] * L}
+                                  for k, m in r.minimum.items()}}
+                     for r in self.rows],
         }
 
 
@@ -118,6 +123,39 @@ def _intervals(chi: np.ndarray, g: np.ndarray) -> list:
     return out
 
 
+#: points of the chi scan of a few-link chain (one run each)
+N_SCAN_RUNS = 200
+#: above this relative bound a table point is unknown (not admissible, not nominal)
+BOUND_TRUST = T.BOUND_TRUST
+
+
+def _scan_runs(chi: np.ndarray, links: int, tip: float):
+    """The peaks of one fast run at every chi (values, errors 0: the method's tolerance)."""
+    from tqdm.auto import tqdm
+
+    from .table.build import run_point
+
+    keys = ("v_peak", "a_peak", "sigma_peak", "t_snap_v")
+    out = {q: np.full(chi.size, np.nan) for q in keys}
+    for i, c in enumerate(tqdm(chi, desc=f"runs ({links} links, tip mass {tip:g})", unit="run", leave=False,
+                               disable=None)):
+        d = run_point(float(c), links, tip)
+        if d["status"] == "completed" and d.get("snap_reached"):
+            for q in keys:
+                out[q][i] = d[q]
+    errors = {q: np.where(np.isfinite(out[q]), 0.0, np.inf) for q in keys}
+    return out, errors
+
+
+def _both_neighbours(g: np.ndarray) -> np.ndarray:
+    """g on the midpoints' terms: a sample counts as meeting the limit (g <= 0) only if it and
+    both its neighbours do, so an interval never reaches past the last sampled run that met it."""
+    out = g.copy()
+    out[1:] = np.maximum(out[1:], g[:-1])
+    out[:-1] = np.maximum(out[:-1], g[1:])
+    return out
+
+
 def design(chain: Chain, links: int, *, max_tension: float | None = None, max_speed: float | None = None,
            max_acceleration: float | None = None, tip_mass: float | None = None, table=None) -> DesignResult:
     """The end separations (as chi = separation / length) that keep every given peak
@@ -134,20 +172,30 @@ def design(chain: Chain, links: int, *, max_tension: float | None = None, max_sp
     limits = {k: V.positive(k, v) for k, v in (("max_tension", max_tension), ("max_speed", max_speed),
                                                ("max_acceleration", max_acceleration)) if v is not None}
     if not limits:
-        raise V.SnappingInputError("give at least one limit: max_tension [N], max_speed [m/s] or "
-                                   "max_acceleration [m/s^2]")
+        raise V.SnappingInputError("give at least one limit: max_tension= [N], max_speed= [m/s] or "
+                                   "max_acceleration= [m/s^2]")
     links = V.integer("links", links, 1)
     tab = T.load_table(table)
     r = tab.ranges
+    notes = []
     if tip_mass is None:
         tips = [float(t) for t in tab.tip] if links <= tab.n_tip_max else [0.0]
+        if links > tab.n_tip_max:
+            notes.append(f"the table has tip masses only up to {tab.n_tip_max} links: tip mass 0 alone")
     else:
         tips = [check_tip_mass(tip_mass)]
     tab.check(r["chi"][0], links, tips[-1])
-    chi = np.geomspace(r["chi"][0], r["chi"][1], N_SCAN)
+    few = links <= FEW_LINKS
+    chi = np.geomspace(r["chi"][0], r["chi"][1], N_SCAN_RUNS if few else N_SCAN)
+    if few:
+        notes.append(f"a chain of {links} links snaps erratically from one separation to the next: the peaks are "
+                     f"those of {chi.size} runs of the fast method per tip mass (not the table), and a separation "
+                     f"between two runs is admissible only if both are")
     rows, curves = [], {}
     for tip in tips:
-        values, errors = tab.evaluate(chi, links, tip)
+        values, errors = _scan_runs(chi, links, tip) if few else tab.evaluate(chi, links, tip)
+        # a bound above BOUND_TRUST is no bound (the snap changes character near there): never admissible
+        errors = {q: np.where(e <= BOUND_TRUST, e, np.inf) for q, e in errors.items()}
         curves[tip] = {}
         ratio = {True: [], False: []}
         row = DesignRow(tip_mass=tip)
@@ -158,22 +206,29 @@ def design(chain: Chain, links: int, *, max_tension: float | None = None, max_sp
             with np.errstate(over="ignore"):  # (a limit of 5e-324 N: every peak is infinitely over it)
                 ratio[True].append(si * (1.0 + e) / lim - 1.0)
                 ratio[False].append(si / lim - 1.0)
-            i = int(np.argmin(si))
-            row.minimum[key] = {"peak": float(si[i]), "error": float(e[i]), "chi": float(chi[i])}
-        row.admissible = _intervals(chi, np.max(ratio[True], axis=0))
-        row.nominal = _intervals(chi, np.max(ratio[False], axis=0))
+            upper = np.where(np.isfinite(si), si * (1.0 + e), np.inf)  # (inf: no run, or no bound)
+            i = int(np.argmin(upper)) if np.isfinite(upper).any() else int(np.nanargmin(si))
+            row.minimum[key] = {"peak": float(si[i]), "error": float(e[i]), "chi": float(chi[i]),
+                                "upper": float(upper[i])}
+        g_bound = np.max(ratio[True], axis=0)
+        g_nominal = np.where(np.isfinite(g_bound), np.max(ratio[False], axis=0), np.inf)
+        if few:  # between two runs, only if both meet the limits (no interpolation of an erratic peak)
+            g_bound = _both_neighbours(g_bound)
+            g_nominal = _both_neighbours(g_nominal)
+        row.admissible = _intervals(chi, g_bound)
+        row.nominal = _intervals(chi, g_nominal)
         rows.append(row)
     if not any(row.admissible for row in rows):
         span = f"{links} links, separations {r['chi'][0] * chain.length:.3g} to {r['chi'][1] * chain.length:.3g} m"
 
-        def smallest(key):  # the smallest peak of one quantity over chi and the tip masses, and where
-            best = min(rows, key=lambda row: row.minimum[key]["peak"])
+        def smallest(key):  # the smallest bounded peak of one quantity over chi and the tip masses, and where
+            best = min(rows, key=lambda row: (row.minimum[key]["upper"], row.minimum[key]["peak"]))
             m = best.minimum[key]
             tip_txt = f", tip mass {best.tip_mass:g}" if best.tip_mass or len(tips) > 1 else ""
-            return m, (f"the minimum is {m['peak']:.4g} {LIMITS[key][2]} (+-{100 * m['error']:.2g}%) at separation "
+            return m, (f"the minimum is {m['peak']:.4g} {LIMITS[key][2]} ({_pct(m['error'])}) at separation "
                        f"{m['chi'] * chain.length:.3g} m (chi = {m['chi']:.3g}{tip_txt})")
 
-        alone = [k for k in limits if smallest(k)[0]["peak"] * (1.0 + smallest(k)[0]["error"]) > limits[k]]
+        alone = [k for k in limits if smallest(k)[0]["upper"] > limits[k]]
         if alone:  # a limit that no separation meets by itself
             key = alone[0]
             raise NoAdmissibleSeparation(
@@ -183,7 +238,12 @@ def design(chain: Chain, links: int, *, max_tension: float | None = None, max_sp
         raise NoAdmissibleSeparation(f"{given}: each is met at some separation, but no separation meets them all "
                                      f"for this chain ({span}); " + "; ".join(
                                          f"{LIMITS[k][3]}: {smallest(k)[1]}" for k in limits))
-    return DesignResult(chain=chain, links=links, limits=limits, rows=rows, curves=curves)
+    return DesignResult(chain=chain, links=links, limits=limits, rows=rows, curves=curves, notes=notes,
+                        source="runs" if few else "table")
+
+
+def _pct(e: float) -> str:
+    return "no bound" if not math.isfinite(e) else ("exact" if e == 0 else f"+-{100 * e:.2g}%")
 
 
 def _fmt_intervals(iv: list, L: float) -> str:
@@ -200,16 +260,20 @@ def print_design(res: DesignResult, file=None) -> None:
     c = res.chain
     lim = ", ".join(f"{LIMITS[k][3]} <= {v:g} {LIMITS[k][2]}" for k, v in res.limits.items())
     print(f"Separations that keep the snap's peaks under the limits ({lim})", file=out)
-    print(f"chain: length {c.length:g} m, mass {c.mass:g} kg, g {c.g:g} m/s^2, {res.links} links; peaks from the "
-          f"table of fast exact runs (snapping.table)", file=out)
-    print("admissible: computed peak + its error bound under every limit; nominal: the computed peak alone", file=out)
+    where = "runs of the fast method" if res.source == "runs" else "the table of fast exact runs (snapping.table)"
+    print(f"chain: length {c.length:g} m, mass {c.mass:g} kg, g {c.g:g} m/s^2, {res.links} links; peaks from "
+          f"{where}", file=out)
+    print("admissible: computed peak + its error bound under every limit; nominal: the computed peak alone "
+          f"(neither where the bound is above {100 * BOUND_TRUST:g}%: the snap changes character there)", file=out)
+    for n in res.notes:
+        print(f"note: {n}", file=out)
     print(file=out)
     for row in res.rows:
         print(f"  tip mass {row.tip_mass:g} x the chain's mass:", file=out)
         print(f"    admissible: {_fmt_intervals(row.admissible, c.length)}", file=out)
         print(f"    nominal:    {_fmt_intervals(row.nominal, c.length)}", file=out)
         for k, m in row.minimum.items():
-            print(f"    smallest {LIMITS[k][3]}: {m['peak']:.4g} {LIMITS[k][2]} (+-{100 * m['error']:.2g}%) at "
+            print(f"    smallest {LIMITS[k][3]}: {m['peak']:.4g} {LIMITS[k][2]} ({_pct(m['error'])}) at "
                   f"{m['chi'] * c.length:.3g} m", file=out)
 
 
@@ -236,7 +300,8 @@ def plot_design(res: DesignResult, path=None, *, overwrite: bool = False):
             chi, si, e = res.curves[tip][key]
             color = cmap(n / max(len(tips) - 1, 1))
             ax.plot(chi * L, si, color=color, label=f"tip mass {tip:g}" if len(tips) > 1 else "computed peak")
-            ax.fill_between(chi * L, si * (1 - e), si * (1 + e), color=color, alpha=0.2, lw=0)
+            band = np.isfinite(e)
+            ax.fill_between(chi * L, si / (1 + e), si * (1 + e), where=band, color=color, alpha=0.2, lw=0)
         ax.axhline(res.limits[key], color="C3", ls="--", label=f"limit {res.limits[key]:g} {LIMITS[key][2]}")
         if len(tips) == 1:
             for a, b in res.rows[0].admissible:
@@ -245,7 +310,7 @@ def plot_design(res: DesignResult, path=None, *, overwrite: bool = False):
         ax.set_yscale("log")
         ax.set_xlabel("end separation [m]")
         ax.set_ylabel(f"peak {LIMITS[key][3]} [{LIMITS[key][2]}]")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=6, ncol=2 if len(tips) > 4 else 1)
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(f"{res.links}-link chain, {L:g} m, {res.chain.mass:g} kg: peaks of the snap (table of fast runs)",
                  fontsize=10)
@@ -301,7 +366,7 @@ def run_instead(chi: float, links: int, tip_mass: float, errors: dict, *,
     if not over:
         return False, ""
     return False, (f"the table's error bound here ({bound}) is above {target}; one run of the fast method "
-                   f"(simulate_estimate, snapping estimate --simulate) would take about {cost:.0f} s")
+                   f"(simulate_estimate, snapping estimate --simulate) would take about {cost:.3g} CPU s")
 
 
 def computed_estimate(chain: Chain, *, chi: float | None = None, separation: float | None = None,

@@ -78,12 +78,14 @@ def _cmd_fit(args) -> int:
             raise SnappingInputError(f"--window={w!r} must look like NAME=LO,HI (e.g. v_max=1e-4,1e-2)") from None
         windows[key.strip()] = (lo, hi)
     if args.plot is not None:  # before the (slow) fits
+        from .._files import figure_format
         from ..simulate.dataset import check_writable
 
         if Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
             raise SnappingInputError(f"--plot={args.plot!r}: the figure suffix must be .png, .pdf or .svg")
         out = Path(args.plot)
         for path in (out, out.with_name(f"{out.stem}_slopes{out.suffix}"), out.with_name(f"{out.stem}_delta{out.suffix}")):
+            figure_format(path, name="--plot")
             check_writable(path, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
     runs, names = [], []
     for f in args.files:

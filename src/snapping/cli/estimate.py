@@ -115,6 +115,8 @@ def _cmd_estimate(args) -> int:
     where = {k: getattr(args, k) for k in ("chi", "separation", "curvature") if getattr(args, k) is not None}
     if args.simulate and args.links is None:
         raise SnappingInputError("--simulate needs --links (the number of links of the chain to simulate)")
+    if args.table and args.links is None:
+        raise SnappingInputError("--table needs --links (the table's peaks are those of a chain of given links)")
     if args.tip_mass and args.links is None:
         raise SnappingInputError(f"--tip-mass {args.tip_mass:g} needs --links: the estimate with a tip mass is the "
                                  f"computed one")
@@ -133,8 +135,8 @@ def _cmd_estimate(args) -> int:
             else:
                 est = estimates.design_estimate(chain, **where, N=args.N, links=args.links, tip_mass=args.tip_mass)
         except table.OutsideTable as exc:
-            raise table.OutsideTable(f"{exc}; add --simulate to compute this chain with one run of the fast "
-                                     f"method instead") from None
+            raise table.OutsideTable(f"{exc}; {'drop --table and ' if args.table else ''}add --simulate to "
+                                     f"compute this chain with one run of the fast method instead") from None
     if args.json:
         print_json(est.to_dict())
     else:
@@ -181,9 +183,11 @@ def _add_design(sub) -> None:
 def _cmd_design(args) -> int:
     from .. import design
     from .._files import check_output as check_writable
+    from .._files import figure_format
 
     chain = _chain_of(args)
     if args.plot:
+        figure_format(args.plot, name="--plot")
         check_writable(args.plot, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
     res = design.design(chain, args.links, max_tension=args.max_tension, max_speed=args.max_speed,
                         max_acceleration=args.max_acceleration, tip_mass=args.tip_mass)

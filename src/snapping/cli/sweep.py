@@ -180,9 +180,11 @@ def _cmd_converge(args) -> int:
     scales = _si_scales(args)
     if args.plot is not None:
         from .._validate import SnappingInputError
+        from .._files import figure_format
         from ..simulate.dataset import check_writable
 
         try:
+            figure_format(args.plot, name="plot")
             check_writable(args.plot, name="plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None

@@ -337,8 +337,14 @@ def attach_computed(est: DesignEstimate, computed: dict, errors: dict, *, source
     except (T.OutsideTable, OSError):  # a simulated chain outside the table: no ranges
         est.factor_ranges = {}
     if tip_mass:
-        est.warnings.append(f"the paper's estimators below take no tip mass into account (tip mass "
-                            f"{tip_mass:g} of the chain's mass): their factors say how far off that makes them")
+        est.warnings.append(f"the paper's estimators take no tip mass into account (tip mass {tip_mass:g} of the "
+                            f"chain's mass): their error factors below say how far off that makes them")
+    wide = {k: e for k, e in est.computed_errors.items() if e > T.BOUND_TRUST}
+    if wide and source == "table":
+        est.computed_note = (f"the table's bound here ({', '.join(f'{k} +-{100 * e:.2g}%' for k, e in wide.items())})"
+                             f" is above {100 * T.BOUND_TRUST:g}%: the snap changes character near this point and "
+                             f"the bound itself may fail; run it (snapping.design.simulate_estimate, snapping "
+                             f"estimate --simulate)")
     return est
 
 
@@ -435,10 +441,10 @@ def print_estimate(est: DesignEstimate, file=None) -> None:
         return
     line(f"Error factors: estimate / computed peak, here and (geometric mean [min, max]) over the table's "
          f"separations chi {est.factor_span} for this chain")
-    line(f"  {'scale':<14} {'v here':>7} {'a here':>8} {'sigma here':>10} | {'v over chi':>22} "
-         f"{'a over chi':>22} {'sigma over chi':>22}")
+    line(f"  {'scale':<14} {'v here':>8} {'a here':>9} {'sigma here':>10} | {'v over chi':>24} "
+         f"{'a over chi':>24} {'sigma over chi':>24}")
     for name, f in est.factors.items():
         rng = est.factor_ranges.get(name, {})
         cells = [f"{r[0]:.2g} [{r[1]:.2g}, {r[2]:.2g}]" if r else "-" for r in (rng.get(q) for q in ("v", "a", "sigma"))]
-        line(f"  {name:<14} {f['v']:>7.3g} {f['a']:>8.3g} {f['sigma']:>10.3g} | {cells[0]:>22} {cells[1]:>22} "
-             f"{cells[2]:>22}")
+        line(f"  {name:<14} {f['v']:>8.3g} {f['a']:>9.3g} {f['sigma']:>10.3g} | {cells[0]:>24} {cells[1]:>24} "
+             f"{cells[2]:>24}")

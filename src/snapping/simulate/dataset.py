@@ -5,7 +5,6 @@ All names, units and long names come from :mod:`snapping.schema`.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numpy as np

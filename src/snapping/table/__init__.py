@@ -38,7 +38,7 @@ import numpy as np
 from .. import _validate as V
 
 __all__ = ["TABLE_FILE", "QUANTITIES", "ERROR_QUANTITIES", "OutsideTable", "Table", "TablePeaks", "load_table",
-           "lookup", "leave_one_out", "TIP_SCALE", "BOUND_FACTOR"]
+           "lookup", "leave_one_out", "TIP_SCALE", "BOUND_FACTOR", "BOUND_TRUST"]
 
 #: the shipped table (package data)
 TABLE_FILE = Path(__file__).resolve().parent.parent / "data" / "snap_table.nc"
@@ -52,6 +52,11 @@ ERROR_QUANTITIES = ("v_peak", "a_peak", "sigma_peak", "t_snap_v")
 #: wiggle of a link's period (the tension at small chi: +-1.5% from one N to the next), which a query
 #: between grid points can meet with either sign (calibrated with benchmarks/bench_table.py)
 BOUND_FACTOR = 2.0
+
+#: the largest relative error bound that still bounds anything: above it the snap changes character
+#: near the point (e.g. a later, larger event of a heavy tip mass between the grid points), and the
+#: bound itself can fail (snapping.design treats such a point as unknown)
+BOUND_TRUST = 0.5
 
 #: the tip-mass axis is interpolated in asinh(tip_mass / TIP_SCALE): log-like above 0.001, linear through 0
 TIP_SCALE = 1e-3
@@ -198,8 +203,8 @@ class Table:
                                   ("tip_mass", tip_a, r["tip_mass"])):
             bad = a[~((a >= lo) & (a <= hi))]
             if bad.size:
-                raise OutsideTable(f"{name}={float(bad[0]):g} is outside the table of computed snaps: it covers "
-                                   f"{name} in [{lo:g}, {hi:g}]")
+                raise OutsideTable(f"{name}={float(bad[0]):g} is outside the table of computed snaps, which covers "
+                                   f"[{lo:g}, {hi:g}]")
         if np.any((tip_a > 0) & (N_a > self.n_tip_max)):
             raise OutsideTable(f"tip_mass={float(tip_a.max()):g} with links={int(N_a.max())}: the table has tip "
                                f"masses only for links <= {self.n_tip_max} (tip_mass 0 for up to {r['N'][1]})")
