@@ -80,6 +80,13 @@ def _finite(obj, path="result", allow=ALLOW_NONFINITE) -> None:
     elif isinstance(obj, scaling.LocalSlope):  # NaN where a centre has too few samples, by design
         _finite(obj.tau, f"{path}.tau")
         assert np.isfinite(obj.slope).any(), f"{path}.slope has no finite local slope"
+    elif isinstance(obj, design.DesignResult):  # a bound above BOUND_TRUST is inf by design ("no bound")
+        _finite(obj.rows, f"{path}.rows", allow + ("upper", "error"))
+        for tip, per in obj.curves.items():
+            for key, (chi, si, err) in per.items():
+                _finite(chi, f"{path}.curves[{tip}][{key}].chi")
+                _finite(si, f"{path}.curves[{tip}][{key}].peak")
+                assert np.all(np.isfinite(err) | (err == np.inf)) and np.isfinite(err).any(), path
     elif isinstance(obj, mpmath.mpf):
         assert mpmath.isfinite(obj), f"{path} = {obj}"
     elif isinstance(obj, numbers.Number):

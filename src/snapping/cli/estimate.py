@@ -194,7 +194,7 @@ def _cmd_design(args) -> int:
     if args.plot:
         design.plot_design(res, args.plot, overwrite=args.overwrite)
     if args.json:
-        print_json(res.to_dict())
+        print_json({**res.to_dict(), "plot": args.plot})
     else:
         design.print_design(res)
         if args.plot:
