@@ -5,8 +5,9 @@ import importlib
 
 import pytest
 
-MODULES = ["snapping.schema", "snapping.estimates", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
-           "snapping._files", "snapping.units"]
+MODULES = ["snapping.schema", "snapping.estimates", "snapping.estimates.catenary", "snapping.estimates.rules",
+           "snapping.table", "snapping.design", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
+           "snapping._files", "snapping.units", "snapping.cli"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -7,14 +7,19 @@ fast exact runs (:mod:`snapping.table`, interpolated with an error bound);
 :func:`design` finds the separations whose peaks stay under every limit, for the
 given tip mass or for every tip mass of the table. A separation is *admissible*
 when the computed peak plus its error bound is under the limit (``nominal``: the
-computed peak alone). :func:`simulate_estimate` computes one case with the fast
-method instead (a point outside the table, or a check).
+computed peak alone); where the bound is above :data:`BOUND_TRUST` (the snap changes
+character near there) a separation is neither. Chains of at most :data:`FEW_LINKS`
+links, whose peaks jump from one separation to the next, are run instead
+(:data:`N_SCAN_RUNS` runs of the fast method per tip mass; a separation between two runs
+is admissible only if both are). :func:`simulate_estimate` computes one case with the
+fast method (a point outside the table, or a check); :func:`computed_estimate` chooses
+between the table and a run (:func:`run_instead`).
 
 >>> from snapping.estimates import Chain
 >>> res = design(Chain(length=2.0, mass=0.05), links=100, max_tension=20.0, tip_mass=0.0)
 >>> lo, hi = res.rows[0].admissible[0]
->>> 0.3 < lo < 0.5, hi                              # far enough apart: the chain's ends
-(True, 0.9)
+>>> round(lo * 2.0, 2), hi                  # from 0.36 m apart (chi 0.18) to the table's widest
+(0.36, 0.9)
 """
 
 from __future__ import annotations
