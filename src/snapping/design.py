@@ -43,7 +43,7 @@ TARGETS = {"v": 0.01, "a": 0.03, "sigma": 0.01}
 MAX_SECONDS = 10.0
 #: chains of at most this many links are always run (their peaks jump with chi between the table's
 #: points, where the leave-one-out bound cannot see it; a run costs milliseconds)
-FEW_LINKS = 48
+FEW_LINKS = T.FEW_LINKS
 
 #: the limits: keyword -> (table quantity, Chain converter, unit, what)
 LIMITS = {
@@ -392,5 +392,6 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     if run:
         est = simulate_estimate(chain, chi=est.nondim["chi"], links=est.links, tip_mass=est.tip_mass,
                                 progress=progress)
-    est.computed_note = why
+    if why:
+        est.computed_note = why
     return est

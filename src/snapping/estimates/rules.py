@@ -340,7 +340,11 @@ def attach_computed(est: DesignEstimate, computed: dict, errors: dict, *, source
         est.warnings.append(f"the paper's estimators take no tip mass into account (tip mass {tip_mass:g} of the "
                             f"chain's mass): their error factors below say how far off that makes them")
     wide = {k: e for k, e in est.computed_errors.items() if e > T.BOUND_TRUST}
-    if wide and source == "table":
+    if source == "table" and links <= T.FEW_LINKS:
+        est.computed_note = (f"a chain of {links} links snaps erratically from one separation to the next: the "
+                             f"table's peaks and bounds are not reliable for it; run it (snapping.design."
+                             f"computed_estimate or simulate_estimate, snapping estimate without --table)")
+    elif wide and source == "table":
         est.computed_note = (f"the table's bound here ({', '.join(f'{k} +-{100 * e:.2g}%' for k, e in wide.items())})"
                              f" is above {100 * T.BOUND_TRUST:g}%: the snap changes character near this point and "
                              f"the bound itself may fail; run it (snapping.design.simulate_estimate, snapping "

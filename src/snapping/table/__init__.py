@@ -38,7 +38,7 @@ import numpy as np
 from .. import _validate as V
 
 __all__ = ["TABLE_FILE", "QUANTITIES", "ERROR_QUANTITIES", "OutsideTable", "Table", "TablePeaks", "load_table",
-           "lookup", "leave_one_out", "TIP_SCALE", "BOUND_FACTOR", "BOUND_TRUST"]
+           "lookup", "leave_one_out", "TIP_SCALE", "BOUND_FACTOR", "BOUND_TRUST", "FEW_LINKS"]
 
 #: the shipped table (package data)
 TABLE_FILE = Path(__file__).resolve().parent.parent / "data" / "snap_table.nc"
@@ -57,6 +57,10 @@ BOUND_FACTOR = 2.0
 #: near the point (e.g. a later, larger event of a heavy tip mass between the grid points), and the
 #: bound itself can fail (snapping.design treats such a point as unknown)
 BOUND_TRUST = 0.5
+
+#: chains of at most this many links snap erratically from one separation to the next: their peaks
+#: jump between the table's chi points, where the leave-one-out bound cannot see it (a run costs ms)
+FEW_LINKS = 48
 
 #: the tip-mass axis is interpolated in asinh(tip_mass / TIP_SCALE): log-like above 0.001, linear through 0
 TIP_SCALE = 1e-3
