@@ -214,7 +214,7 @@ class Table:
                                f"masses only for links <= {self.n_tip_max} (tip_mass 0 for up to {r['N'][1]})")
 
     # -- interpolation
-    def _part(self, tip: bool):
+    def _stacked(self, tip: bool):
         """(axes, log values stacked over :data:`QUANTITIES` on a last axis, per-axis
         leave-one-out errors of :data:`ERROR_QUANTITIES` stacked the same way), computed once."""
         if tip not in self._interp:
@@ -255,7 +255,7 @@ class Table:
             if not sel.any():
                 continue
             pts = np.column_stack((x[sel], y[sel], z[sel]) if tip else (x[sel], y[sel]))
-            axes, vals, errs = self._part(tip)
+            axes, vals, errs = self._stacked(tip)
             out[sel] = np.exp(_interp(vals, axes, pts))
             err[sel] = self._bound(axes, errs, pts)
         values = {q: out[:, i].reshape(shape) for i, q in enumerate(QUANTITIES)}
