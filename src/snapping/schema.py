@@ -94,6 +94,7 @@ PIN_STEP_VARS: dict[str, dict[str, str]] = {
     "pin_vx": _v("velocity of the held end, e1 component"),
     "pin_vy": _v("velocity of the held end, e2 component"),
     "pin_work": _v("work done on the chain by the held end since t = 0 (energy - pin_work is conserved)"),
+    "v_rel_max": _v("maximum node speed relative to the held end, max_j |v_j - v_pin| (what the stop rule judges)"),
 }
 
 #: Dimension of the pin-motion table of a general run (``pin_motion = 'table'``).
@@ -120,6 +121,9 @@ PROBLEM_ATTRS: dict[str, str] = {
     "gravity": "gravity along +e2 (1: the nondimensional g; 0: none)",
     "pin_motion": "motion of the held end: 'fixed', 'pull', 'flick' or 'table'",
     "start": "start shape: 'catenary', 'supports', 'curve' or 'nodes'",
+    "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
+                      "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
+                      "to the held end) from then on, after it has risen above its value then"),
 }
 
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
@@ -160,7 +164,8 @@ RESULT_ATTRS: dict[str, str] = {
     "t_snap_sigma": ("snapping time from the peak of the maximum tension (NaN: the run did not reach the snap, "
                      "or this peak is at the run's last step)"),
     "snap_reached": ("1 if the run reached the snap: at some recorded step v_max fell below stop_fraction of its "
-                     "running peak (the rule that stops an automatic run, applied to a run with t_end too); 0 if "
+                     "running peak (with a moving held end: v_rel_max, from t_pin_settled on; the rule that stops an "
+                     "automatic run, applied to a run with t_end too); 0 if "
                      "not: then the t_snap_* are NaN and the *_peak are maxima over the run, not snap peaks"),
     "snap_note": "'' if snap_reached, else one line saying why there is no snapping time",
     "v_peak": "peak of the maximum speed (if snap_reached is 0: its maximum over the run)",

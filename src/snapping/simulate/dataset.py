@@ -5,6 +5,8 @@ All names, units and long names come from :mod:`snapping.schema`.
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,11 +98,30 @@ def summary(ds: xr.Dataset) -> dict:
     return out
 
 
+def relative_fall(records: np.ndarray, settle: float, f: float) -> bool:
+    """Whether the recorded speed relative to a moving held end (``v_rel_max``) rose after
+    ``settle`` (the held end's settle time, :func:`snapping.simulate.general.settle_time`)
+    above its value then and fell below ``f`` of its running peak since then: the stop
+    rule of :func:`snapping.simulate.rk.after_attempt` for a moving held end, on the record."""
+    from . import general as G
+
+    col = K.NREC + G.RECORD_NAMES_G.index("v_rel_max")
+    rec = np.asarray(records, dtype=float)
+    if rec.ndim != 2 or rec.shape[1] <= col:
+        return False
+    v = rec[rec[:, K.R_T] >= settle, col]
+    if v.size < 2:
+        return False
+    running = np.fmax.accumulate(v)
+    return bool(np.any((running > v[0]) & (v < f * running)))
+
+
 def snap_results(records: np.ndarray, inputs: dict, results: dict) -> dict:
     """The result attributes with what the run did not compute taken out.
 
     ``snap_reached`` is 1 if, at some recorded step, v_max fell below
-    ``stop_fraction`` of its running peak (the rule that stops an automatic run; for
+    ``stop_fraction`` of its running peak (with a moving held end: the speed relative to
+    it, from its settle time on, :func:`relative_fall`; the rule that stops an automatic run; for
     a run with ``t_end`` it is applied to the record), or at the last step below
     ``stop_fraction`` of ``v_peak`` (what the compiled loop tests). If not, the
     snapping times ``t_snap_*`` are NaN and ``snap_note`` says why; the peaks stay,
@@ -116,7 +137,10 @@ def snap_results(records: np.ndarray, inputs: dict, results: dict) -> dict:
     t_final = float(res.get("t_final", rec[-1, K.R_T] if len(v) else 0.0))
     v_peak = float(res["v_peak"])
     reached = False
-    if v.size and np.isfinite(v_peak) and v_peak > 0.0:
+    settle = float(res.get("t_pin_settled", math.nan))
+    if settle >= 0.0:  # (NaN or absent: a fixed held end)
+        reached = relative_fall(rec, settle, f)
+    elif v.size and np.isfinite(v_peak) and v_peak > 0.0:
         running = np.fmax.accumulate(v)
         reached = bool(np.any(v < f * running) or v[-1] < f * v_peak)
     res["snap_reached"] = int(reached)
@@ -330,7 +354,10 @@ def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
     from . import general as G
 
     names = K.RECORD_NAMES + (G.RECORD_NAMES_G if G.RECORD_NAMES_G[0] in ds.variables else ())
-    cols = [np.asarray(ds[name].values, dtype=float) for name in names]
+    n = ds.sizes.get(schema.STEP_DIM, 0)
+    # (a column added later, e.g. v_rel_max, is NaN in the files written before it)
+    cols = [np.asarray(ds[name].values, dtype=float) if name in ds.variables else np.full(n, np.nan)
+            for name in names]
     return np.stack(cols, axis=1) if cols[0].size else np.zeros((0, len(names)))
 
 

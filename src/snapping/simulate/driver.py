@@ -486,6 +486,10 @@ def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall
                                  int(got["signum"]), dataset=ds, path=path)
         if code == K.RET_STOP:
             reason = f"snap detected: v_max fell below {inputs['stop_fraction']:g} of its peak"
+            settle = float(getattr(eng, "settle_time", -1.0))
+            if settle >= 0.0:
+                reason = (f"snap detected: the speed relative to the held end (settled at t={settle:.9g}) fell below "
+                          f"{inputs['stop_fraction']:g} of its peak")
         elif code == K.RET_END:
             reason = "t_end reached" if t_end is not None else "t_end_max reached before the speed fell after a peak"
         else:

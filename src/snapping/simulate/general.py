@@ -87,7 +87,8 @@ _U = np.uint64
 
 __all__ = [
     "Work", "make_model", "general_rhs", "general_measure", "model_rhs", "model_measure", "pin_kinematics",
-    "general_to_Z", "NMEAS_G", "NREC_G", "M_PX", "M_PY", "M_PVX", "M_PVY", "M_WORK", "RECORD_NAMES_G",
+    "general_to_Z", "NMEAS_G", "NREC_G", "M_PX", "M_PY", "M_PVX", "M_PVY", "M_WORK", "M_VREL", "RECORD_NAMES_G",
+    "settle_time",
 ]
 
 # ---------------------------------------------------------------- the model's scalar parameters
@@ -97,10 +98,10 @@ KIND_UNIFORM, KIND_GENERAL = 0.0, 1.0
 PIN_FIXED, PIN_PULL, PIN_FLICK, PIN_TABLE = 0.0, 1.0, 2.0, 3.0
 
 # ---------------------------------------------------------------- measurements beyond kernels.NMEAS
-M_PX, M_PY, M_PVX, M_PVY, M_WORK = range(K.NMEAS, K.NMEAS + 5)
-NMEAS_G = K.NMEAS + 5
-#: record columns beyond kernels.RECORD_NAMES (the same quantities as M_PX .. M_WORK)
-RECORD_NAMES_G = ("pin_x", "pin_y", "pin_vx", "pin_vy", "pin_work")
+M_PX, M_PY, M_PVX, M_PVY, M_WORK, M_VREL = range(K.NMEAS, K.NMEAS + 6)
+NMEAS_G = K.NMEAS + 6
+#: record columns beyond kernels.RECORD_NAMES (the same quantities as M_PX .. M_VREL)
+RECORD_NAMES_G = ("pin_x", "pin_y", "pin_vx", "pin_vy", "pin_work", "v_rel_max")
 NREC_G = K.NREC + len(RECORD_NAMES_G)
 
 TWO_PI = 2.0 * math.pi
@@ -162,7 +163,12 @@ def _spline(tab, n, off, i, u):
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def pin_kinematics(t, par, tab):
-    """(x, y, vx, vy, ax, ay) of the held end at time t."""
+    """(x, y, vx, vy, ax, ay) of the held end at time t.
+
+    At a breakpoint (:func:`breakpoints`, where the acceleration jumps) this is the left
+    limit, what a step that ends there uses; a step that starts there evaluates at
+    ``nextafter(t, inf)``, the right limit (as :meth:`snapping.simulate.pin.PinMotion.kinematics`
+    reports the motion at t)."""
     kind = par[P_PIN]
     if kind == PIN_FIXED:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -174,7 +180,7 @@ def pin_kinematics(t, par, tab):
         if t <= t0:
             return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         tau = t - t0
-        if tau <= T:
+        if t <= t0 + T:  # (not tau <= T: the breakpoint t0 + T is where the pull ends, as breakpoints() says)
             q = 0.5 * tau * tau
             return ax * q, ay * q, ax * tau, ay * tau, ax, ay
         q = 0.5 * T * T + T * (tau - T)
@@ -188,7 +194,7 @@ def pin_kinematics(t, par, tab):
         cs = math.cos(w * tau)
         v = (1.0 - cs) / w
         r = (tau - sn / w) / w
-        a = sn if t - t0 < T else 0.0
+        a = sn if t < t0 + T else 0.0
         return ax * r, ay * r, ax * v, ay * v, ax * a, ay * a
     # PIN_TABLE: cubic pieces on [t_i, t_{i+1}], constant velocity after the last knot
     n = int(par[P_NKNOT])
@@ -200,7 +206,7 @@ def pin_kinematics(t, par, tab):
             return x, y, vx, vy, axx, ayy
         dt = t - tab[0]
         return x + vx * dt, y + vy * dt, vx, vy, 0.0, 0.0
-    if t >= tab[n - 1]:
+    if t > tab[n - 1]:  # (at the last knot itself: the last piece's end, the left limit)
         i = m - 1
         u = tab[n - 1] - tab[i]
         x, vx, _ = _spline(tab, n, n, i, u)
@@ -364,8 +370,10 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
     arclength of their node from the held end, the free end's speed and acceleration, the
     force of the chain on the held end (``-T_{N-1} t_{N-1}``), the energy
     ``sum m_j (|v_j|^2/2 - g y_j) + g sum m_j s_j`` (zero hanging at rest from the origin),
-    link errors ``| |t_j| - 1 |``, the length, and the held end's position, velocity and
-    work done on the chain (``y[2N]``). ``rinv0`` is unused (links are exact)."""
+    link errors ``| |t_j| - 1 |``, the length, the held end's position, velocity and
+    work done on the chain (``y[2N]``), and the largest node speed relative to the held end
+    ``max_j |v_j - v_p|`` (what the stop rule judges, :func:`settle_time`). ``rinv0`` is
+    unused (links are exact)."""
     general_to_Z(N, t, y, c, s, sig, Z, par, h, invm, invh, snode, tab)
     g = par[P_G]
     vmax2 = -1.0
@@ -375,6 +383,9 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
     ke = 0.0
     pe = 0.0
     fin = 0.0
+    pvx = Z[K.RVX, N]
+    pvy = Z[K.RVY, N]
+    vrel2 = 0.0
     for i in range(N):
         vx = Z[K.RVX, i]
         vy = Z[K.RVY, i]
@@ -389,6 +400,9 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
         if v2 > vmax2:
             vmax2 = v2
             iv = i
+        w2 = (vx - pvx) * (vx - pvx) + (vy - pvy) * (vy - pvy)
+        if w2 > vrel2:
+            vrel2 = w2
         if a2 > amax2:
             amax2 = a2
             ia = i
@@ -442,6 +456,7 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
     meas[M_PVX] = Z[K.RVX, N]
     meas[M_PVY] = Z[K.RVY, N]
     meas[M_WORK] = y[2 * N]
+    meas[M_VREL] = math.sqrt(vrel2)
     tot = fin + ke + pe + smax + length + y[2 * N]
     meas[K.M_FINITE] = 1.0 if (tot - tot) == 0.0 else 0.0
 
@@ -480,6 +495,24 @@ def breakpoints(mdl) -> list[float]:
     if kind == PIN_TABLE:
         return [float(tab[int(par[P_NKNOT]) - 1])]
     return []
+
+
+def settle_time(mdl) -> float:
+    """The time from which the held end's acceleration no longer changes (its last
+    breakpoint), or -1 for a fixed held end.
+
+    The automatic stop rule and the snap detection judge the chain's motion relative to
+    the held end, and only from this time on: while the held end is still being driven
+    (a flick, a finite pull, a table of samples), a fall of the chain's speed can be the
+    held end slowing down, not the snap. After it the held end moves with constant
+    acceleration (an endless pull: in its frame, the chain falls under the changed gravity
+    ``g e2 - A``) or constant velocity (a Galilean frame), and the motion relative to it
+    is the chain's own, so its snap is a rise and fall of ``max_j |v_j - v_p|``. A fixed
+    held end (-1) keeps the rule on ``v_max`` from t = 0 (they are the same)."""
+    par = mdl[0]
+    if par[P_KIND] == KIND_UNIFORM or par[P_PIN] == PIN_FIXED:
+        return -1.0
+    return max([0.0] + breakpoints(mdl))
 
 
 def uniform_model(N: int):

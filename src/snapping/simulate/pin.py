@@ -169,9 +169,23 @@ class PinMotion:
                 "table": self._spline_table() if self.kind == "table" else None}
 
     def kinematics(self, t: float):
-        """(x, y, vx, vy, ax, ay) of the held end at time t (the compiled evaluation)."""
+        """(x, y, vx, vy, ax, ay) of the held end at time t (the compiled evaluation).
+
+        Where the acceleration jumps (the start and end of a pull, the last sample of a
+        table) it is the acceleration from t on, the right limit: what the run uses from t
+        and shows in its snapshot at t (a pull from t0 = 0 accelerates the chain at t = 0).
+
+        >>> PinMotion.pull((0.0, -2.0), duration=0.5).kinematics(0.0)[4:]
+        (0.0, -2.0)
+        >>> PinMotion.pull((0.0, -2.0), duration=0.5).kinematics(0.5)[4:]
+        (0.0, 0.0)
+        """
+        t = V.real("t", t)
         mdl = G.make_model(np.ones(1), np.ones(1), **self.model_args())
-        return tuple(float(v) for v in G.pin_kinematics(float(t), mdl[0], mdl[-1]))
+        out = [float(v) for v in G.pin_kinematics(t, mdl[0], mdl[-1])]
+        if t in G.breakpoints(mdl):  # (position and velocity are continuous there)
+            out[4:] = [float(v) for v in G.pin_kinematics(float(np.nextafter(t, np.inf)), mdl[0], mdl[-1])[4:]]
+        return tuple(out)
 
     def position(self, t: float):
         return self.kinematics(t)[:2]

@@ -91,8 +91,8 @@ ERR_EXPONENT = -1.0 / 8.0
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
  Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ,
- Q_TBRK, Q_LASTBRK) = range(39)
-NQ = 39
+ Q_TBRK, Q_LASTBRK, Q_TSETTLE, Q_ARMED, Q_VRBASE, Q_VRPEAK) = range(43)
+NQ = 43
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
@@ -357,6 +357,21 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     vbest = pk[0, PK_BEST]
     stopfrac = ctl[Q_STOPFRAC]
     vdown = ctl[Q_VDOWN]
+    if ctl[Q_TSETTLE] >= 0.0:
+        # a moving held end (general.settle_time): the chain's speed relative to the held
+        # end, from the time the held end's acceleration stops changing; the rule falls
+        # only after a rise above the speed it was armed with
+        vrel = meas[G.M_VREL]
+        if ctl[Q_ARMED] == 0.0:
+            if t >= ctl[Q_TSETTLE]:
+                ctl[Q_ARMED] = 1.0
+                ctl[Q_VRBASE] = vrel
+                ctl[Q_VRPEAK] = vrel
+        elif vrel > ctl[Q_VRPEAK]:
+            ctl[Q_VRPEAK] = vrel
+        fell = ctl[Q_ARMED] != 0.0 and ctl[Q_VRPEAK] > ctl[Q_VRBASE] and vrel < stopfrac * ctl[Q_VRPEAK]
+    else:
+        fell = vmax < stopfrac * vbest
     code = GO_ON
     if meas[K.M_FINITE] == 0.0:
         code = K.RET_FAIL_NAN
@@ -366,7 +381,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         code = K.RET_FAIL_ENERGY
     elif dt < dtmin:
         code = K.RET_FAIL_DT
-    elif stopfrac > 0.0 and vmax < stopfrac * vbest:
+    elif stopfrac > 0.0 and fell:
         code = K.RET_STOP
     elif last:
         code = K.RET_END

@@ -166,6 +166,11 @@ class Engine(CheckpointMixin):
         c[R.Q_CONSREJ] = 0.0
         c[R.Q_TBRK] = np.inf
         c[R.Q_LASTBRK] = np.nan
+        # the stop rule of a moving held end: armed from its settle time (general.settle_time)
+        c[R.Q_TSETTLE] = G.settle_time(self.mdl)
+        if 0.0 <= c[R.Q_TSETTLE] <= t0:
+            c[R.Q_ARMED] = 1.0
+            c[R.Q_VRBASE] = c[R.Q_VRPEAK] = self.meas[G.M_VREL]
         self.ctl = c
         pk = np.full((4, R.NPKR), np.nan)
         for qi, m in enumerate(_PEAK_MEAS):
@@ -182,6 +187,11 @@ class Engine(CheckpointMixin):
         self.requested = list(snapshot_times)
         self.after_fracs = [f for f in AFTER_PEAK_FRACTIONS if f > stop_fraction]
         self.t0 = t0
+
+    @property
+    def settle_time(self) -> float:
+        """When the stop rule of a moving held end is armed (:func:`general.settle_time`; -1: fixed)."""
+        return float(self.ctl[R.Q_TSETTLE])
 
     def _initial_step(self, y0, f0, t0) -> float:
         """Hairer's starting step (Solving ODE I, II.4), in the max norm of the run."""
@@ -372,6 +382,8 @@ class Engine(CheckpointMixin):
 
         c, pk = self.ctl, self.pk
         results = {"status": status, "stop_reason": reason, "failure": failure, "failure_node": int(node)}
+        if self.general:  # (schema.PROBLEM_ATTRS)
+            results["t_pin_settled"] = float(c[R.Q_TSETTLE]) if c[R.Q_TSETTLE] >= 0.0 else float("nan")
         for qi, name in enumerate(K.PEAK_QUANTITIES):
             if name != "kappa":
                 results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
