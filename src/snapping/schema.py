@@ -96,6 +96,15 @@ PIN_STEP_VARS: dict[str, dict[str, str]] = {
     "pin_work": _v("work done on the chain by the held end since t = 0 (energy - pin_work is conserved)"),
 }
 
+#: Per accepted step, runs of a problem with a body only (:class:`snapping.simulate.Body`: bending
+#: stiffness, damping, drag, a clamp); their ``energy`` is kinetic + gravity + bending, and
+#: ``energy - pin_work + dissipated`` is conserved.
+BODY_STEP_VARS: dict[str, dict[str, str]] = {
+    "bending_energy": _v("bending energy of the chain (sum over nodes of B (turning angle - natural)^2 / (2 l))"),
+    "dissipated": _v("energy dissipated by drag and bending damping since t = 0 (the wind's work counts "
+                     "negative; energy - pin_work + dissipated is conserved)"),
+}
+
 #: Dimension of the pin-motion table of a general run (``pin_motion = 'table'``).
 PIN_TABLE_DIM = "pin_sample"
 
@@ -120,6 +129,8 @@ PROBLEM_ATTRS: dict[str, str] = {
     "gravity": "gravity along +e2 (1: the nondimensional g; 0: none)",
     "pin_motion": "motion of the held end: 'fixed', 'pull', 'flick' or 'table'",
     "start": "start shape: 'catenary', 'supports', 'curve' or 'nodes'",
+    "body": ("JSON description of the body (bending, curvature, damping, drag, wind, tip_drag, clamp; "
+             "nondimensional), runs of a problem with a body only"),
 }
 
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
@@ -194,7 +205,8 @@ def result_units(name: str) -> str:
     return RESULT_UNITS.get(name, "1")
 
 
-ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS}
+ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,
+            **BODY_STEP_VARS}
 
 # ---------------------------------------------------------------- checkpoints
 #: Status values of a run file that :func:`snapping.simulate.resume` continues.
