@@ -205,3 +205,140 @@ def test_accelerations_against_dense_cartesian_solve(N, clamped, moving):
         assert np.abs(f[N:2 * N] - acc).max() < 1e-10 * scale
         assert abs(f[2 * N + 1] - dD) < 1e-10 * (1.0 + abs(dD))
         assert abs(f[2 * N] - dW) < 1e-9 * (1.0 + abs(dW))
+
+
+# ---------------------------------------------------------------- the bending forces are -grad V_b
+def _generalised_forces(mdl, y, t=0.0):
+    """Q_j = sum_k F_k . dr_k/dtheta_j of the kernel's node forces (dr_k/dtheta_j = -h_j n_j, k <= j)."""
+    par, h, invm, invh, snode, tab = mdl
+    N = h.size
+    tab = tab.copy()
+    c, s = np.cos(y[:N]), np.sin(y[:N])
+    FR.node_forces(N, t, y, c, s, par, h, invh, tab, 0.0, 0.0)
+    o, n1 = int(par[FR.P_BOFF]), N + 1
+    FX, FY = tab[o + FR.B_FX * n1:o + FR.B_FX * n1 + N], tab[o + FR.B_FY * n1:o + FR.B_FY * n1 + N]
+    cx, cy = np.cumsum(FX), np.cumsum(FY)
+    return -h * (-s * cx + c * cy)
+
+
+@pytest.mark.parametrize("clamped", [False, True])
+def test_bending_forces_are_minus_the_gradient_of_the_energy(clamped):
+    N = 8
+    h = RNG.uniform(0.5, 1.5, N)
+    h /= h.sum()
+    m = np.full(N, 1.0 / N)
+    body = Body(bending=RNG.uniform(1e-3, 1e-2, N + 1), curvature=RNG.uniform(-1, 1, N + 1),
+                clamp=0.4 if clamped else None)
+    th = np.cumsum(RNG.uniform(-0.6, 0.6, N)) + 1.0
+    mdl = body.model(G.make_model(h, 1.0 / m), h, float(th[-1]))
+    cart = Cartesian(h, m, 1.0, body.node_values("bending", h), body.node_values("curvature", h), np.zeros(N + 1),
+                     *(np.zeros(N + 1),) * 4, (0.0, 0.0), 0.0,
+                     (lambda t: FR.clamp_angle(t, mdl[0], mdl[-1])) if clamped else None)
+    y = np.concatenate([th, np.zeros(N), [0.0, 0.0]])
+    Q = _generalised_forces(mdl, y)
+
+    def V(theta):
+        r, _ = cart.nodes(theta, np.zeros(N), np.zeros(6))
+        return cart.bending_energy(r, 0.0)
+
+    eps = 1e-6
+    grad = np.array([(V(th + eps * e) - V(th - eps * e)) / (2 * eps) for e in np.eye(N)])
+    assert np.abs(Q + grad).max() < 1e-7 * np.abs(grad).max()
+    # and the kernel's reported bending energy is the same V_b
+    from snapping.simulate import force_bending as FB
+
+    par, tab = mdl[0], mdl[-1]
+    o, n1 = int(par[FR.P_BOFF]), N + 1
+    vb = FB.bending_energy(N, y, tab[o:o + n1], tab[o + n1:o + 2 * n1], clamped, FR.clamp_angle(0.0, par, tab)[0])
+    assert abs(vb - V(th)) < 1e-14 * max(1.0, V(th))
+
+
+# ---------------------------------------------------------------- B = 0, no drag: today's runs bit for bit
+def test_inactive_body_gives_todays_runs_bit_for_bit():
+    assert not Body().active and not Body(curvature=3.0, wind=(1.0, 0.0)).active
+    p = Problem.catenary(0.4, 12, body=Body())
+    assert p.body is None and p.is_paper
+    a, b = run(0.4, 12, progress=False).dataset, run(p, progress=False).dataset
+    for k in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v", "n_steps"):
+        assert a.attrs[k] == b.attrs[k]
+    assert bool((a.v_max == b.v_max).all())
+    links = Links.taper(12, 0.3)
+    pin = PinMotion.flick((0.5, 0.0), 0.3)
+    a = run(Problem.catenary(0.4, links=links, pin=pin), t_end=0.4, progress=False).dataset
+    b = run(Problem.catenary(0.4, links=links, pin=pin, body=Body(wind=(0.2, 0.0))), t_end=0.4,
+            progress=False).dataset
+    assert "bending_energy" not in b and "body" not in b.attrs
+    for k in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "n_steps"):
+        assert a.attrs[k] == b.attrs[k]
+    assert bool((a.energy == b.energy).all())
+
+
+# ---------------------------------------------------------------- static: the clamped cantilever
+def test_clamped_cantilever_tip_deflection_converges_to_beam_theory():
+    """A horizontal cantilever (clamped straight out, alpha = 0) under its own weight q = 1 with
+    a large stiffness (small deflection): the static equilibrium of the discrete chain (theta''
+    = 0 at rest, solved from the kernel) has the tip deflection q L^4/(8 B) to O(1/N^2)."""
+    from scipy.optimize import root
+
+    B = 1000.0
+    errs = []
+    Ns = (5, 10, 20)
+    for N in Ns:
+        links = Links.uniform(N, lumping="shared")
+        h = links.h
+        mdl = Body(bending=B, clamp=0.0).model(G.make_model(h, 1.0 / links.m), h, math.pi)
+
+        def F(th):
+            return FR.dense_reference_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+
+        th = root(F, np.full(N, math.pi), method="hybr", tol=1e-14).x
+        assert np.abs(F(th)).max() < 1e-9 * B * N ** 3
+        tip = -float(np.sum(h * np.sin(th)))  # (y downward)
+        errs.append(tip / (1.0 / (8.0 * B)) - 1.0)
+    errs = np.abs(errs)
+    assert errs[-1] < 3e-3
+    orders = np.log2(errs[:-1] / errs[1:])
+    assert np.all(np.abs(orders - 2.0) < 0.05), orders
+
+
+# ---------------------------------------------------------------- dynamic: drag
+def test_line_falling_broadside_follows_the_quadratic_drag_fall():
+    """A straight horizontal line whose held end falls as a body of the same mass per drag,
+    y(t) = (v_t^2/g) ln cosh(g t/v_t): with drag c_n l_j |v|^2 on every node (shared lumping:
+    m_j = l_j) each node falls the same way, so the line stays straight, slack and level and
+    its free end reaches the terminal speed v_t = sqrt(m g/(c_n L)) = 1/sqrt(c_n)."""
+    cn = 4.0
+    vt = 1.0 / math.sqrt(cn)
+    T = 3.0
+    ts = np.linspace(0.0, T, 601)
+    pin = PinMotion.from_table(ts, np.zeros_like(ts), vt ** 2 * np.log(np.cosh(ts / vt)))
+    N = 10
+    x = np.linspace(1.0, 0.0, N + 1)
+    p = Problem.nodes(x, np.zeros(N + 1), links=Links.uniform(N, lumping="shared"), pin=pin,
+                      body=Body(drag_normal=cn, drag_tangential=0.3))
+    ds = run(p, t_end=T, tol=1e-10, progress=False).dataset
+    v_exact = vt * np.tanh(ds.t.values / vt)
+    assert np.abs(ds.v_end.values - v_exact).max() < 1e-6
+    assert abs(float(ds.v_end[-1]) - vt) < 1e-4 * vt
+    fin = ds.isel(snapshot=-1)
+    assert float(np.ptp(fin.y.values)) < 1e-7
+    # without drag the same held end drags a line that falls faster than it (and hangs from it)
+    q = Problem.nodes(x, np.zeros(N + 1), links=Links.uniform(N, lumping="shared"), pin=pin)
+    ds0 = run(q, t_end=1.0, progress=False).dataset
+    assert float(np.ptp(ds0.isel(snapshot=-1).y.values)) > 0.1
+
+
+def test_energy_balance_of_a_run_with_bending_damping_drag_wind_and_a_moving_clamp():
+    t = np.linspace(0.0, 0.6, 7)
+    body = Body(bending=2e-3, damping=1e-4, drag_normal=1.0, drag_tangential=0.05, drag_linear_normal=0.1,
+                wind=(0.3, -0.1), tip_drag=0.5, clamp=(t, 0.3 * np.sin(5 * t)))
+    p = Problem.catenary(0.3, links=Links.uniform(24, lumping="shared"), pin=PinMotion.flick((0.8, -0.3), 0.4),
+                         body=body)
+    ds = run(p, t_end=1.0, tol=1e-9, progress=False).dataset
+    bal = ds.energy - ds.pin_work + ds.dissipated
+    drift = float(np.abs(bal - bal[0]).max())
+    D = float(ds.dissipated[-1])
+    assert D > 0.05 and float(ds.bending_energy.max()) > 1e-3 and float(np.abs(ds.pin_work).max()) > 0.01
+    assert drift < 1e-7 and drift == pytest.approx(ds.attrs["energy_drift"], rel=1e-6, abs=1e-15)
+    # the stepper's check is on the balance: a bound below the dissipated energy is not hit
+    run(p, t_end=1.0, tol=1e-9, max_energy_drift=1e-6, progress=False)
