@@ -143,7 +143,7 @@ class Body:
         set_(self, "clamp", self._check_clamp(clamp))
         if self.clamp is not None and self._zero("bending"):
             raise V.SnappingInputError(f"clamp={clamp!r} needs bending stiffness: a clamped held end holds the "
-                                       f"line's direction only through its bending stiffness (give bending > 0)")
+                                       f"line's direction only through its bending stiffness (give bending=B > 0)")
 
     @staticmethod
     def _check_clamp(clamp):
