@@ -342,3 +342,103 @@ def test_energy_balance_of_a_run_with_bending_damping_drag_wind_and_a_moving_cla
     assert drift < 1e-7 and drift == pytest.approx(ds.attrs["energy_drift"], rel=1e-6, abs=1e-15)
     # the stepper's check is on the balance: a bound below the dissipated energy is not hit
     run(p, t_end=1.0, tol=1e-9, max_energy_drift=1e-6, progress=False)
+
+
+# ---------------------------------------------------------------- bad input, before any work
+@pytest.mark.parametrize("kw, name", [
+    ({"bending": -1.0}, "bending="), ({"bending": math.nan}, "bending="), ({"bending": math.inf}, "bending="),
+    ({"bending": [1.0, -1.0, 0.0]}, "bending[1]="), ({"damping": -1e-3}, "damping="),
+    ({"drag_normal": -2.0}, "drag_normal="), ({"drag_tangential": math.inf}, "drag_tangential="),
+    ({"drag_linear_normal": -1.0}, "drag_linear_normal="), ({"drag_linear_tangential": math.nan},
+                                                              "drag_linear_tangential="),
+    ({"curvature": math.nan}, "curvature="), ({"tip_drag": -0.1}, "tip_drag="), ({"wind": 1.0}, "wind="),
+    ({"wind": (1.0, 2.0, 3.0)}, "wind="), ({"wind": (math.nan, 0.0)}, "wind="), ({"clamp": 0.3}, "clamp="),
+    ({"bending": 1e-3, "clamp": math.inf}, "clamp="), ({"bending": 1e-3, "clamp": ([0.5, 1.0], [0.0, 0.1])}, "clamp"),
+    ({"bending": [[1.0]]}, "bending"),
+])
+def test_bad_body_is_refused_naming_the_parameter(kw, name):
+    with pytest.raises(SnappingInputError) as exc:
+        Body(**kw)
+    msg = str(exc.value)
+    assert name in msg and "\n" not in msg
+
+
+def test_per_node_profiles_are_checked_against_the_chain():
+    with pytest.raises(SnappingInputError, match=r"curvature has 3 entries; the chain has 11 nodes"):
+        Problem.catenary(0.3, 10, body=Body(bending=1e-3, curvature=[0.0, 1.0, 2.0]))
+    with pytest.raises(SnappingInputError, match=r"bending\(s\) failed"):
+        Problem.catenary(0.3, 10, body=Body(bending=lambda s: 1 / 0))
+    with pytest.raises(SnappingInputError, match=r"bending\[6\]=-1.0 is out of range"):  # (node 6: s = 0.4)
+        Problem.catenary(0.3, 10, body=Body(bending=lambda s: -1.0 if s < 0.45 else 1.0))
+    with pytest.raises(SnappingInputError, match="stiffness at the held end"):
+        Problem.catenary(0.3, 10, body=Body(bending=np.r_[np.ones(10), 0.0], clamp=0.0))
+    with pytest.raises(SnappingInputError, match="body=str"):
+        Problem.catenary(0.3, 10, body="stiff")
+    # a taper profile is fine, and recorded with its node values
+    p = Problem.catenary(0.3, 10, body=Body(bending=Body.taper_profile(1e-3, 0.1, 4)))
+    d = p.describe()["body"]
+    assert d["bending"]["function"].startswith("taper") and len(d["nodes"]["bending"]) == 11
+
+
+def test_euler_richardson_refuses_a_body_by_name():
+    p = Problem.catenary(0.3, 10, body=Body(drag_normal=1.0))
+    with pytest.raises(SnappingInputError, match="a body \\(bending stiffness, damping, drag"):
+        run(p, method="euler-richardson", t_end=0.01)
+
+
+def test_a_body_run_is_recorded_and_reruns_bit_for_bit(tmp_path):
+    import json
+
+    from snapping.simulate import rerun
+
+    body = Body(bending=Body.taper_profile(2e-3, 0.2), curvature=0.5, drag_normal=1.0, wind=(0.2, 0.0), clamp=1.2)
+    p = Problem.catenary(0.3, 12, body=body)
+    r = run(p, t_end=0.3, progress=False, output=tmp_path / "b.nc")
+    ds = r.dataset
+    assert json.loads(ds.attrs["body"])["clamp"] == 1.2 and "body" in json.loads(ds.attrs["problem"])
+    import xarray as xr
+
+    back = xr.open_dataset(tmp_path / "b.nc").load()
+    r2 = rerun(back, output=None)
+    assert r2.dataset.attrs["v_peak"] == ds.attrs["v_peak"] and bool((r2.dataset.dissipated == ds.dissipated).all())
+
+
+CLI_BAD = [("--bending", "-1"), ("--bending", "nan"), ("--bending", "1e308"), ("--bending-damping", "-1"),
+           ("--drag-normal", "-2"), ("--drag-normal", "inf"), ("--drag-tangential", "abc"),
+           ("--drag-linear", "1,2,3"), ("--drag-linear", "-1"), ("--wind", "1"), ("--wind", "1,2,3"),
+           ("--wind", "nan,0"), ("--tip-drag", "-1"), ("--clamped", "0.3"), ("--clamped", "abc")]
+
+
+@pytest.mark.parametrize("opt, value", CLI_BAD)
+def test_cli_bad_body_option_is_one_line_exit_2(opt, value, capsys):
+    from snapping.cli import main
+
+    argv = ["simulate", "--chi", "0.3", "--N", "10", "--t-end", "1e-3", "--json", "--no-progress", opt, value]
+    if opt == "--clamped" and value == "abc":
+        argv += ["--bending", "1e-3"]
+    try:
+        status = main(argv)
+    except SystemExit as exc:  # (argparse's own type errors)
+        status = exc.code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and opt in err[-1] and "error" in err[-1], err
+
+
+def test_cli_runs_a_body(capsys, tmp_path):
+    import json
+
+    from snapping.cli import main
+
+    status = main(["simulate", "--chi", "0.3", "--N", "12", "--t-end", "0.2", "--json", "--no-progress", "--bending",
+                   "1e-3", "--drag-normal", "1", "--drag-tangential", "0.05", "--drag-linear", "0.1,0.01", "--wind",
+                   "0.3,0", "--tip-drag", "0.2", "--clamped", "-o", str(tmp_path / "c.nc")])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0 and out["status"] == "completed" and out["energy_drift"] < 1e-8
+    import xarray as xr
+
+    ds = xr.open_dataset(tmp_path / "c.nc")
+    b = json.loads(ds.attrs["body"])
+    assert b["drag_linear_tangential"] == 0.01 and b["wind"] == [0.3, 0.0] and b["clamp"] is not None
+    x, y = ds.start_x.values, ds.start_y.values
+    assert b["clamp"] == pytest.approx(math.atan2(y[-2] - y[-1], x[-2] - x[-1]), abs=1e-15)  # the start's direction
+    ds.close()

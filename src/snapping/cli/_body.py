@@ -45,6 +45,10 @@ def body_from_args(args):
         v = _numbers("--drag-linear", args.drag_linear, 1, 2)
         kw["drag_linear_normal"] = v[0]
         kw["drag_linear_tangential"] = v[1] if len(v) > 1 else 0.0
+        try:
+            Body(drag_linear_normal=kw["drag_linear_normal"], drag_linear_tangential=kw["drag_linear_tangential"])
+        except SnappingInputError as exc:
+            raise SnappingInputError(f"--drag-linear={args.drag_linear!r}: {exc}") from None
     if args.wind is not None:
         try:
             w = [float(x) for x in args.wind.split(",")]
