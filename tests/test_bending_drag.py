@@ -442,3 +442,50 @@ def test_cli_runs_a_body(capsys, tmp_path):
     x, y = ds.start_x.values, ds.start_y.values
     assert b["clamp"] == pytest.approx(math.atan2(y[-2] - y[-1], x[-2] - x[-1]), abs=1e-15)  # the start's direction
     ds.close()
+
+
+# ---------------------------------------------------------------- small oscillations with bending
+def test_small_oscillations_of_a_hanging_line_with_bending_against_an_eigen_solve():
+    """Linearise the kernel about the line hanging straight down (finite differences of theta''
+    in theta) and compare its frequencies with those of the Lagrangian written independently:
+    mass matrix M_jk = h_j h_k sum_{i <= min(j,k)} m_i, stiffness diag(g h_k sum_{i<=k} m_i)
+    (gravity) + D^T diag(B_i/l_i) D (bending, D the turning-angle difference operator)."""
+    N = 12
+    h = RNG.uniform(0.7, 1.3, N)
+    h /= h.sum()
+    m = RNG.uniform(0.7, 1.3, N) / N
+    B = RNG.uniform(5e-3, 2e-2, N + 1)
+    body = Body(bending=B)
+    mdl = body.model(G.make_model(h, 1.0 / m), h, -math.pi / 2)
+    th0 = np.full(N, -math.pi / 2)
+    eps = 1e-6
+    J = np.zeros((N, N))
+    for k in range(N):
+        e = np.zeros(N)
+        e[k] = eps
+        fp = FR.dense_reference_rhs(0.0, np.concatenate([th0 + e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+        fm = FR.dense_reference_rhs(0.0, np.concatenate([th0 - e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+        J[:, k] = (fp - fm) / (2 * eps)
+    w_kernel = np.sort(np.sqrt(np.linalg.eigvals(-J).real))
+    cm = np.cumsum(m)
+    M = np.outer(h, h) * cm[np.minimum.outer(np.arange(N), np.arange(N))]
+    l = (h[:-1] + h[1:]) / 2
+    D = np.zeros((N - 1, N))
+    D[np.arange(N - 1), np.arange(N - 1)] = -1.0
+    D[np.arange(N - 1), np.arange(1, N)] = 1.0
+    Kmat = np.diag(h * cm) + D.T @ np.diag(B[1:N] / l) @ D
+    from scipy.linalg import eigh
+
+    w_eigen = np.sqrt(eigh(Kmat, M, eigvals_only=True))
+    assert np.abs(w_kernel / w_eigen - 1.0).max() < 1e-7
+    # bending stiffens the line: every frequency above the chain's
+    K0 = np.diag(h * cm)
+    assert np.all(w_eigen > np.sqrt(eigh(K0, M, eigvals_only=True)))
+
+
+def test_body_docstring_examples():
+    import doctest
+
+    from snapping.simulate import body
+
+    assert doctest.testmod(body).failed == 0
