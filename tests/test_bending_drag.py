@@ -145,7 +145,25 @@ class Cartesian:
         dK = sum(self.m[j] * v[j] @ a[j] for j in range(N))
         dP = -self.g * sum(self.m[j] * v[j, 1] for j in range(N))
         D = diss - pdrag
+        self.last = {"a": a, "pin_force": sol[n + N - 1] * (r[N] - r[N - 1]) + F[N], "r": r, "v": v}
         return acc, dK + dP + dV + D, D
+
+
+def _measure(mdl, y, t):
+    """The kernel's per-step diagnostics (meas) and position-form state Z at (t, y)."""
+    from snapping.simulate import kernels as K
+
+    par, h, invm, invh, snode, tab = mdl
+    N = h.size
+    tab = tab.copy()
+    w = G.Work(N)
+    f = np.empty(2 * N + 2)
+    FR.forced_rhs(N, t, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, par, h, invm, invh, snode, tab)
+    Z = np.zeros((K.NROWS, N + 1))
+    meas = np.zeros(FR.NMEAS_B)
+    FR.forced_measure(N, t, y, w.c, w.s, w.sig, Z, np.zeros(N), meas, par, h, invm, invh, snode, tab)
+    assert (K.RAX, K.RAY, K.M_PFX, K.M_PFY, K.M_ENERGY) == (4, 5, 9, 10, 11)
+    return Z, meas
 
 
 def _random_case(N, clamped, moving_clamp):
@@ -205,6 +223,17 @@ def test_accelerations_against_dense_cartesian_solve(N, clamped, moving):
         assert np.abs(f[N:2 * N] - acc).max() < 1e-10 * scale
         assert abs(f[2 * N + 1] - dD) < 1e-10 * (1.0 + abs(dD))
         assert abs(f[2 * N] - dW) < 1e-9 * (1.0 + abs(dW))
+        # the recorded diagnostics: node accelerations (with the node forces), the force of the
+        # chain on the held end (tension and the held link's bending couple), the energy
+        Z, meas = _measure(mdl, y, t)
+        a = cart.last["a"]
+        assert np.abs(Z[4, :N] - a[:N, 0]).max() < 1e-10 * scale and np.abs(Z[5, :N] - a[:N, 1]).max() < 1e-10 * scale
+        pf = cart.last["pin_force"]
+        assert abs(meas[9] - pf[0]) < 1e-10 * scale and abs(meas[10] - pf[1]) < 1e-10 * scale
+        r, v = cart.last["r"], cart.last["v"]
+        e = (0.5 * np.sum(cart.m * np.sum(v[:N] ** 2, axis=1)) - cart.g * np.sum(cart.m * r[:N, 1])
+             + cart.bending_energy(r, t) + mdl[0][G.P_EOFF])
+        assert abs(meas[11] - e) < 1e-12 * (1 + abs(e)) and meas[FR.M_BEND] == pytest.approx(cart.bending_energy(r, t))
 
 
 # ---------------------------------------------------------------- the bending forces are -grad V_b
