@@ -409,6 +409,17 @@ def test_per_node_profiles_are_checked_against_the_chain():
     assert d["bending"]["function"].startswith("taper") and len(d["nodes"]["bending"]) == 11
 
 
+def test_clamp_at_the_start_direction():
+    p = Problem.catenary(0.3, 10, body=Body(bending=1e-3, clamp="start"))
+    x, y = p.x, p.y
+    assert p.body.clamp == math.atan2(y[-2] - y[-1], x[-2] - x[-1])
+    assert math.pi / 4 < p.body.clamp < math.pi / 2  # (the catenary leaves the held end down and to the right)
+    with pytest.raises(SnappingInputError, match="clamp="):
+        Body(clamp="start")
+    with pytest.raises(SnappingInputError, match="clamp="):
+        Body(bending=1.0, clamp="begin")
+
+
 def test_euler_richardson_refuses_a_body_by_name():
     p = Problem.catenary(0.3, 10, body=Body(drag_normal=1.0))
     with pytest.raises(SnappingInputError, match="a body \\(bending stiffness, damping, drag"):

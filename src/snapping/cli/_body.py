@@ -5,8 +5,6 @@ the options as typed (``bending=-1`` -> ``--bending=-1``)."""
 
 from __future__ import annotations
 
-import math
-
 BODY_DESTS = ("bending", "damping", "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp")
 
 
@@ -62,22 +60,14 @@ def body_from_args(args):
         except ValueError:
             raise SnappingInputError(f"--clamped={args.clamp!r} must be an angle in radians (or no value: the "
                                      f"start's direction)") from None
-    kw["clamp"] = 0.0 if clamp == "start" else clamp  # (placeholder angle; set from the start in attach)
-    body = Body(**kw)
-    return body, clamp == "start"
+    kw["clamp"] = clamp
+    return Body(**kw)
 
 
-def attach_body(problem, body_spec, args):
+def attach_body(problem, body, args):
     """The problem (None: the paper's, from --chi and --N) with the body of :func:`body_from_args`."""
-    from ..simulate import Body, Problem
+    from ..simulate import Problem
 
-    body, from_start = body_spec
     if problem is None:
         problem = Problem.catenary(args.chi, args.N, chords=args.chords)
-    if from_start:
-        x, y = problem.x, problem.y
-        angle = math.atan2(y[-2] - y[-1], x[-2] - x[-1])
-        d = body.describe()
-        d["clamp"] = angle
-        body = Body.from_describe(d)
     return problem.with_body(body)

@@ -17,7 +17,8 @@ in the units of the chain (length L, mass M of the chain, g; ``lambda = M/L``):
   (units of ``lambda sqrt(g/L)``); ``wind``: a uniform air velocity ``(wx, wy)``
   (y downward); ``tip_drag``: body drag ``c_d`` of the free end's tip body
   (force ``-c_d |u| u``, units of ``M/L``);
-* ``clamp``: None (the held end a free hinge, the default), an angle (radians: the
+* ``clamp``: None (the held end a free hinge, the default), ``"start"`` (clamped in the
+  direction the start leaves the held end, set when the problem is built), an angle (radians: the
   direction in which the line leaves the held end, measured from +x towards +y, y
   downward: 0 straight out to the right, pi/2 hanging down), or a prescribed motion
   ``(t, angle)`` (samples from t = 0; a cubic spline with zero rate at both ends, constant
@@ -147,8 +148,8 @@ class Body:
 
     @staticmethod
     def _check_clamp(clamp):
-        if clamp is None:
-            return None
+        if clamp is None or (isinstance(clamp, str) and clamp == "start"):
+            return clamp
         if np.ndim(clamp) == 0:
             a = V.real("clamp", clamp)
             if not (math.isfinite(a) and abs(a) <= 1e3):
@@ -228,12 +229,23 @@ class Body:
             raise V.SnappingInputError("clamp: the bending stiffness at the held end (s = 0) is 0; a clamp needs "
                                        "bending > 0 there")
 
+    def resolved(self, x, y) -> "Body":
+        """This body with ``clamp="start"`` replaced by the direction in which a start with
+        nodes ``x, y`` (index N the held end) leaves the held end."""
+        if not (isinstance(self.clamp, str) and self.clamp == "start"):
+            return self
+        d = self.describe()
+        d["clamp"] = math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1]))
+        return Body.from_describe(d)
+
     def model(self, mdl, h, theta0: float):
         """The compiled model (:func:`snapping.simulate.forced.make_body_model`) from the general
         model ``mdl`` of a chain with links ``h``; ``theta0``: the held link's angle at t = 0
         (the clamp's link angle is taken within pi of it)."""
         from . import forced as FR
 
+        if isinstance(self.clamp, str):
+            raise V.SnappingInputError("clamp='start' is set from a start: build the Problem with this body")
         h = np.asarray(h, dtype=float)
         N = h.size
         l = np.zeros(N + 1)
@@ -281,6 +293,8 @@ class Body:
         d["tip_drag"] = self.tip_drag
         if isinstance(self.clamp, tuple):
             d["clamp"] = {"t": [float(x) for x in self.clamp[0]], "angle": [float(x) for x in self.clamp[1]]}
+        elif self.clamp == "start":
+            d["clamp"] = "start"
         else:
             d["clamp"] = self.clamp
         return d

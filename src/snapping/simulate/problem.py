@@ -502,7 +502,7 @@ class Problem:
                                        f"must keep every link's length (relative velocity normal to the link)")
         if moving:
             start = {**start, "velocities": True}
-        return cls(links, x, y, vx, vy, pin, g, start, chi, chords, body)
+        return cls(links, x, y, vx, vy, pin, g, start, chi, chords, None if body is None else body.resolved(x, y))
 
     def with_body(self, body: Body | None) -> "Problem":
         """This problem with another body (validated; None or an inactive body: none)."""
