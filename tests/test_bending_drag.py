@@ -559,3 +559,13 @@ def test_a_body_run_interrupted_resumes_bit_for_bit(tmp_path, monkeypatch):
     for k in ("energy", "dissipated", "bending_energy", "v_max", "pin_work"):
         np.testing.assert_array_equal(ds[k].values, ref[k].values)
     assert ds.attrs["energy_drift"] == ref.attrs["energy_drift"]
+
+
+def test_energy_bound_failure_names_the_balance():
+    from snapping.simulate import EnergyDriftError
+
+    p = Problem.catenary(0.3, 12, body=Body(bending=1e-3, drag_normal=1.0))
+    with pytest.raises(EnergyDriftError, match=r"\|E - E0\| = [0-9.e+-]+ > max_energy_drift=1e-13") as exc:
+        run(p, t_end=0.5, tol=1e-4, max_energy_drift=1e-13, progress=False)
+    de = float(str(exc.value).split("|E - E0| = ")[1].split(" ")[0])
+    assert de < 1e-6  # (the balance's drift, not the dissipated energy)

@@ -471,7 +471,10 @@ def _failure_message(code: int, eng: Engine, node: int = -1) -> str:
         return (f"link-length drift past the bound at t={t:.9g}: relative link error "
                 f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error = {c[R.Q_MAXLINK]:.3g}{where}")
     if code == K.RET_FAIL_ENERGY:
-        de = abs(eng.meas[K.M_ENERGY] - c[R.Q_E0])
+        ebal = eng.meas[K.M_ENERGY]
+        if eng.meas.size > K.NMEAS:  # (the balance the compiled loop bounds: E - W [+ D with a body])
+            ebal = ebal - eng.meas[G.M_WORK] + (eng.meas[G.NMEAS_G + 1] if eng.meas.size > G.NMEAS_G else 0.0)
+        de = abs(ebal - c[R.Q_E0])
         return (f"energy drift past the bound at t={t:.9g}: |E - E0| = {de:.3g} > "
                 f"max_energy_drift={c[R.Q_MAXENERGY]:.3g}{where}")
     if code == K.RET_FAIL_REJECT:
