@@ -20,7 +20,8 @@ def add_body_options(p) -> None:
                    help="quadratic tangential (skin friction) drag per length, units of lambda/L")
     g.add_argument("--drag-linear", default=None, metavar="KN[,KT]",
                    help="linear (Stokes) drag per length, normal [and tangential], units of lambda sqrt(g/L)")
-    g.add_argument("--wind", default=None, metavar="WX,WY", help="uniform wind velocity (y downward), units of sqrt(gL)")
+    g.add_argument("--wind", default=None, metavar="WX,WY",
+                   help="uniform wind velocity (y downward), units of sqrt(gL)")
     g.add_argument("--tip-drag", type=float, default=0.0, metavar="CD",
                    help="body drag of the free end's tip body, force CD |u| u, units of M/L")
     g.add_argument("--clamped", dest="clamp", nargs="?", const="start", default=None, metavar="ANGLE",

@@ -55,7 +55,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.5 --N 300 --method fast --pin-motion pull:0,-2,0.3   # yank it up\n"
             "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
             "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
-            "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held straight out\n"
+            "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
             "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
