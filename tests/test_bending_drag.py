@@ -569,3 +569,31 @@ def test_energy_bound_failure_names_the_balance():
         run(p, t_end=0.5, tol=1e-4, max_energy_drift=1e-13, progress=False)
     de = float(str(exc.value).split("|E - E0| = ")[1].split(" ")[0])
     assert de < 1e-6  # (the balance's drift, not the dissipated energy)
+
+
+def test_small_oscillations_of_a_hanging_chain_without_bending_are_the_bessel_frequencies():
+    """The frequencies of the hanging chain (no bending, consistent lumping) converge to
+    (j_{0,n}/2) sqrt(g/L) (zeros of J0) at second order in 1/N."""
+    from scipy.special import jn_zeros
+
+    errs = []
+    for N in (50, 100):
+        links = Links.uniform(N, lumping="shared")
+        mdl = G.make_model(links.h, 1.0 / links.m)
+        th0 = np.full(N, -math.pi / 2)
+        eps = 1e-7
+        w = G.Work(N)
+        f = np.empty(2 * N + 1)
+        J = np.zeros((N, N))
+        for k in range(N):
+            cols = []
+            for sgn in (1.0, -1.0):
+                y = np.concatenate([th0, np.zeros(N), [0.0]])
+                y[k] += sgn * eps
+                G.general_rhs(N, 0.0, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, *mdl)
+                cols.append(f[N:2 * N].copy())
+            J[:, k] = (cols[0] - cols[1]) / (2 * eps)
+        wk = np.sort(np.sqrt(np.abs(np.linalg.eigvals(-J).real)))[:3]
+        errs.append(np.abs(wk / (jn_zeros(0, 3) / 2) - 1.0))
+    assert np.all(errs[1] < 2e-3)
+    assert np.all(np.abs(np.log2(errs[0] / errs[1]) - 2.0) < 0.1)
