@@ -597,3 +597,37 @@ def test_small_oscillations_of_a_hanging_chain_without_bending_are_the_bessel_fr
         errs.append(np.abs(wk / (jn_zeros(0, 3) / 2) - 1.0))
     assert np.all(errs[1] < 2e-3)
     assert np.all(np.abs(np.log2(errs[0] / errs[1]) - 2.0) < 0.1)
+
+
+def test_large_deflection_cantilever_converges_to_the_elastica():
+    """A soft horizontal cantilever (B = 0.1, tip rotation ~60 degrees) against the heavy
+    elastica B theta'' = -q (L - s) cos theta, theta(0) = 0, theta'(L) = 0, shot with scipy:
+    the static chain's tip converges to the elastica's at second order."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq, root
+
+    B = 0.1
+
+    def rhs(s, z):
+        return [z[1], -(1.0 - s) * math.cos(z[0]) / B, math.cos(z[0]), math.sin(z[0])]
+
+    def shoot(k0):
+        return solve_ivp(rhs, (0.0, 1.0), [0.0, k0, 0.0, 0.0], rtol=1e-12, atol=1e-13).y[:, -1]
+
+    k0 = brentq(lambda k: shoot(k)[1], 0.1, 1.0 / (2.0 * B) + 1.0, xtol=1e-14)
+    _, _, xe, ye = shoot(k0)
+    assert 0.9 < shoot(k0)[0] < 1.2  # (a large deflection: the tip turns by about 60 degrees)
+    errs = []
+    for N in (10, 20, 40):
+        links = Links.uniform(N, lumping="shared")
+        h = links.h
+        mdl = Body(bending=B, clamp=0.0).model(G.make_model(h, 1.0 / links.m), h, math.pi)
+
+        def F(th):
+            return FR.dense_reference_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+
+        th = root(F, np.full(N, 3.0), method="hybr", tol=1e-13).x
+        assert np.abs(F(th)).max() < 1e-8
+        errs.append(math.hypot(-np.sum(h * np.cos(th)) - xe, -np.sum(h * np.sin(th)) - ye))
+    assert errs[-1] < 5e-4
+    assert np.all(np.abs(np.log2(np.array(errs[:-1]) / errs[1:]) - 2.0) < 0.05), errs
