@@ -216,7 +216,7 @@ def test_accelerations_against_dense_cartesian_solve(N, clamped, moving):
     for _ in range(3):
         mdl, th, om, t, pin, cart = _random_case(N, clamped, moving)
         y = np.concatenate([th, om, [0.0, 0.0]])
-        f = FR.dense_reference_rhs(t, y, mdl)
+        f = FR.evaluate_rhs(t, y, mdl)
         acc, dW, dD = cart.accelerations(th, om, t, pin)
         scale = 1.0 + np.abs(acc).max()
         assert np.abs(f[:N] - om).max() == 0.0
@@ -318,7 +318,7 @@ def test_clamped_cantilever_tip_deflection_converges_to_beam_theory():
         mdl = Body(bending=B, clamp=0.0).model(G.make_model(h, 1.0 / links.m), h, math.pi)
 
         def F(th):
-            return FR.dense_reference_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+            return FR.evaluate_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
 
         th = root(F, np.full(N, math.pi), method="hybr", tol=1e-14).x
         assert np.abs(F(th)).max() < 1e-9 * B * N ** 3
@@ -503,8 +503,8 @@ def test_small_oscillations_of_a_hanging_line_with_bending_against_an_eigen_solv
     for k in range(N):
         e = np.zeros(N)
         e[k] = eps
-        fp = FR.dense_reference_rhs(0.0, np.concatenate([th0 + e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
-        fm = FR.dense_reference_rhs(0.0, np.concatenate([th0 - e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+        fp = FR.evaluate_rhs(0.0, np.concatenate([th0 + e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+        fm = FR.evaluate_rhs(0.0, np.concatenate([th0 - e, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
         J[:, k] = (fp - fm) / (2 * eps)
     w_kernel = np.sort(np.sqrt(np.linalg.eigvals(-J).real))
     cm = np.cumsum(m)
@@ -624,7 +624,7 @@ def test_large_deflection_cantilever_converges_to_the_elastica():
         mdl = Body(bending=B, clamp=0.0).model(G.make_model(h, 1.0 / links.m), h, math.pi)
 
         def F(th):
-            return FR.dense_reference_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+            return FR.evaluate_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
 
         th = root(F, np.full(N, 3.0), method="hybr", tol=1e-13).x
         assert np.abs(F(th)).max() < 1e-8
@@ -649,7 +649,7 @@ def test_a_damped_run_relaxes_to_the_static_cantilever():
     mdl = p.model()
 
     def F(th):
-        return FR.dense_reference_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
+        return FR.evaluate_rhs(0.0, np.concatenate([th, np.zeros(N), [0.0, 0.0]]), mdl)[N:2 * N]
 
     th = root(F, np.full(N, 3.0), method="hybr", tol=1e-13).x
     h = links.h

@@ -31,7 +31,9 @@ Model: the tuple of :mod:`snapping.simulate.general` with ``par[P_KIND] = KIND_B
 ``par`` extended by the body's scalars (indices ``P_BOFF`` ...) and ``tab`` by the body
 block at ``par[P_BOFF]``: ``NB_IN`` node arrays (``Bl, K0L, El, CN, CT, KN, KT``, N + 1
 each), ``NB_SCR`` scratch node arrays (``FX, FY, VX, VY, MM, AN``), and the clamp's angle
-table at ``par[P_CLOFF]`` (``t`` then the cubic coefficients) when it moves.
+table at ``par[P_CLOFF]`` (``t`` then the cubic coefficients) when it moves. Because the
+scratch lives in the model, one model tuple serves one evaluation at a time (each engine
+builds its own with :meth:`snapping.simulate.problem.Problem.model`).
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ from . import general as G
 from . import kernels as K
 
 __all__ = ["KIND_BODY", "make_body_model", "forced_rhs", "forced_measure", "node_forces", "clamp_angle",
-           "M_BEND", "M_DISS", "NMEAS_B", "NREC_B", "RECORD_NAMES_B", "dense_reference_rhs"]
+           "M_BEND", "M_DISS", "NMEAS_B", "NREC_B", "RECORD_NAMES_B", "evaluate_rhs"]
 
 KIND_BODY = G.KIND_BODY
 
@@ -269,8 +271,10 @@ def forced_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode
         meas[K.M_FINITE] = 0.0
 
 
-def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
-    """``forced_rhs`` through a copy of the model (numpy entry for tests)."""
+def evaluate_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
+    """``[theta', theta'', W', D']`` at (t, y) from :func:`forced_rhs`, on a copy of the model's
+    table (a numpy entry point for tests and linearisations; not the dense check, which is
+    written independently in ``tests/test_bending_drag.py``)."""
     par, h, invm, invh, snode, tab = mdl
     N = h.size
     tab = tab.copy()
