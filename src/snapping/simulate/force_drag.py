@@ -54,8 +54,9 @@ def add_drag(N, c, s, wx, wy, CN, CT, KN, KT, cd, VX, VY, FX, FY):
             by = s[j - 1] + ty
             nb = math.sqrt(bx * bx + by * by)
             if nb > 1e-12:
-                tx = bx / nb
-                ty = by / nb
+                inb = 1.0 / nb
+                tx = bx * inb
+                ty = by * inb
         ux = VX[j] - wx
         uy = VY[j] - wy
         ut = ux * tx + uy * ty
@@ -63,7 +64,7 @@ def add_drag(N, c, s, wx, wy, CN, CT, KN, KT, cd, VX, VY, FX, FY):
         uty = ut * ty
         unx = ux - utx
         uny = uy - uty
-        un = math.sqrt(unx * unx + uny * uny)
+        un = abs(ux * ty - uy * tx)  # (|u_n| = |u x tau|, tau a unit vector)
         an = CN[j] * un + KN[j]
         at = CT[j] * abs(ut) + KT[j]
         fx = -an * unx - at * utx

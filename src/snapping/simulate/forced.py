@@ -200,9 +200,9 @@ def forced_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
         w = y[N + j]
         r = -h[j] * (w * w) - (afx * cj + afy * sj)
         e = (cn * cj + sn * sj) * imn
-        den = -(im + imn) - eprev * cprev
-        cprev = e / den
-        dprev = (r - eprev * dprev) / den
+        inv = 1.0 / (-(im + imn) - eprev * cprev)
+        cprev = e * inv
+        dprev = (r - eprev * dprev) * inv
         cp[j] = cprev
         dp[j] = dprev
         eprev = e
