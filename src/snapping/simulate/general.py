@@ -494,7 +494,7 @@ def uniform_model(N: int):
 
 
 def state_dim(mdl) -> int:
-    """Length of the state vector of a model with N links: 2N (uniform) or 2N + 1."""
+    """Length of the state vector of a model with N links: 2N (uniform), 2N + 1, or 2N + 2 (with a body)."""
     par, h = mdl[0], mdl[1]
     return 2 * h.size + (0 if par[P_KIND] == KIND_UNIFORM else 1) + (1 if par[P_KIND] == KIND_BODY else 0)
 
