@@ -97,6 +97,15 @@ PIN_STEP_VARS: dict[str, dict[str, str]] = {
     "v_rel_max": _v("maximum node speed relative to the held end, max_j |v_j - v_pin| (what the stop rule judges)"),
 }
 
+#: Per accepted step, runs of a problem with a body only (:class:`snapping.simulate.Body`: bending
+#: stiffness, damping, drag, a clamp); their ``energy`` is kinetic + gravity + bending, and
+#: ``energy - pin_work + dissipated`` is conserved.
+BODY_STEP_VARS: dict[str, dict[str, str]] = {
+    "bending_energy": _v("bending energy of the chain (sum over nodes of B (turning angle - natural)^2 / (2 l))"),
+    "dissipated": _v("energy dissipated by drag and bending damping since t = 0 (the wind's work counts "
+                     "negative; energy - pin_work + dissipated is conserved)"),
+}
+
 #: Dimension of the pin-motion table of a general run (``pin_motion = 'table'``).
 PIN_TABLE_DIM = "pin_sample"
 
@@ -124,6 +133,8 @@ PROBLEM_ATTRS: dict[str, str] = {
     "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
                       "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
                       "to the held end) from then on, after it has risen above its value then"),
+    "body": ("JSON description of the body (bending, curvature, damping, drag, wind, tip_drag, clamp; "
+             "nondimensional), runs of a problem with a body only"),
 }
 
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
@@ -199,7 +210,8 @@ def result_units(name: str) -> str:
     return RESULT_UNITS.get(name, "1")
 
 
-ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS}
+ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,
+            **BODY_STEP_VARS}
 
 # ---------------------------------------------------------------- checkpoints
 #: Status values of a run file that :func:`snapping.simulate.resume` continues.

@@ -54,6 +54,8 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.5 --N 300 --method fast --pin-motion flick:3,0,0.25  # flick the end\n"
             "  snapping simulate --chi 0.5 --N 300 --method fast --pin-motion pull:0,-2,0.3   # yank it up\n"
             "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
+            "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
+            "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
             "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
@@ -97,6 +99,9 @@ def _add_simulate(sub) -> None:
     p.add_argument("--pin-motion", default=None, metavar="SPEC",
                    help="held end: fixed (default), pull:AX,AY[,DURATION[,T0]] or flick:AX,AY,PERIOD[,T0]")
     p.add_argument("--gravity", type=float, default=1.0, help="gravity along +y in units of g (default 1; 0: none)")
+    from ._body import add_body_options
+
+    add_body_options(p)
     p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
@@ -144,6 +149,11 @@ def _cmd_simulate(args) -> int:
         problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
                                tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
                                pin_motion=args.pin_motion, gravity=args.gravity)
+        from ._body import attach_body, body_from_args
+
+        body = body_from_args(args)
+        if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
+            problem = attach_body(problem, body, args)
     try:
         if args.resume is not None:
             expect = _resume_expect(args, times)
@@ -216,7 +226,8 @@ def _cmd_simulate(args) -> int:
 _RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "snapshot_times", "record_thin",
                 "chords", "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
 #: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
-_PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity")
+_PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity", "bending", "damping",
+                    "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp")
 
 
 def _given_text(args, key: str) -> str:

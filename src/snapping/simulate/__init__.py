@@ -37,7 +37,7 @@ from .ensemble import run_ensemble
 from .errors import (DriftError, EnergyDriftError, NonFiniteError, RejectionError, RunInterrupted, SimulationError,
                      StepSizeError)
 from .options import RunOptions, memory_need
-from .problem import Links, PinMotion, Problem
+from .problem import Body, Links, PinMotion, Problem
 from .resuming import is_resumable, resume
 
 __all__ = [
@@ -45,6 +45,7 @@ __all__ = [
     "Problem",
     "Links",
     "PinMotion",
+    "Body",
     "RunOptions",
     "run_ensemble",
     "rerun",

@@ -197,8 +197,10 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
         if name == "t":
             continue
         data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(schema.STEP_VARS[name]))
-    for col, name in enumerate(G.RECORD_NAMES_G[:records.shape[1] - K.NREC], start=K.NREC):
-        data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(schema.PIN_STEP_VARS[name]))
+    step_vars_g = {**schema.PIN_STEP_VARS, **schema.BODY_STEP_VARS}  # (BODY_STEP_VARS: runs with a Body)
+    for col, name in enumerate((G.RECORD_NAMES_G + tuple(schema.BODY_STEP_VARS))[:records.shape[1] - K.NREC],
+                               start=K.NREC):
+        data_vars[name] = (schema.STEP_DIM, records[:, col].copy(), dict(step_vars_g[name]))
     snapshots = sorted(snapshots, key=lambda s: s[0])
     ns = len(snapshots)
     prof = {name: np.full((ns, N + 1), np.nan) for name in schema.NODE_PROFILE_VARS}
@@ -254,6 +256,10 @@ def _add_problem(problem, data_vars: dict, coords: dict, attrs: dict) -> None:
             data_vars[name] = (schema.PIN_TABLE_DIM, np.asarray(arr, dtype=float).copy(),
                                dict(schema.PROBLEM_VARS[name]))
     attrs["problem"] = problem.describe_json()
+    if getattr(problem, "body", None) is not None:
+        import json
+
+        attrs["body"] = json.dumps(problem.body.describe(problem.links.h), sort_keys=True)
     attrs["tip_mass"] = float(problem.links.tip_mass)
     attrs["gravity"] = float(problem.gravity)
     attrs["pin_motion"] = problem.pin.kind
@@ -354,6 +360,7 @@ def records_from_dataset(ds: xr.Dataset) -> np.ndarray:
     from . import general as G
 
     names = K.RECORD_NAMES + (G.RECORD_NAMES_G if G.RECORD_NAMES_G[0] in ds.variables else ())
+    names += tuple(schema.BODY_STEP_VARS) if "bending_energy" in ds.variables else ()
     n = ds.sizes.get(schema.STEP_DIM, 0)
     # (a column added later, e.g. v_rel_max, is NaN in the files written before it)
     cols = [np.asarray(ds[name].values, dtype=float) if name in ds.variables else np.full(n, np.nan)
@@ -486,8 +493,13 @@ def problem_from_dataset(ds: xr.Dataset):
             pin = PinMotion.from_table(ds["pin_table_t"].values, ds["pin_table_x"].values, ds["pin_table_y"].values)
         st = dict(desc["start"])
         vel = (ds["start_vx"].values, ds["start_vy"].values) if st.get("velocities") else (None, None)
+        body = None
+        if "body" in desc:
+            from .body import Body
+
+            body = Body.from_describe(desc["body"])
         p = Problem._make(links, ds["start_x"].values, ds["start_y"].values, *vel, pin,
-                          float(desc["gravity"]), st, chi=st.get("chi"), chords=st.get("chords"))
+                          float(desc["gravity"]), st, chi=st.get("chi"), chords=st.get("chords"), body=body)
     except (KeyError, TypeError, ValueError, json.JSONDecodeError) as exc:
         if isinstance(exc, V.SnappingInputError):
             raise

@@ -88,6 +88,8 @@ def _resolve_problem(chi, N, chords, initial, problem, method):
             why.append(f"a moving held end (pin motion {problem.pin.kind!r})")
         if problem.gravity != 1.0:
             why.append(f"gravity={problem.gravity:g} (it takes g = 1)")
+        if getattr(problem, "body", None) is not None:
+            why.append("a body (bending stiffness, damping, drag or a clamped held end)")
         if why:
             raise V.SnappingInputError(f"method={method!r} takes only the paper's chain with a fixed held end and "
                                        f"g = 1; this problem has {', '.join(why)}: use method='fast' (dop853)")

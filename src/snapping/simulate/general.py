@@ -95,6 +95,8 @@ __all__ = [
 P_KIND, P_G, P_PIN, P_AX, P_AY, P_T0, P_T1, P_NKNOT, P_EOFF = range(9)
 NPAR = 9
 KIND_UNIFORM, KIND_GENERAL = 0.0, 1.0
+#: a chain with node forces (bending, drag): :mod:`snapping.simulate.forced`, state ``[theta, theta', W, D]``
+KIND_BODY = 2.0
 PIN_FIXED, PIN_PULL, PIN_FLICK, PIN_TABLE = 0.0, 1.0, 2.0, 3.0
 
 # ---------------------------------------------------------------- measurements beyond kernels.NMEAS
@@ -469,6 +471,8 @@ def model_rhs(N, t, y, f, c, s, S, cp, dp, sig, mdl):
     par, h, invm, invh, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)
+    elif par[P_KIND] == KIND_BODY:  # node forces (bending, drag): snapping.simulate.forced
+        FR.forced_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
     else:
         general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
 
@@ -480,6 +484,8 @@ def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
     par, h, invm, invh, snode, tab = mdl
     if par[P_KIND] == KIND_UNIFORM:
         AG.measure_angles(N, y, c, s, sig, Z, rinv0, meas)
+    elif par[P_KIND] == KIND_BODY:
+        FR.forced_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab)
     else:
         general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab)
 
@@ -521,9 +527,9 @@ def uniform_model(N: int):
 
 
 def state_dim(mdl) -> int:
-    """Length of the state vector of a model with N links: 2N (uniform) or 2N + 1."""
+    """Length of the state vector of a model with N links: 2N (uniform), 2N + 1, or 2N + 2 (with a body)."""
     par, h = mdl[0], mdl[1]
-    return 2 * h.size + (0 if par[P_KIND] == KIND_UNIFORM else 1)
+    return 2 * h.size + (0 if par[P_KIND] == KIND_UNIFORM else 1) + (1 if par[P_KIND] == KIND_BODY else 0)
 
 
 def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
@@ -551,3 +557,6 @@ def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
             acc[j] = (Sd[j] * T[j + 1] * invm[j + 1] - lo) / h[j]
     W = T[N - 1] * (math.cos(th[N - 1]) * pvx + math.sin(th[N - 1]) * pvy)
     return np.concatenate([om, acc, [W]])
+
+
+from . import forced as FR  # noqa: E402 (forced builds on this module; used at compile time only)

@@ -39,9 +39,10 @@ import numpy as np
 
 from .. import _validate as V
 from . import general as G
+from .body import Body
 from .pin import PIN_KINDS, PinMotion, parse_pin_motion
 
-__all__ = ["Links", "PinMotion", "Problem", "LUMPINGS", "PIN_KINDS"]
+__all__ = ["Links", "PinMotion", "Problem", "Body", "LUMPINGS", "PIN_KINDS"]
 
 LUMPINGS = ("shared", "paper")
 #: mass of the free-end node: its share of link 0, or all of it
@@ -318,6 +319,8 @@ class Problem:
     start: dict = field(default_factory=dict)
     chi: float | None = None
     chords: str | None = None
+    #: what the line is made of (bending, damping, drag, a clamp): None, or an active Body
+    body: Body | None = None
 
     @property
     def N(self) -> int:
@@ -327,17 +330,17 @@ class Problem:
     def is_paper(self) -> bool:
         """The paper's problem: its chain from the catenary, at rest, fixed pin, g = 1."""
         return bool(self.links.is_paper and self.start.get("kind") == "catenary" and self.pin.is_fixed
-                    and self.gravity == 1.0 and not self.start.get("velocities"))
+                    and self.gravity == 1.0 and not self.start.get("velocities") and self.body is None)
 
     @property
     def is_uniform_fixed(self) -> bool:
         """The paper's chain and held end with g = 1, from any start (what Euler-Richardson takes)."""
-        return bool(self.links.is_paper and self.pin.is_fixed and self.gravity == 1.0)
+        return bool(self.links.is_paper and self.pin.is_fixed and self.gravity == 1.0 and self.body is None)
 
     # -- constructors
     @classmethod
     def catenary(cls, chi: float, N: int | None = None, *, chords: str = "exact", links: Links | None = None,
-                 pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
+                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None) -> "Problem":
         """The paper's start: the level catenary of end separation ``chi``, at rest. With the
         paper's links (default: ``Links.uniform(N)``) the nodes are those of
         :func:`snapping.simulate.initial_state` (``chords`` as there); other links are placed
@@ -377,11 +380,11 @@ class Problem:
                 x, y = L * np.asarray(xs, dtype=float), L * np.asarray(ys, dtype=float)
                 x[-1] = y[-1] = 0.0
         return cls._make(links, x, y, None, None, pin, gravity, {"kind": "catenary", "chi": chi, "chords": chords},
-                         chi=chi, chords=chords)
+                         chi=chi, chords=chords, body=body)
 
     @classmethod
     def supports(cls, dx: float, dy: float, N: int | None = None, *, links: Links | None = None,
-                 pin: PinMotion | None = None, gravity: float = 1.0) -> "Problem":
+                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None) -> "Problem":
         """The catenary hanging between the held end (origin) and a second support at
         ``(dx, dy)`` (``dy > 0``: lower, y grows downward), released at rest from there;
         nodes at chords exactly ``h_j``."""
@@ -393,11 +396,12 @@ class Problem:
         dy = V.real("dy", dy)
         curve = shapes.catenary_between(dx, dy, links.length)
         x, y = shapes.place_on_curve(curve, links.h)
-        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "supports", "dx": dx, "dy": dy})
+        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "supports", "dx": dx, "dy": dy}, body=body)
 
     @classmethod
     def curve(cls, curve, N: int | None = None, *, links: Links | None = None, vx=None, vy=None,
-              pin: PinMotion | None = None, gravity: float = 1.0, name: str = "curve") -> "Problem":
+              pin: PinMotion | None = None, gravity: float = 1.0, name: str = "curve",
+              body: Body | None = None) -> "Problem":
         """Any start curve: a function ``s -> (x, y)`` of the arclength from the held end (at
         the origin), or a polyline ``(xc, yc)`` starting at the held end; nodes at chords
         exactly ``h_j`` along it."""
@@ -413,11 +417,11 @@ class Problem:
         except Exception as exc:  # noqa: BLE001 - the user's curve function failed
             raise V.SnappingInputError(f"{name}: the curve function failed or did not return (x, y) "
                                        f"({type(exc).__name__}: {str(exc)[:120]})") from None
-        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "curve", "name": str(name)})
+        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "curve", "name": str(name)}, body=body)
 
     @classmethod
     def nodes(cls, x, y, *, links: Links | None = None, vx=None, vy=None, pin: PinMotion | None = None,
-              gravity: float = 1.0, name: str = "nodes") -> "Problem":
+              gravity: float = 1.0, name: str = "nodes", body: Body | None = None) -> "Problem":
         """Start from node coordinates (N + 1 each, index 0 the free end, index N the held end
         at the origin); ``links`` default: the uniform chain of the nodes' count. Link lengths
         must agree with the chain's ``h`` to ``SHAPE_RTOL``; velocities (default: at rest, or
@@ -441,13 +445,18 @@ class Problem:
             j = int(np.argmax(rel))
             raise V.SnappingInputError(f"x, y: shape link {j} has length {lens[j]:.9g} but the chain's link is "
                                        f"{links.h[j]:.9g} (relative difference {rel[j]:.3g} > {SHAPE_RTOL:g})")
-        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "nodes", "name": str(name)})
+        return cls._make(links, x, y, vx, vy, pin, gravity, {"kind": "nodes", "name": str(name)}, body=body)
 
     @classmethod
-    def _make(cls, links, x, y, vx, vy, pin, gravity, start, chi=None, chords=None) -> "Problem":
+    def _make(cls, links, x, y, vx, vy, pin, gravity, start, chi=None, chords=None, body=None) -> "Problem":
         from . import shapes
 
         _check_links(links)
+        if body is not None:
+            if not isinstance(body, Body):
+                raise V.SnappingInputError(f"body={type(body).__name__} is not a snapping.simulate.Body")
+            body.check(links.h)
+            body = body if body.active else None  # (an inactive body: today's problem, bit for bit)
         if not (np.all(links.m >= 1.0 / MASS_RANGE) and np.all(links.m <= MASS_RANGE)):
             j = int(np.argmax((links.m < 1.0 / MASS_RANGE) | (links.m > MASS_RANGE)))
             raise V.SnappingInputError(f"m[{j}]={float(links.m[j])!r} is out of range: node masses must lie in "
@@ -493,7 +502,13 @@ class Problem:
                                        f"must keep every link's length (relative velocity normal to the link)")
         if moving:
             start = {**start, "velocities": True}
-        return cls(links, x, y, vx, vy, pin, g, start, chi, chords)
+        return cls(links, x, y, vx, vy, pin, g, start, chi, chords, None if body is None else body.resolved(x, y))
+
+    def with_body(self, body: Body | None) -> "Problem":
+        """This problem with another body (validated; None or an inactive body: none)."""
+        return Problem._make(self.links, self.x, self.y, self.vx if self.start.get("velocities") else None,
+                             self.vy if self.start.get("velocities") else None, self.pin, self.gravity,
+                             dict(self.start), chi=self.chi, chords=self.chords, body=body)
 
     # -- the compiled form
     def model(self):
@@ -501,7 +516,10 @@ class Problem:
         chain with a fixed held end and g = 1, whatever the start)."""
         if self.is_uniform_fixed:
             return G.uniform_model(self.N)
-        return G.make_model(self.links.h, 1.0 / self.links.m, g=self.gravity, **self.pin.model_args())
+        mdl = G.make_model(self.links.h, 1.0 / self.links.m, g=self.gravity, **self.pin.model_args())
+        if self.body is not None:  # node forces: snapping.simulate.forced
+            mdl = self.body.model(mdl, self.links.h, float(self.initial_angles()[self.N - 1]))
+        return mdl
 
     def initial_angles(self) -> np.ndarray:
         """The initial state of the link-angle form: ``[theta, theta']`` (paper's chain) or
@@ -515,7 +533,8 @@ class Problem:
 
             return AG.state_to_angles(ChainState(self.x, self.y, self.vx, self.vy, 0.0))
         om = (-np.sin(th) * dvx + np.cos(th) * dvy) / self.links.h
-        return np.concatenate([th, om, [0.0]]).astype(float)
+        extra = [0.0, 0.0] if self.body is not None else [0.0]  # (W, and D with a body)
+        return np.concatenate([th, om, extra]).astype(float)
 
     def estimate(self) -> dict:
         """The paper's estimates from this start shape and these masses
@@ -534,8 +553,11 @@ class Problem:
 
     def describe(self) -> dict:
         """JSON-friendly description (recorded in the run file)."""
-        return {"chain": self.links.describe(), "start": dict(self.start), "pin": self.pin.describe(),
-                "gravity": self.gravity}
+        d = {"chain": self.links.describe(), "start": dict(self.start), "pin": self.pin.describe(),
+             "gravity": self.gravity}
+        if self.body is not None:
+            d["body"] = self.body.describe(self.links.h)
+        return d
 
     def describe_json(self) -> str:
         return json.dumps(self.describe(), sort_keys=True)

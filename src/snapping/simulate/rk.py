@@ -349,6 +349,8 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     ebal = meas[K.M_ENERGY]
     if meas.shape[0] > K.NMEAS:
         ebal -= meas[G.M_WORK]
+    if meas.shape[0] > G.NMEAS_G:  # a chain with node forces: + the energy dissipated (forced.M_DISS)
+        ebal += meas[G.NMEAS_G + 1]
     de = abs(ebal - ctl[Q_E0])
     if de > ctl[Q_DRIFT_E]:
         ctl[Q_DRIFT_E] = de

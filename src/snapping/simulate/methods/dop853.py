@@ -92,7 +92,7 @@ class Engine(CheckpointMixin):
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
                  dt_min=1e-14, max_energy_drift=None, max_rejections=100, mdl=None):
-        N = y0.size // 2
+        N = y0.size // 2 if mdl is None else mdl[1].size
         self.N = N
         self.mdl = G.uniform_model(N) if mdl is None else mdl
         self.general = self.mdl[0][G.P_KIND] != G.KIND_UNIFORM
@@ -117,6 +117,8 @@ class Engine(CheckpointMixin):
         self.rinv0 = np.full(N, float(N) * float(N))
         self.nmeas = G.NMEAS_G if self.general else K.NMEAS
         self.nrec = G.NREC_G if self.general else K.NREC
+        if self.mdl[0][G.P_KIND] == G.KIND_BODY:  # (bending energy and energy dissipated: forced.M_BEND, M_DISS)
+            self.nmeas, self.nrec = G.NMEAS_G + 2, G.NREC_G + 2
         self.meas = np.zeros(self.nmeas)
         self.rec = np.zeros((RECORD_CHUNK, self.nrec))
         self.tol = tol
@@ -481,7 +483,10 @@ def _failure_message(code: int, eng: Engine, node: int = -1) -> str:
         return (f"link-length drift past the bound at t={t:.9g}: relative link error "
                 f"{eng.meas[K.M_LINKERR]:.3g} > max_link_error = {c[R.Q_MAXLINK]:.3g}{where}")
     if code == K.RET_FAIL_ENERGY:
-        de = abs(eng.meas[K.M_ENERGY] - c[R.Q_E0])
+        ebal = eng.meas[K.M_ENERGY]
+        if eng.meas.size > K.NMEAS:  # (the balance the compiled loop bounds: E - W [+ D with a body])
+            ebal = ebal - eng.meas[G.M_WORK] + (eng.meas[G.NMEAS_G + 1] if eng.meas.size > G.NMEAS_G else 0.0)
+        de = abs(ebal - c[R.Q_E0])
         return (f"energy drift past the bound at t={t:.9g}: |E - E0| = {de:.3g} > "
                 f"max_energy_drift={c[R.Q_MAXENERGY]:.3g}{where}")
     if code == K.RET_FAIL_REJECT:

@@ -1,0 +1,79 @@
+"""Air drag as node forces (numba, ``cache=True``): one force family of
+:mod:`snapping.simulate.forced`.
+
+Node j (j < N; the held end's own drag is taken by the held end) moves with velocity
+``v_j`` (``v_N`` the held end's, ``v_j = v_{j+1} - h_j theta_j' n_j``) through air moving
+with the uniform wind ``w``; ``u = v_j - w`` is its velocity relative to the air. Its
+tangent ``tau_j`` is the unit bisector of its two links, ``(t_{j-1} + t_j)/|t_{j-1} + t_j|``
+(the link's own tangent ``t_0`` at the free end, and ``t_j`` where the two links fold back
+on each other exactly); ``u_t = (u.tau) tau``, ``u_n = u - u_t``. Over its share of length
+``l_j`` (``(h_{j-1} + h_j)/2``, ``h_0/2`` at the free end) the line pulls it with::
+
+    F_j = -(c_n l_j |u_n| + k_n l_j) u_n - (c_t l_j |u_t| + k_t l_j) u_t   [ - c_d |u| u at j = 0 ]
+
+quadratic normal (cylinder cross-flow) and tangential (skin friction) parts, linear
+(Stokes) parts, and a body drag ``c_d`` on the free end's tip body. Coefficients are
+nondimensional: per unit length ``c_n`` in units of ``lambda/L`` (a line falling broadside
+has the terminal speed ``sqrt(lambda g / c_n)``, 1/sqrt(c_n) nondimensional), ``k_n`` in
+units of ``lambda sqrt(g/L)``, ``c_d`` in units of ``M/L``.
+
+Arrays (length N + 1, by node, each already times ``l_j``): ``CN, CT, KN, KT``; ``VX, VY``
+scratch for the node velocities; ``FX, FY`` the node forces (added to).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+__all__ = ["node_velocities", "add_drag"]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def node_velocities(N, y, c, s, h, pvx, pvy, VX, VY):
+    """Node velocities from the held end's ``(pvx, pvy)`` and the angular velocities."""
+    VX[N] = pvx
+    VY[N] = pvy
+    for j in range(N - 1, -1, -1):
+        w = y[N + j] * h[j]
+        VX[j] = VX[j + 1] + s[j] * w
+        VY[j] = VY[j + 1] - c[j] * w
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def add_drag(N, c, s, wx, wy, CN, CT, KN, KT, cd, VX, VY, FX, FY):
+    """Add the drag forces (velocities ``VX, VY`` from :func:`node_velocities`); returns their
+    power ``sum_j F_j.v_j`` (<= 0 without wind)."""
+    p = 0.0
+    for j in range(N):
+        tx = c[j]
+        ty = s[j]
+        if j > 0:
+            bx = c[j - 1] + tx
+            by = s[j - 1] + ty
+            nb = math.sqrt(bx * bx + by * by)
+            if nb > 1e-12:
+                inb = 1.0 / nb
+                tx = bx * inb
+                ty = by * inb
+        ux = VX[j] - wx
+        uy = VY[j] - wy
+        ut = ux * tx + uy * ty
+        utx = ut * tx
+        uty = ut * ty
+        unx = ux - utx
+        uny = uy - uty
+        un = abs(ux * ty - uy * tx)  # (|u_n| = |u x tau|, tau a unit vector)
+        an = CN[j] * un + KN[j]
+        at = CT[j] * abs(ut) + KT[j]
+        fx = -an * unx - at * utx
+        fy = -an * uny - at * uty
+        if j == 0 and cd != 0.0:
+            u = math.sqrt(ux * ux + uy * uy)
+            fx -= cd * u * ux
+            fy -= cd * u * uy
+        FX[j] += fx
+        FY[j] += fy
+        p += fx * VX[j] + fy * VY[j]
+    return p
