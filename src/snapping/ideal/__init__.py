@@ -70,12 +70,16 @@ from __future__ import annotations
 #   kink       the exact motion s0(t), tensions, free end (numerical inversion of the time map)
 #   scalings   exponents and prefactors of the power laws near t*
 #   report     summary() / print_summary() (snapping ideal)
+from . import snap_time as _snap_time
 from .kink import (TAU_MIN, KinkState, fold_tension, free_end_acceleration, free_end_speed, kink_energy, kink_state,
                    moving_arm_length, s0, s0_ddot, s0_dot, tether_tension)
 from .report import print_summary, summary
 from .scalings import Scaling, asymptotic_scalings, observed_scalings
-from .snap_time import _T_HI, _T_LO, T_STAR, T_STAR_METHODS, t_star, t_star_mp, t_star_str  # noqa: F401 (_T_*)
+from .snap_time import _T_HI, _T_LO, T_STAR_METHODS, t_star, t_star_mp, t_star_str  # noqa: F401 (_T_*)
 from .symbolic import Derivation, check_printed_equations, derivation
+
+#: t* = 2 E(pi/4 | 2) as the nearest double (paper eq. for t*).
+T_STAR: float = _snap_time.T_STAR
 
 __all__ = [
     "T_STAR",
