@@ -2,6 +2,7 @@
 
 import doctest
 import importlib
+import pkgutil
 
 import pytest
 
@@ -10,9 +11,20 @@ MODULES = ["snapping.schema", "snapping.estimates", "snapping.estimates.catenary
            "snapping._files", "snapping.units", "snapping.cli"]
 
 
+def _with_submodules(module):
+    """The module and, for a package, every module in it (doctest.testmod skips the functions a
+    package only re-exports from its modules: each module's own examples are run there)."""
+    if not hasattr(module, "__path__"):
+        return [module]
+    return [module] + [importlib.import_module(m.name) for m in pkgutil.walk_packages(module.__path__, module.__name__ + ".")
+                       if not m.name.endswith(".__main__")]  # (runs the command line)
+
+
 @pytest.mark.parametrize("name", MODULES)
 def test_docstring_examples(name):
-    module = importlib.import_module(name)
-    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    failed = attempted = 0
+    for module in _with_submodules(importlib.import_module(name)):
+        result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+        failed, attempted = failed + result.failed, attempted + result.attempted
     # a module without examples would pass by construction: require that some ran
-    assert result.failed == 0 and result.attempted > 0, result
+    assert failed == 0 and attempted > 0, (name, failed, attempted)

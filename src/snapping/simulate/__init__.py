@@ -11,8 +11,10 @@ Layout (what is solved, how it is stepped, what is recorded, kept apart):
 
 * ``problem``: :class:`Problem`, :class:`Links`, :class:`PinMotion` (physics only);
   ``chain``: the paper's initial catenary and state; ``shapes``: start curves;
-* ``kernels`` (position form), ``angles`` (link-angle form, the paper's chain),
-  ``general`` (link-angle form, any chain and held end): the compiled equations;
+* ``kernels`` (position form: ``layout``, the array layouts; ``accelerations``, the
+  tension solve; ``measures``; ``stepping``, the Euler-Richardson loop), ``angles``
+  (link-angle form, the paper's chain), ``general`` (link-angle form, any chain and held
+  end): the compiled equations;
 * ``methods``: the table of methods, ``methods.euler_richardson`` and
   ``methods.dop853`` (with ``rk``, the compiled DOP853 loop): how a run is stepped;
 * ``options``: :class:`RunOptions`, the validated options every method shares;
@@ -21,6 +23,10 @@ Layout (what is solved, how it is stepped, what is recorded, kept apart):
   :func:`is_resumable`); ``errors``: the failures;
 * ``dataset``: building, saving and loading the run Dataset; ``ensemble``: several
   chains in one vectorised kernel.
+
+Imports run one way, problem -> options -> methods -> driver -> dataset (the shared
+readers and the memory guard sit apart, in ``_netcdf`` and ``_memory``);
+``tests/test_structure.py`` fails on an import circle.
 
 Example
 -------

@@ -15,15 +15,14 @@ import numpy as np
 
 from .. import _validate as V
 from . import kernels as K
-from .dataset import records_from_dataset
+from ._netcdf import records_from_dataset
+from .options import RECORD_CHUNK  # noqa: F401 (the engines take it from here)
 
 #: automatic snapshots when v_max first reaches SPEED_LEVEL_0 * SPEED_LEVEL_FACTOR**n
 SPEED_LEVEL_0 = 1.0
 SPEED_LEVEL_FACTOR = 1.5
 #: automatic snapshots after the peak, when v_max falls below these fractions of it
 AFTER_PEAK_FRACTIONS = (0.9, 0.7)
-#: record buffer rows handed back to Python at a time
-RECORD_CHUNK = 8192
 
 
 def _pad(vals) -> np.ndarray:

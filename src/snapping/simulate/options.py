@@ -20,14 +20,13 @@ snapping._validate.SnappingInputError: record_thin=1.5 is out of range: must lie
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, fields
 
 import numpy as np
 
 from .. import _validate as V
 from . import kernels as K
-from ._engine_common import RECORD_CHUNK
+from ._memory import MEMORY_MARGIN, _available_memory  # noqa: F401 (re-exported: options.MEMORY_MARGIN)
 
 __all__ = ["RunOptions", "memory_need", "check_memory", "check_progress", "check_checkpoint_every", "MAX_TOL"]
 
@@ -36,10 +35,10 @@ MAX_TOL = 0.1
 #: smallest stepper tolerance accepted (a few times the round-off of an O(1) velocity)
 MIN_TOL = 1e-15
 _DT_MIN_DEFAULT = 1e-14
+#: record buffer rows handed back to Python at a time (the engines' chunk; memory_need counts it)
+RECORD_CHUNK = 8192
 #: latest end time accepted (units of sqrt(l/g); the snap is at t ~ 1.2)
 T_MAX = 1e6
-#: fraction of the available memory a run may plan to use (resource guard)
-MEMORY_MARGIN = 0.8
 
 
 @dataclass(frozen=True)
@@ -163,21 +162,6 @@ def check_progress(progress):
 
 
 # ---------------------------------------------------------------- resource guard
-def _available_memory() -> int | None:
-    """Bytes of memory available to a new allocation (MemAvailable, else free pages); None if unknown."""
-    try:
-        with open("/proc/meminfo") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return int(os.sysconf("SC_AVPHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return None
-
-
 #: a count beyond any run (steps, records): extreme inputs are counted as this, then refused
 _MAX_COUNT = 1e30
 

@@ -114,7 +114,7 @@ BYTES_PER_LINK = 1000
 
 def _links_count(name: str, N) -> int:
     """N >= 1, and small enough that a chain of N links fits in the available memory."""
-    from .options import MEMORY_MARGIN, _available_memory
+    from ._memory import MEMORY_MARGIN, _available_memory
 
     N = V.integer(name, N, 1)
     avail = _available_memory()
@@ -572,7 +572,7 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
 
     p = check_input(path, name="shape")
     if p.endswith((".nc", ".nc4", ".cdf")):
-        from .dataset import open_netcdf
+        from ._netcdf import open_netcdf
 
         ds = open_netcdf(p)
         if "x" not in ds.variables or "y" not in ds.variables:
