@@ -39,7 +39,7 @@ tuple ``mdl = (par, h, invm, invh, snode, tab)`` of float64 arrays built by
 :meth:`snapping.simulate.problem.Problem.model`: scalar parameters (indices ``P_*``),
 link lengths, inverse node masses, inverse link lengths, the arclength of each node
 from the held end, and the pin-motion table. ``par[P_KIND] == KIND_UNIFORM`` marks the paper's chain, for which
-:func:`model_rhs` and :func:`model_measure` call the uniform kernels of
+:func:`snapping.simulate.models.model_rhs` and :func:`~snapping.simulate.models.model_measure` call the uniform kernels of
 :mod:`snapping.simulate.angles` unchanged (bit for bit the runs of before).
 
 Pin motions (``par[P_PIN]``): ``PIN_FIXED``; ``PIN_PULL``: acceleration ``(ax, ay)`` from
@@ -86,7 +86,7 @@ _SPLIT1 = 4503599627370497.0
 _U = np.uint64
 
 __all__ = [
-    "Work", "make_model", "general_rhs", "general_measure", "model_rhs", "model_measure", "pin_kinematics",
+    "Work", "make_model", "general_rhs", "general_measure", "pin_kinematics",
     "general_to_Z", "NMEAS_G", "NREC_G", "M_PX", "M_PY", "M_PVX", "M_PVY", "M_WORK", "M_VREL", "RECORD_NAMES_G",
     "settle_time",
 ]
@@ -463,33 +463,6 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
     meas[K.M_FINITE] = 1.0 if (tot - tot) == 0.0 else 0.0
 
 
-# ---------------------------------------------------------------- dispatch on the model's kind
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
-def model_rhs(N, t, y, f, c, s, S, cp, dp, sig, mdl):
-    """The derivative of y at t: the paper's uniform kernel (:func:`angles.angle_rhs`, state
-    of length 2N) when ``mdl`` is the uniform model, else :func:`general_rhs`."""
-    par, h, invm, invh, snode, tab = mdl
-    if par[P_KIND] == KIND_UNIFORM:
-        AG.angle_rhs(N, y, f, c, s, S, cp, dp, sig)
-    elif par[P_KIND] == KIND_BODY:  # node forces (bending, drag): snapping.simulate.forced
-        FR.forced_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
-    else:
-        general_rhs(N, t, y, f, c, s, S, cp, dp, sig, par, h, invm, invh, snode, tab)
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
-def model_measure(N, t, y, c, s, sig, Z, rinv0, meas, mdl):
-    """The per-step diagnostics of y at t (:func:`angles.measure_angles` for the uniform
-    model, else :func:`general_measure`)."""
-    par, h, invm, invh, snode, tab = mdl
-    if par[P_KIND] == KIND_UNIFORM:
-        AG.measure_angles(N, y, c, s, sig, Z, rinv0, meas)
-    elif par[P_KIND] == KIND_BODY:
-        FR.forced_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab)
-    else:
-        general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snode, tab)
-
-
 def breakpoints(mdl) -> list[float]:
     """Times where the held end's acceleration jumps (the steppers land on them): the start
     and end of a pull or a flick (a flick's acceleration is continuous, its third derivative
@@ -559,4 +532,3 @@ def dense_reference_rhs(t: float, y: np.ndarray, mdl) -> np.ndarray:
     return np.concatenate([om, acc, [W]])
 
 
-from . import forced as FR  # noqa: E402 (forced builds on this module; used at compile time only)

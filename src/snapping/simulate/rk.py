@@ -57,6 +57,7 @@ from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dc
 
 from . import general as G
+from . import models as MD
 from . import kernels as K
 
 NS = _dc.N_STAGES  # 12
@@ -124,14 +125,14 @@ def _stage_state(n, s, h, y0, Kst, out):
 def rk_step(N, t, h, y0, y1, Kst, ytmp, c, s, S, cp, dp, sig, tol, mdl):
     """One DOP853 step of size h from y0 at time t (with Kst[0] = f(t, y0)) into y1;
     Kst[1..12] are filled (Kst[12] = f(t + h, y1), and c, s, sig then belong to y1).
-    ``mdl`` is the chain's model (:func:`snapping.simulate.general.model_rhs`); the state
+    ``mdl`` is the chain's model (:func:`snapping.simulate.models.model_rhs`); the state
     has ``y0.shape[0]`` components. Returns the scaled error (accept if <= 1)."""
     n = y0.shape[0]
     for st in range(1, NS):
         _stage_state(n, st, h, y0, Kst, ytmp)
-        G.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
+        MD.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
     end_state(n, h, y0, Kst, y1)
-    G.model_rhs(N, t + h, y1, Kst[NS], c, s, S, cp, dp, sig, mdl)
+    MD.model_rhs(N, t + h, y1, Kst[NS], c, s, S, cp, dp, sig, mdl)
     return step_error(n, h, tol, y0, y1, Kst, ytmp)
 
 
@@ -192,7 +193,7 @@ def dense_build(N, t, h, y0, y1, Kst, F, ytmp, c, s, S, cp, dp, sig, mdl):
     n = y0.shape[0]
     for st in range(NS + 1, NSX):
         _stage_state(n, st, h, y0, Kst, ytmp)
-        G.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
+        MD.model_rhs(N, t + C_RK[st] * h, ytmp, Kst[st], c, s, S, cp, dp, sig, mdl)
     for i in range(n):
         dy = y1[i] - y0[i]
         f0 = Kst[0, i]
@@ -315,7 +316,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
         ctl[Q_DT_MAX_ACC] = h
     if err > ctl[Q_ERR_MAX_ACC]:
         ctl[Q_ERR_MAX_ACC] = err
-    G.model_measure(N, t, y1, c, s, sig, Z, rinv0, meas, mdl)
+    MD.model_measure(N, t, y1, c, s, sig, Z, rinv0, meas, mdl)
     # ---- running peaks (every accepted step)
     for qi in range(4):
         if qi == 0:
@@ -446,7 +447,7 @@ def advance_rk(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0,
         if ctl[Q_T] == ctl[Q_LASTBRK]:
             # a step from a breakpoint of the held end's motion (its acceleration jumps):
             # the first stage is the derivative just after it, not the last step's end (FSAL)
-            G.model_rhs(N, np.nextafter(ctl[Q_T], np.inf), y0, KK[ns, 0], c, s, S, cp, dp, sig, mdl)
+            MD.model_rhs(N, np.nextafter(ctl[Q_T], np.inf), y0, KK[ns, 0], c, s, S, cp, dp, sig, mdl)
             ctl[Q_NRHS] += 1.0
         else:
             for i in range(n):

@@ -41,6 +41,7 @@ from scipy.optimize import minimize_scalar
 from ... import _validate as V
 from .. import angles as AG
 from .. import general as G
+from .. import models as MD
 from .. import kernels as K
 from .. import rk as R
 from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0, SPEED_LEVEL_FACTOR, CheckpointMixin,
@@ -126,10 +127,10 @@ class Engine(CheckpointMixin):
         # initial state: slot 0 holds it as the end of a zero-length step
         self.Y1[0] = y0
         w = self.w
-        G.model_rhs(N, t_eval, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
+        MD.model_rhs(N, t_eval, y0, self.KK[0, R.NS], w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.TS[0] = t0
         self.HS[0] = 0.0
-        G.model_measure(N, t_eval, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas, self.mdl)
+        MD.model_measure(N, t_eval, y0, w.c, w.s, w.sig, self.Z, self.rinv0, self.meas, self.mdl)
         self.meas0 = self.meas.copy()
         self.link_error_initial = float(self.meas[K.M_LINKERR])
         if dt0 is None:
@@ -205,7 +206,7 @@ class Engine(CheckpointMixin):
         y1 = y0 + h0 * f0
         f1 = np.empty_like(y0)
         w = self.rw
-        G.model_rhs(N, t0 + h0, y1, f1, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
+        MD.model_rhs(N, t0 + h0, y1, f1, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.n_extra += 1
         d2 = np.max(np.abs(f1 - f0) / sc) / h0
         if max(d1, d2) <= 1e-15:
@@ -251,11 +252,11 @@ class Engine(CheckpointMixin):
         y = self.state_at(t)
         w = self.rw
         f = np.empty_like(y)
-        G.model_rhs(self.N, t, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
+        MD.model_rhs(self.N, t, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
         self.ctl[R.Q_NRHS] += 1
         Z = np.zeros((K.NROWS, self.N + 1))
         meas = np.zeros(self.nmeas)
-        G.model_measure(self.N, t, y, w.c, w.s, w.sig, Z, self.rinv0, meas, self.mdl)
+        MD.model_measure(self.N, t, y, w.c, w.s, w.sig, Z, self.rinv0, meas, self.mdl)
         return Z, meas
 
     def refine(self) -> None:
