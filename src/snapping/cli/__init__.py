@@ -41,6 +41,16 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
 
+class _Version(argparse.Action):
+    """--version, reading the installed version only when asked (importlib.metadata is slow to import)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .. import __version__
+
+        print(f"snapping {__version__}")
+        parser.exit(0)
+
+
 # ---------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     """The ``snapping`` command's parser, with one subparser per subcommand.
@@ -48,8 +58,6 @@ def build_parser() -> argparse.ArgumentParser:
     >>> build_parser().parse_args(["estimate", "--chi", "0.25"]).chi
     0.25
     """
-    from .. import __version__
-
     parser = _Parser(
         prog="snapping",
         formatter_class=_formatter,
@@ -69,7 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
             "  snapping <command> --help           # each command's options and examples"
         ),
     )
-    parser.add_argument("--version", action="version", version=f"snapping {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
     for add in _SUBCOMMANDS:
         add(sub)
