@@ -61,3 +61,59 @@ def test_version_still_reported(capsys):
         main(["--version"])
     assert exc.value.code == 0
     assert capsys.readouterr().out.startswith("snapping ")
+
+
+def test_a_mistyped_option_names_the_subcommand_and_suggests(capsys):
+    assert main(["estimate", "--chi", "0.25", "--lenght", "2", "--mass", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("snapping estimate: error: unrecognized argument: --lenght (did you mean --length?); "
+                   "see `snapping estimate --help`")
+    assert main(["simulate", "--chi", "0.3", "--t-ned=1"]) == 2
+    assert "snapping simulate: error: unrecognized argument: --t-ned (did you mean --t-end" in capsys.readouterr().err
+
+
+def test_a_mistyped_subcommand_gets_a_suggestion(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["estmate", "--chi", "0.25"])
+    assert exc.value.code == 2
+    assert "did you mean estimate" in capsys.readouterr().err
+
+
+def test_integers_are_echoed_as_integers(capsys):
+    assert main(["estimate", "--chi", "0.25", "--links", "1000000", "--table"]) == 2
+    err = capsys.readouterr().err
+    assert "--links=1000000 is outside" in err and "[10, 10000]" in err and "e+0" not in err
+    from snapping.cli import print_table
+
+    print_table([("steps", 1234567.0), ("t", 1.5)])
+    out = capsys.readouterr().out
+    assert "1234567" in out and "e+06" not in out
+
+
+def test_cli_messages_say_overwrite_the_cli_way(tmp_path, capsys):
+    png = tmp_path / "d.png"
+    png.write_bytes(b"x")
+    argv = ["design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--tip-mass", "0",
+            "--plot", str(png)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--overwrite" in err and "overwrite=True" not in err
+
+
+def test_design_says_the_table_end_is_no_limit_of_the_chain(capsys):
+    main(["design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--tip-mass", "0"])
+    out = capsys.readouterr().out
+    assert "admissible: 0.359-1.8 m (chi 0.18-0.9) [1.8 m: the end of the table's range, not a limit of the chain]" in out
+    res = json.loads(_json(["design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100",
+                            "--tip-mass", "0", "--json"]))
+    assert res["rows"][0]["admissible_separation_m"][0][1] == pytest.approx(1.8)
+
+
+def _json(argv):
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(argv) == 0
+    return buf.getvalue()

@@ -38,6 +38,16 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
 
     def error(self, message: str):  # noqa: D401 - argparse API
+        import re
+
+        bad = re.match(r"argument <command>: invalid choice: '([^']*)'", message)
+        if bad:  # a mistyped subcommand: suggest the closest
+            import difflib
+
+            choices = next(a for a in self._actions if isinstance(a, argparse._SubParsersAction)).choices
+            close = difflib.get_close_matches(bad.group(1), list(choices), n=2, cutoff=0.5)
+            if close:
+                message += f"; did you mean {' or '.join(close)}?"
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
 
@@ -121,7 +131,10 @@ def main(argv: list[str] | None = None) -> int:
     """Run the ``snapping`` command on ``argv`` (default: ``sys.argv[1:]``); returns the exit status
     (0 done, 1 numerical failure or I/O fault, 2 bad input, 130 or 143 interrupted by SIGINT or SIGTERM)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:
+        print(_unknown_message(parser, getattr(args, "command", None), unknown), file=sys.stderr)
+        return EXIT_BAD_INPUT
     if not getattr(args, "func", None):
         parser.print_help()
         return EXIT_BAD_INPUT
@@ -129,7 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
-        print(f"snapping {args.command}: error: {_as_typed(parser, args.command, str(exc))}", file=sys.stderr)
+        print(f"snapping {args.command}: error: {_cli_words(_as_typed(parser, args.command, str(exc)))}",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print(f"snapping {args.command}: interrupted", file=sys.stderr)
@@ -143,6 +157,39 @@ def main(argv: list[str] | None = None) -> int:
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
         return EXIT_FAILED
+
+
+def _cli_words(msg: str) -> str:
+    """A library message in the words of the command line (``--overwrite``, not ``overwrite=True``)."""
+    for lib in ("overwrite=True (--overwrite)", "--overwrite (overwrite=True)", "overwrite=True"):
+        msg = msg.replace(lib, "--overwrite")
+    return msg
+
+
+def _unknown_message(parser, command, unknown: list[str]) -> str:
+    """The one-line error for arguments no option takes, naming the subcommand and suggesting
+    the closest options of that subcommand (difflib)."""
+    import difflib
+
+    sub = None
+    if command:
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices.get(command)
+    where = sub or parser
+    options = sorted({o for a in where._actions for o in a.option_strings if o.startswith("--")})
+    parts, after_option = [], False
+    for arg in unknown:
+        if arg.startswith("-") and len(arg) > 1 and not arg[1:2].isdigit():
+            name = arg.split("=", 1)[0]
+            close = difflib.get_close_matches(name, options, n=3, cutoff=0.6)
+            hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+            parts.append(f"{name}{hint}")
+            after_option = "=" not in arg
+        elif not after_option:  # (a value right after an unknown option is taken to be its value)
+            parts.append(repr(arg))
+        else:
+            after_option = False
+    prog = f"snapping {command}" if command else "snapping"
+    return f"{prog}: error: unrecognized argument{'s' if len(parts) > 1 else ''}: {', '.join(parts)}; see `{prog} --help`"
 
 
 def _explicit_dests(argv) -> set[str]:

@@ -72,8 +72,8 @@ def print_table(rows, title: str | None = None) -> None:
     fmt_rows = []
     for r in rows:
         name, value = r[0], r[1]
-        if isinstance(value, float):
-            value = f"{value:.6g}"
+        if isinstance(value, float):  # (a count held as a float prints as an integer, not 1e+06)
+            value = str(int(value)) if value.is_integer() and 1e6 <= abs(value) < 1e15 else f"{value:.6g}"
         fmt_rows.append((str(name), str(value), *(str(c) for c in r[2:])))
     w0 = max(len(r[0]) for r in fmt_rows)
     w1 = max(len(r[1]) for r in fmt_rows)

@@ -70,6 +70,12 @@ class OutsideTable(V.SnappingInputError):
     """A query outside the table's range (names the input and the range)."""
 
 
+def _num(x) -> str:
+    """A number as the user would type it: an integer as an integer (``1000000``, not ``1e+06``)."""
+    x = float(x)
+    return str(int(x)) if x.is_integer() and abs(x) < 1e16 else f"{x:g}"
+
+
 def _coords(chi, N, tip):
     return np.log(np.asarray(chi, float)), np.log(np.asarray(N, float)), np.arcsinh(np.asarray(tip, float) / TIP_SCALE)
 
@@ -207,8 +213,8 @@ class Table:
                                   ("tip_mass", tip_a, r["tip_mass"])):
             bad = a[~((a >= lo) & (a <= hi))]
             if bad.size:
-                raise OutsideTable(f"{name}={float(bad[0]):g} is outside the table of computed snaps, which covers "
-                                   f"[{lo:g}, {hi:g}]")
+                raise OutsideTable(f"{name}={_num(bad[0])} is outside the table of computed snaps, which covers "
+                                   f"[{_num(lo)}, {_num(hi)}]")
         if np.any((tip_a > 0) & (N_a > self.n_tip_max)):
             raise OutsideTable(f"tip_mass={float(tip_a.max()):g} with links={int(N_a.max())}: the table has tip "
                                f"masses only for links <= {self.n_tip_max} (tip_mass 0 for up to {r['N'][1]})")
