@@ -137,7 +137,9 @@ def _print_si(scales, rows, title: str = "") -> None:
     from .. import units
 
     if scales is None:
-        print(f"  {units.NONDIMENSIONAL_NOTE}")
+        import textwrap
+
+        print(textwrap.fill(units.NONDIMENSIONAL_NOTE, width=100, initial_indent="  ", subsequent_indent="    "))
         return
 
     def fmt(v):

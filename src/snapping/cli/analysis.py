@@ -105,8 +105,8 @@ def _cmd_fit(args) -> int:
             raise SnappingInputError(f"{name}: {exc}") from None
     def run_line(ds) -> str:
         a = ds.attrs
-        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')}; "
-                f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
+        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')};\n"
+                f"  units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
 
     if args.json:
         if len(results) == 1:
@@ -125,7 +125,7 @@ def _cmd_fit(args) -> int:
             title=f"{names[0]}: chi = {res.chi:g}, N = {res.N}",
         )
         print()
-        print_table(scaling.report_rows(res), title="Exponents y ~ A (t* - t)^beta")
+        _print_exponents(scaling.report_rows(res))
         if res.delta is not None:
             d = res.delta
             print()
@@ -138,7 +138,7 @@ def _cmd_fit(args) -> int:
         for line in dict.fromkeys(run_line(r) for r in runs):  # (each distinct one once)
             print(f"runs: {line}")
         print()
-        print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
+        _print_columns(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
         if scales is None:
             _print_si(None, [])
         for name, res in zip(names, results):
@@ -155,6 +155,55 @@ def _cmd_fit(args) -> int:
         if not args.json:
             print("\nfigures: " + ", ".join(str(p) for p in paths))
     return 0
+
+
+def _print_columns(rows: list[tuple], title: str, keep: int = 2, width: int = 100) -> None:
+    """A table (first row: the headers) in blocks of columns that fit ``width``, each block
+    repeating the first ``keep`` columns (chi, N of a run)."""
+    print(title)
+    print("-" * len(title))
+    rows = [tuple(str(c).strip() for c in r) for r in rows]
+    w = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    blocks, cur = [], []
+    base = 2 + sum(w[:keep]) + 2 * keep
+    for i in range(keep, len(w)):
+        if cur and base + sum(w[j] + 2 for j in cur) + w[i] > width:
+            blocks.append(cur)
+            cur = []
+        cur.append(i)
+    blocks.append(cur)
+    for n, block in enumerate(blocks):
+        if n:
+            print()
+        for r in rows:
+            cells = [r[i].ljust(w[i]) for i in range(keep)] + [r[i].rjust(w[i]) for i in block]
+            print(("  " + "  ".join(cells)).rstrip())
+
+
+#: short headers of the exponent table's numeric columns (the text fits 100 columns)
+_EXPONENT_HEADERS = ("quantity", "beta, t*=t*_chi", "ref", "ideal", "window of t*-t", "beta, t* fitted",
+                     "A/A_ideal")
+
+
+def _print_exponents(rows: list[tuple], width: int = 100) -> None:
+    """The exponent table of one run (:func:`snapping.scaling.report_rows`) in ``width``
+    columns: the numbers on one line per quantity, its verdict and notes wrapped below it."""
+    import textwrap
+
+    title = "Exponents y ~ A (t* - t)^beta"
+    print(title)
+    print("-" * len(title))
+    body = [tuple(c.strip().replace(" ± ", " ±") for c in r) for r in rows[1:]]
+    table = [_EXPONENT_HEADERS] + [r[:7] for r in body]
+    w = [max(len(r[i]) for r in table) for i in range(7)]
+    for k, r in enumerate(table):
+        cells = [r[0].ljust(w[0])] + [c.rjust(w[i + 1]) for i, c in enumerate(r[1:])]
+        print(("  " + "  ".join(cells)).rstrip())
+        if k:
+            words = "; ".join(c for c in body[k - 1][7:] if c)
+            for line in textwrap.wrap(words, width=width - 6):
+                print(f"      {line}")
+    print("  (ideal: the exact folded string's exponent on the same window; z = (beta - ref) / uncertainty)")
 
 
 # ----------------------------------------------------------------------- reproduce
