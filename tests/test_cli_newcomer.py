@@ -117,3 +117,66 @@ def _json(argv):
     with contextlib.redirect_stdout(buf):
         assert main(argv) == 0
     return buf.getvalue()
+
+
+# ------------------------------------------------------------------ runs: silence, fit width
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    """One short run (chi 0.25, 300 links) with snapshots, written by the CLI."""
+    import contextlib
+    import io
+
+    path = tmp_path_factory.mktemp("newcomer") / "run.nc"
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        assert main(["simulate", "--chi", "0.25", "--N", "300", "-o", str(path)]) == 0
+    return path, err.getvalue()
+
+
+def test_a_run_without_a_terminal_prints_progress_lines(run_file, tmp_path, capsys, monkeypatch):
+    _, err = run_file  # (stderr was not a terminal): a line when it starts and one when it stops
+    assert "chain N=300 (dop853): started at t=0" in err and "chain N=300 (dop853): stopped at t=" in err
+    from snapping.simulate import progress_lines
+
+    monkeypatch.setattr(progress_lines, "EVERY", 0.0)  # a line at every chunk of the compiled loop
+    assert main(["simulate", "--chi", "0.25", "--N", "300", "--t-end", "0.5", "-o", str(tmp_path / "r.nc")]) == 0
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("chain N=300")]
+    assert len(lines) >= 3 and "t=0.5" in lines[-1]
+    assert all("/0.5" in ln for ln in lines[1:-1])  # t of t_end
+
+
+def test_no_progress_lines_with_no_progress(tmp_path, capsys):
+    assert main(["simulate", "--chi", "0.25", "--N", "50", "--no-progress", "-o", str(tmp_path / "r.nc")]) == 0
+    assert "chain N=" not in capsys.readouterr().err
+
+
+def test_sigterm_before_the_first_step_says_so(tmp_path, capsys, monkeypatch):
+    import signal
+    import time
+
+    from snapping import simulate
+
+    def killed(*a, **k):
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)
+        raise AssertionError("SIGTERM did not interrupt")
+
+    monkeypatch.setattr(simulate, "run", killed)
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--chi", "0.25", "--N", "50", "-o", str(out)]) == 143
+    err = capsys.readouterr().err
+    assert "terminated by SIGTERM before the run's first step: nothing was written" in err and not out.exists()
+    assert signal.getsignal(signal.SIGTERM) is not None  # (restored: not ours any more)
+    assert "_Terminated" not in repr(signal.getsignal(signal.SIGTERM))
+
+
+def test_the_fit_table_fits_100_columns(run_file, capsys):
+    path, _ = run_file
+    assert main(["fit", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert max(len(ln) for ln in out.splitlines()) <= 100
+    assert "Exponents y ~ A (t* - t)^beta" in out and "v_max" in out
+    assert main(["fit", str(path), str(path)]) == 0
+    out = capsys.readouterr().out
+    assert max(len(ln) for ln in out.splitlines()) <= 100
+    assert "kappa_max" in out and "delta_kappa_m" in out

@@ -139,14 +139,18 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
+    restore = _on_sigterm_raise()
     try:
         return int(args.func(args) or 0)
+    except _Terminated:  # SIGTERM outside a run's loop (which saves a checkpoint on it itself)
+        print(f"snapping {args.command}: terminated by SIGTERM {_outside_run(args)}", file=sys.stderr)
+        return 143
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
         print(f"snapping {args.command}: error: {_cli_words(_as_typed(parser, args.command, str(exc)))}",
               file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        print(f"snapping {args.command}: interrupted", file=sys.stderr)
+        print(f"snapping {args.command}: interrupted by SIGINT {_outside_run(args)}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of stdout went away (`snapping ... | head`): stop quietly
         import os
@@ -157,6 +161,41 @@ def main(argv: list[str] | None = None) -> int:
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
         return EXIT_FAILED
+    finally:
+        restore()
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM received while no run loop had its own handler (starting up, compiling, writing)."""
+
+
+def _on_sigterm_raise():
+    """Make SIGTERM raise :class:`_Terminated` (the command then says so and exits 143 instead of
+    dying without a word); returns the function that restores the previous handler."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def handler(signum, frame):
+        raise _Terminated()
+
+    try:
+        old = signal.signal(signal.SIGTERM, handler)
+    except (ValueError, OSError):  # pragma: no cover - exotic embedding
+        return lambda: None
+    return lambda: signal.signal(signal.SIGTERM, old)
+
+
+def _outside_run(args) -> str:
+    """What an interruption outside a run's loop left behind (a run's loop says it itself)."""
+    import os
+
+    out = getattr(args, "output", None)
+    if args.command == "simulate" and out and not os.path.exists(out):
+        return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
+    return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"
 
 
 def _cli_words(msg: str) -> str:
