@@ -1,7 +1,8 @@
 """Progress as plain lines, for a run whose stderr is not a terminal (a log file, a pipe,
 a batch job): the tqdm bar is off there, so without these lines a long run says nothing
-until it ends. One line when the run starts, then one every :data:`EVERY` seconds, then one
-at the end; the same calls as the tqdm bar (``update``, ``set_postfix_str``, ``close``)."""
+until it ends. A run shorter than :data:`EVERY` seconds prints nothing; a longer one prints a
+line every :data:`EVERY` seconds (the first says why) and one when it stops. The same calls as
+the tqdm bar (``update``, ``set_postfix_str``, ``close``)."""
 
 from __future__ import annotations
 
@@ -22,8 +23,7 @@ class LineProgress:
         self.file = file or sys.stderr
         self.postfix = ""
         self.t0 = self.last = time.monotonic()
-        of = "" if not total else f" of t={total:.4g}{' (the estimated snap)' if estimated else ''}"
-        self._print(f"started at t={self.n:.6g}{of}; a line every {self.every:g} s (stderr is not a terminal)")
+        self.printed = 0
 
     def _print(self, text: str) -> None:
         try:
@@ -43,10 +43,15 @@ class LineProgress:
         now = time.monotonic()
         if now - self.last >= self.every:
             self.last = now
+            if not self.printed:
+                of = "" if not self.total else f" (of t={self.total:.4g}{', the estimated snap' if self.estimated else ''})"
+                self._print(f"running{of}; a line every {self.every:g} s (stderr is not a terminal: no progress bar)")
+            self.printed += 1
             self._print(self._line())
 
     def set_postfix_str(self, s: str = "", refresh: bool = True) -> None:
         self.postfix = s
 
     def close(self) -> None:
-        self._print(f"stopped at {self._line()}")
+        if self.printed:
+            self._print(f"stopped at {self._line()}")
