@@ -7,13 +7,14 @@ figures (Fig. 3 and 4) live in :mod:`snapping.scaling`.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from .estimates import Chain, PAPER_CHAIN
 
-__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "convergence_figure", "save"]
+__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "convergence_figure", "save", "run_label"]
 
 
 def _plt():
@@ -91,6 +92,57 @@ def _snapshots_before(ds, n: int):
     return np.unique(np.round(np.linspace(0, last, n)).astype(int))
 
 
+def run_label(ds) -> str:
+    """A short title of a run that tells it from others: chi (or the start: supports, a shape
+    file), N, and what is not the paper's chain: tip mass, taper, held-end motion, gravity.
+
+    >>> import xarray as xr
+    >>> run_label(xr.Dataset(attrs={"chi": 0.25, "N": 1000}))
+    '$\\chi$ = 0.25, N = 1000'
+    """
+    import json
+    import math
+
+    a = ds.attrs
+    try:
+        prob = json.loads(a["problem"]) if a.get("problem") else {}
+    except (TypeError, ValueError):
+        prob = {}
+    start, chain, pin = prob.get("start", {}), prob.get("chain", {}), prob.get("pin", {})
+    chi = float(a.get("chi", start.get("chi", math.nan)))
+    parts = []
+    if start.get("kind") == "supports":
+        parts.append(f"supports ({start['dx']:g}, {start['dy']:g})")
+    elif start.get("kind") in ("curve", "nodes"):
+        name = str(start.get("name", ""))
+        parts.append(f"start {name.rsplit('/', 1)[-1] or start['kind']}")
+    elif math.isfinite(chi):
+        parts.append(rf"$\chi$ = {chi:g}")
+    parts.append(f"N = {int(a['N'])}" if "N" in a else "")
+    if chain.get("tip_mass"):
+        parts.append(f"tip mass {float(chain['tip_mass']):g}")
+    if chain.get("kind") == "taper":
+        power = float(chain.get("power", 1.0))
+        parts.append(f"taper {float(chain['ratio']):g}" + ("" if power == 1.0 else f":{power:g}"))
+    elif chain.get("kind") not in (None, "uniform", "paper"):
+        parts.append(f"{chain['kind']} links")
+    if pin.get("kind") in ("pull", "flick"):
+        ax, ay = pin.get("accel", (math.nan, math.nan))
+        T = pin.get("period" if pin["kind"] == "flick" else "duration")
+        parts.append(f"{pin['kind']} ({float(ax):g}, {float(ay):g})" + ("" if T is None else f" T {float(T):g}")
+                     + (f" from t {float(pin['t0']):g}" if pin.get("t0") else ""))
+    elif pin.get("kind") not in (None, "fixed"):
+        parts.append(f"held end: {pin['kind']}")
+    if "gravity" in prob and float(prob["gravity"]) != 1.0:
+        parts.append(f"gravity {float(prob['gravity']):g}")
+    return ", ".join(p for p in parts if p)
+
+
+def _held_end(sn, dist):
+    """The held end (the last node) of a snapshot, drawn as (x, height)."""
+    return dist(float(sn["x"].values[-1])), -dist(float(sn["y"].values[-1]))
+
+
 def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimensional"):
     """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run,
     coloured by time (a colour bar per panel).
@@ -103,10 +155,13 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
     runs = list(runs)
     fig, axes = plt.subplots(1, len(runs), figsize=(4.6 * len(runs), 4.4), squeeze=False)
     # fixed positions (a layout engine costs seconds per save): room for each panel's colour bar
-    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86, wspace=0.55)
+    titles = ["\n".join(textwrap.wrap(run_label(ds), 34)) for ds in runs]
+    lines = max(t.count("\n") for t in titles)  # (a general problem's title takes more lines)
+    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86 - 0.045 * lines,
+                        wspace=0.55)
     from matplotlib.colors import Normalize
 
-    for ax, ds in zip(axes[0], runs):
+    for ax, ds, title in zip(axes[0], runs, titles):
         idx = _snapshots_before(ds, n)
         ts = np.array([time(float(ds["t_snapshot"].values[int(i)])) for i in idx])
         norm = Normalize(0.0, max(float(ts.max()), 1e-300))
@@ -114,9 +169,9 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
         for tt, i in zip(ts, idx):
             sn = ds.isel(snapshot=int(i))
             ax.plot(dist(sn["x"].values), -dist(sn["y"].values), color=cmap(norm(tt)), lw=1.2)
-        ax.plot([0], [0], "ks", ms=5)
+            ax.plot(*_held_end(sn, dist), "s", color=cmap(norm(tt)), mec="k", ms=5, zorder=3)  # (it may move)
         ax.set_aspect("equal")
-        ax.set_title(rf"$\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
+        ax.set_title(title, fontsize=9 if "\n" in title else None)
         ax.set_xlabel(f"$x$  [{u['length']}]")
         ax.set_ylabel(f"height  [{u['length']}]")
         x0, x1 = ax.get_xlim()
@@ -151,8 +206,7 @@ def pin_force(ds, chain: Chain = PAPER_CHAIN, units: str = "nondimensional"):
     for a in (a1, a2):
         a.grid(alpha=0.3)
     what = f", chain {chain.length:g} m, {chain.mass:g} kg" if units == "si" else " (nondimensional)"
-    a1.set_title(rf"Force on the pin, $\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}{what}",
-                 fontsize=10)
+    a1.set_title(f"Force on the pin, {run_label(ds)}{what}", fontsize=10)
     return fig
 
 
@@ -180,8 +234,7 @@ def profiles(ds, n: int = 7):
         a.grid(alpha=0.3)
     # the speed grows towards the free end (s = 1): the upper left of panel (a) is free
     axes[0].legend(fontsize=7, loc="upper left", title=f"time [{u['time']}]", title_fontsize=7)
-    fig.suptitle(rf"Along the chain up to the snap: $\chi$ = {float(ds.attrs['chi']):g}, "
-                 f"N = {int(ds.attrs['N'])} (nondimensional)")
+    fig.suptitle(f"Along the chain up to the snap: {run_label(ds)} (nondimensional)")
     return fig
 
 
