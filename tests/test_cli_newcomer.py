@@ -181,3 +181,126 @@ def test_the_fit_table_fits_100_columns(run_file, capsys):
     out = capsys.readouterr().out
     assert max(len(ln) for ln in out.splitlines()) <= 100
     assert "kappa_max" in out and "delta_kappa_m" in out
+
+
+# ------------------------------------------------------------------------ figures, plot, animate
+def test_plot_draws_one_run(run_file, tmp_path, capsys):
+    from PIL import Image
+
+    path, _ = run_file
+    out = tmp_path / "run.png"
+    assert main(["plot", str(path), "-o", str(out), "--snapshots", "4"]) == 0
+    assert capsys.readouterr().out.strip() == f"wrote {out}: chi = 0.25, N = 300"
+    with Image.open(out) as im:
+        assert im.format == "PNG" and im.size[0] > 800
+    assert main(["plot", str(path), "-o", str(out)]) == 2  # exists
+    assert "--overwrite" in capsys.readouterr().err
+
+
+def test_plot_overview_panels_are_labelled(run_file):
+    from snapping import figures
+    from snapping.simulate import load_run
+
+    fig = figures.overview(load_run(run_file[0]), n=3)
+    for ax in fig.axes:
+        assert ax.get_xlabel() and ax.get_ylabel() and ax.get_title(loc="left")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_run_label_tells_general_problems_apart():
+    import json as js
+
+    import xarray as xr
+
+    from snapping.figures import run_label
+
+    def label(**problem):
+        return run_label(xr.Dataset(attrs={"chi": float("nan"), "N": 100, "problem": js.dumps(problem)}))
+
+    base = {"start": {"kind": "supports", "dx": 0.4, "dy": 0.2}, "chain": {"kind": "uniform", "tip_mass": 0.0},
+            "pin": {"kind": "fixed"}, "gravity": 1.0}
+    plain = label(**base)
+    assert plain == "supports (0.4, 0.2), N = 100" and "nan" not in plain
+    tip = label(**{**base, "chain": {"kind": "uniform", "tip_mass": 0.2}})
+    taper = label(**{**base, "chain": {"kind": "taper", "ratio": 0.1, "power": 2.0, "tip_mass": 0.0}})
+    flick = label(**{**base, "pin": {"kind": "flick", "accel": [3.0, 0.0], "period": 0.25, "t0": 0.0}})
+    pull = label(**{**base, "pin": {"kind": "pull", "accel": [0.0, -2.0], "duration": 0.3, "t0": 0.1}})
+    shape = label(**{**base, "start": {"kind": "curve", "name": "/some/dir/start.csv"}})
+    labels = [plain, tip, taper, flick, pull, shape]
+    assert len(set(labels)) == len(labels)
+    assert "tip mass 0.2" in tip and "taper 0.1:2" in taper and "flick (3, 0) T 0.25" in flick
+    assert "pull (0, -2) T 0.3 from t 0.1" in pull and "start start.csv" in shape
+
+
+def test_shapes_mark_the_held_end_where_it_is(run_file):
+    import numpy as np
+
+    from snapping import figures
+    from snapping.simulate import load_run
+
+    ds = load_run(run_file[0]).copy()
+    ds["x"] = ds["x"] + 0.1  # a held end that moved to x = 0.1
+    fig = figures.shapes([ds], n=3)
+    marks = [ln for ln in fig.axes[0].lines if ln.get_marker() == "s"]
+    assert marks and all(np.allclose(m.get_xdata(), 0.1) for m in marks)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_continuum_figure_ticks_legend_and_order(tmp_path):
+    import numpy as np
+    import xarray as xr
+
+    from snapping import figures
+
+    frac = np.array([0.08, 0.04, 0.02])
+    ds = xr.Dataset({q: ("frac", v) for q, v in (("v_peak", [10.0, 10.5, 10.6]), ("a_peak", [900.0, 950, 960]),
+                                                 ("sigma_peak", [20.0, 20.5, 20.6]))}, coords={"frac": frac},
+                    attrs={"chi": 0.25, "lumping": "shared"})
+    for q, lim in (("v_peak", 10.65), ("a_peak", 965.0), ("sigma_peak", 20.65)):
+        ds.attrs.update({f"{q}_limit": lim, f"{q}_error": 0.01 * lim, f"{q}_order": 2.0})
+    ds.attrs["a_peak_order"] = float("nan")
+    fig = figures.convergence_figure(ds)
+    ax1, ax2 = fig.axes[:2]
+    texts = [t.get_text() for t in ax2.get_legend().get_texts()]
+    assert not any("nan" in t for t in texts) and any("order not measured" in t for t in texts)
+    for ax in (ax1, ax2):
+        leg = ax.get_legend()
+        assert leg.get_bbox_to_anchor().y0 < ax.get_window_extent().y0 + 1  # below the panel
+        assert sorted(ax.get_xticks()) == sorted(frac)
+        assert [t.get_text() for t in ax.get_xticklabels(minor=True) if t.get_text()] == []
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_chi_is_not_labelled_as_a_length():
+    import inspect
+
+    from snapping.scaling import plots
+
+    src = inspect.getsource(plots)
+    assert r"$\chi$  [" not in src and "separation $\\chi$ (fraction of the length)" in src
+
+
+def test_animate_frames_reruns_with_dense_snapshots(run_file, tmp_path, capsys):
+    import numpy as np
+
+    from snapping.cli.analysis import _dense_rerun
+    from snapping.simulate import load_run
+
+    path, _ = run_file
+    ds = load_run(path)
+    dense = _dense_rerun(ds, 30, str(path))
+    t = dense["t_snapshot"].values
+    assert np.sum(t <= ds.attrs["t_snap_v"]) >= 30 > np.sum(ds["t_snapshot"].values <= ds.attrs["t_snap_v"])
+    assert dense.attrs["v_peak"] == pytest.approx(ds.attrs["v_peak"], rel=1e-9)  # the same run
+    capsys.readouterr()
+    out = tmp_path / "a.gif"
+    assert main(["animate", str(path), "-o", str(out), "--frames", "12", "--max-frames", "4"]) == 0
+    cap = capsys.readouterr()
+    assert "rerunning" in cap.err and "wrote" in cap.out and out.exists()
+    assert main(["animate", str(path), "-o", str(tmp_path / "b.gif"), "--frames", "1"]) == 2

@@ -14,7 +14,8 @@ import numpy as np
 
 from .estimates import Chain, PAPER_CHAIN
 
-__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "convergence_figure", "save", "run_label"]
+__all__ = ["shapes", "pin_force", "profiles", "overview", "peak_speed_vs_N", "convergence_figure", "save",
+           "run_label"]
 
 
 def _plt():
@@ -238,6 +239,61 @@ def profiles(ds, n: int = 7):
     return fig
 
 
+def overview(ds, n: int = 7):
+    """One run at a glance (``snapping plot``): (a) the chain's shapes at up to ``n``
+    snapshots up to the snap, the held end marked (it may move); (b) speed and (c) tension
+    along the chain at the same snapshots; (d) the maxima over the chain (speed,
+    acceleration, tension) against time, with the snapping time. Nondimensional.
+    Returns the Figure."""
+    plt = _plt()
+    u = _U["nondimensional"]
+    idx = _snapshots_before(ds, n)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8.4))
+    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.07, top=0.9, wspace=0.25, hspace=0.3)
+    (a_shape, a_speed), (a_tension, a_max) = axes
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(idx), 2)))
+    s_node, s_link = ds["s_node"].values, ds["s_link"].values
+    ident = lambda x: x  # noqa: E731
+    for c, i in zip(colors, idx):
+        sn = ds.isel(snapshot=int(i))
+        lab = f"t = {float(sn['t_snapshot']):.4f}"
+        a_shape.plot(sn["x"].values, -sn["y"].values, color=c, lw=1.2, label=lab)
+        a_shape.plot(*_held_end(sn, ident), "s", color=c, mec="k", ms=5, zorder=3)
+        a_speed.plot(s_node, sn["speed"].values, color=c, label=lab)
+        a_tension.plot(s_link, sn["tension"].values, color=c, label=lab)
+    a_shape.set_aspect("equal", adjustable="datalim")
+    a_shape.set_xlabel(f"$x$  [{u['length']}]")
+    a_shape.set_ylabel(f"height  [{u['length']}]")
+    a_shape.set_title("(a) shapes (square: the held end)", loc="left", fontsize=10)
+    a_speed.set_xlabel(f"arclength $s$ from the held end  [{u['length']}]")
+    a_speed.set_ylabel(f"speed $|v|$  [{u['speed']}]")
+    a_speed.set_title("(b) speed along the chain", loc="left", fontsize=10)
+    a_tension.set_xlabel(f"arclength $s$ from the held end  [{u['length']}]")
+    a_tension.set_ylabel(rf"tension $\sigma$  [{u['force']}]")
+    a_tension.set_title("(c) tension along the chain", loc="left", fontsize=10)
+    a_speed.legend(fontsize=7, loc="upper left", title=f"time [{u['time']}]", title_fontsize=7)
+    from .scaling.plots import thin_envelope
+
+    t = np.asarray(ds["t"].values, dtype=float)
+    for name, lab, c in (("v_max", rf"speed [{u['speed']}]", "C0"), ("a_max", rf"acceleration [{u['accel']}]", "C1"),
+                         ("sigma_max", rf"tension [{u['force']}]", "C2")):
+        y = np.asarray(ds[name].values, dtype=float)
+        k = thin_envelope(t, y)
+        a_max.semilogy(t[k], y[k], color=c, label=lab)
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    if np.isfinite(t_snap):
+        a_max.axvline(t_snap, color="k", lw=0.6, ls="--", label=f"snap, t = {t_snap:.5g}")
+    a_max.set_xlabel(f"time $t$  [{u['time']}]")
+    a_max.set_ylabel("maximum over the chain (units in the legend)")
+    a_max.set_title("(d) maxima against time", loc="left", fontsize=10)
+    a_max.legend(fontsize=7, loc="upper left")
+    for a in (a_speed, a_tension, a_max):
+        a.grid(alpha=0.3)
+    fig.suptitle(f"{run_label(ds)}: {ds.attrs.get('status', '')}, {ds.attrs.get('method', '')} "
+                 f"(nondimensional)")
+    return fig
+
+
 def peak_speed_vs_N(table):
     """Fig. 2(d): peak speed against N for several chi, with the N^(1/2) line a singularity
     regularised by discreteness would follow (nondimensional).
@@ -261,6 +317,25 @@ def peak_speed_vs_N(table):
     return fig
 
 
+def _order_text(order) -> str:
+    """The observed order of convergence for a legend (not a number where it was not measured)."""
+    order = float(order)
+    return f"order {order:.2f}" if np.isfinite(order) else "order not measured (not converging)"
+
+
+def _level_ticks(ax, frac) -> None:
+    """Major ticks of a log axis at ``frac`` (thinned to at most 6), labelled as plain numbers,
+    and no minor tick labels."""
+    from matplotlib.ticker import FixedLocator, NullFormatter
+
+    ticks = np.unique(np.asarray(frac, dtype=float))
+    if ticks.size > 6:
+        ticks = ticks[np.unique(np.round(np.linspace(0, ticks.size - 1, 6)).astype(int))]
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(lambda x, pos: f"{x:.3g}")
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
 def convergence_figure(ds, path=None, uniform=None, other=None):
     """The continuum limit (:func:`snapping.continuum.converge`): (a) each peak over its
     extrapolated limit against the resolution of the fold (``frac``), with the limit's
@@ -276,7 +351,7 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
     colors = ("C0", "C1", "C2")
     frac = np.asarray(ds.frac.values, dtype=float)
     a_cat = estimates.catenary_parameter(float(ds.attrs["chi"]))
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 5.2), constrained_layout=True)
     for (q, label), c in zip(quantities, colors):
         lim, err = float(ds.attrs[q + "_limit"]), float(ds.attrs[q + "_error"])
         vals = np.asarray(ds[q].values, dtype=float)
@@ -288,14 +363,14 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
                      label=f"{label} uniform N = " + ", ".join(str(int(u.attrs["N"])) for u in uniform))
         dist = np.abs(vals - lim) / abs(lim)
         ok = dist > 0
-        ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: order {float(ds.attrs[q + '_order']):.2f}")
+        ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: {_order_text(ds.attrs[q + '_order'])}")
         if other is not None:
             fo, vo = np.asarray(other.frac.values, dtype=float), np.asarray(other[q].values, dtype=float)
             lump = other.attrs.get("lumping", "other")
             ax1.plot(fo, vo / lim, "^:", color=c, label=f"{label} graded, {lump} lumping")
             do = np.abs(vo - lim) / abs(lim)
             ax2.loglog(fo[do > 0], do[do > 0], "^:", color=c,
-                       label=f"{label}, {lump} lumping: order {float(other.attrs[q + '_order']):.2f}")
+                       label=f"{label}, {lump} lumping: {_order_text(other.attrs[q + '_order'])}")
     ax1.set_xscale("log")
     ax1.set_xlim(frac.min() / 1.5, max([frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or []))])
                  * 1.5)
@@ -304,11 +379,15 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
     ax1.set_ylabel("peak / extrapolated limit")
     ax1.set_title(f"(a) $\\chi$ = {float(ds.attrs['chi']):g}: peaks against resolution "
                   f"({ds.attrs.get('lumping', '')} lumping)")
-    ax1.legend(fontsize=7, loc="lower right")
     ax2.set_xlabel("link length on the fold / its radius of curvature")
     ax2.set_ylabel(r"$|$peak $-$ limit$|$ / limit")
     ax2.set_title("(b) distance to the limit")
-    ax2.legend(fontsize=8, loc="upper left")
+    for ax in (ax1, ax2):  # ticks at the levels' resolutions, plain numbers (log minor labels overlap)
+        _level_ticks(ax, frac)
+    # the legends below the panels: inside they hide points (the coarsest level's acceleration)
+    ax1.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1, frameon=False)
+    ax2.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2 if other is not None else 1,
+               frameon=False)
     if path is not None:
         from ._files import save_figure
 

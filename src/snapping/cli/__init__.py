@@ -9,7 +9,7 @@ one line on stderr and exits with status 2, without a traceback.
 
 The subcommands live in one module per group: ``estimate`` (ideal, estimate,
 design), ``simulate``, ``sweep`` (sweep, converge) and ``analysis`` (fit,
-reproduce, animate); ``_common`` holds what they share (printing, the SI
+reproduce, plot, animate); ``_common`` holds what they share (printing, the SI
 options). This module holds the parser, :func:`main` and the error handling.
 """
 
@@ -19,7 +19,7 @@ import argparse
 import sys
 
 from ._common import PLOT_BYTES, _formatter, print_json, print_table
-from .analysis import _add_animate, _add_fit, _add_reproduce
+from .analysis import _add_animate, _add_fit, _add_plot, _add_reproduce
 from .estimate import _add_design, _add_estimate, _add_ideal
 from .simulate import _add_simulate
 from .sweep import _add_converge, _add_sweep
@@ -31,7 +31,7 @@ EXIT_FAILED = 1  # a numerical failure or an I/O fault (e.g. a full disk)
 
 #: the subcommands' ``_add_<name>`` functions, in the order of the help
 _SUBCOMMANDS = (_add_ideal, _add_estimate, _add_design, _add_simulate, _add_sweep, _add_fit, _add_converge,
-                _add_reproduce, _add_animate)
+                _add_reproduce, _add_plot, _add_animate)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -82,6 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
             "  snapping estimate --chi 0.25 --links 229   # how big will the spike be?\n"
             "  snapping design --max-tension 20 --length 2 --mass 0.05 --links 100\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
+            "  snapping plot run.nc -o run.png     # shapes, profiles and maxima of one run\n"
             "  snapping fit run.nc --plot fit.png  # exponents near the snap\n"
             "  snapping reproduce --quick -o out   # every claim and figure of the paper\n"
             "  snapping <command> --help           # each command's options and examples"
