@@ -403,7 +403,11 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     (heavy tip masses, whose peaks jump between the table's points, cost a second or so), and
     always for chains of at most :data:`FEW_LINKS` links (milliseconds); else the table's
     answer, with ``computed_note`` naming its bound (:func:`run_instead` decides). Outside
-    the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
+    the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it).
+
+    This is what ``snapping estimate --links`` prints; ``design_estimate(..., links=...)``
+    is the table's answer alone (``snapping estimate --table``), so where the table's bound
+    misses the targets the two differ: one run's peaks here, the interpolated ones there."""
     max_seconds = V.real("max_seconds", max_seconds)
     est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
                           tip_mass=tip_mass)
