@@ -139,7 +139,10 @@ def _print_si(scales, rows, title: str = "") -> None:
     if scales is None:
         import textwrap
 
-        print(textwrap.fill(units.NONDIMENSIONAL_NOTE, width=100, initial_indent="  ", subsequent_indent="    "))
+        head, _, tail = units.NONDIMENSIONAL_NOTE.partition("; ")  # (tail: how to get SI, kept on one line)
+        print(textwrap.fill(head + (";" if tail else ""), width=100, initial_indent="  ", subsequent_indent="    "))
+        if tail:
+            print(f"    {tail}")
         return
 
     def fmt(v):
