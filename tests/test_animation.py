@@ -36,9 +36,11 @@ def test_gif_has_one_frame_per_snapshot_and_the_chain_coloured_by_speed(tiny, ca
     n_snap = np.unique(ds["t_snapshot"].values).size
     with Image.open(out) as im:
         assert im.format == "GIF" and im.n_frames == n_snap
-    # few automatic snapshots: the note gives a runnable command with denser snapshot times
-    assert "--snapshot-times" in err and "--chi 0.25 --N 20" in err
-    times = [float(v) for v in err.split("--snapshot-times ")[1].split()[0].split(",")]
+    # few automatic snapshots: the note says how to get more (--frames) in one short line
+    assert "add --frames 60" in err and len(err.strip().splitlines()) == 1 and len(err) < 300
+    hint = animation.denser_run_hint(ds, str(p))  # (from Python: the runnable command with denser snapshots)
+    assert "--snapshot-times" in hint and "--chi 0.25 --N 20" in hint
+    times = [float(v) for v in hint.split("--snapshot-times ")[1].split()[0].split(",")]
     assert len(times) >= animation.DENSE_FRAMES and np.all(np.diff(times) > 0) and times[-1] < ds.attrs["t_snap_v"]
 
     # the colours are the links' speeds (mean of the two nodes' |v|) on a log scale

@@ -128,13 +128,19 @@ def test_fit_table_has_one_row_per_quantity_and_plain_verdicts(tmp_path, capsys)
     assert main(["fit", str(path), "--no-joint"]) == 0
     out = capsys.readouterr().out
     table = out.split("Exponents", 1)[1].split("Scales", 1)[0]
-    names = [l.split()[0] for l in table.splitlines()[3:] if l.strip()]
-    assert names == ["v_max", "a_end", "a_max", "sigma_max", "kappa_max"]
+    # one line of numbers per quantity (indented 2), its verdict and notes wrapped below it (indented 6)
+    rows, verdicts = [], {}
+    for line in table.splitlines()[3:]:
+        if line.startswith("  ") and not line.startswith("   ") and not line.startswith("  ("):
+            rows.append(line.split()[0])
+            verdicts[rows[-1]] = ""
+        elif line.startswith("      ") and rows:
+            verdicts[rows[-1]] += " " + line.strip()
+    assert rows == ["v_max", "a_end", "a_max", "sigma_max", "kappa_max"]
     assert "differs; differs" not in out and "(late)" not in out and "(intermediate)" not in out
     assert "method dop853, chords exact, tol 1e-06" in out and UNITS in out
-    for line in table.splitlines()[3:]:
-        if line.strip():
-            assert "agrees with" in line or "differs from" in line or "inconclusive:" in line, line
+    for name, verdict in verdicts.items():
+        assert verdict.strip().startswith(("agrees with", "differs from", "inconclusive:")), (name, verdict)
 
 
 # ---------------------------------------------------------------- estimate

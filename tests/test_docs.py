@@ -56,6 +56,8 @@ def _text(site: Path, page: str) -> str:
     ("guide/fit.html", ["snapping fit run.nc", "fit_run", "--plot"]),
     ("guide/sweep.html", ["LocalCluster", "Client", "scheduler=client", "--scheduler tcp://", "run_sweep"]),
     ("guide/reproduce.html", ["snapping reproduce --quick -o paper_quick", "REPORT.md"]),
+    ("guide/converge.html", ["snapping converge --chi 0.25", "converge(0.25", "order", "converge.png"]),
+    ("guide/animate.html", ["snapping plot run.nc -o run.png", "--frames 60", "figures.overview", "plot.png"]),
     ("conventions.html", ["sqrt(L/g)", "M g", 'chords="exact"', "max_link_error",
                           "link-angle form", "position form", "methods_and_chords.py", "19.437688"]),
     ("architecture.html", ["The run Dataset", "METHODS", "arXiv:2206.07864"]),
@@ -92,7 +94,8 @@ def test_cli_page_is_the_parsers_help(site):
     finally:
         sys.path.remove(str(DOCS / "_ext"))
     text = html.unescape(re.sub(r"<[^>]+>", "", _text(site, "cli.html")))
-    for command in (None, "ideal", "estimate", "design", "simulate", "sweep", "fit", "converge", "reproduce"):
+    for command in (None, "ideal", "estimate", "design", "simulate", "sweep", "fit", "converge", "reproduce", "plot",
+                    "animate"):
         assert help_text(command).strip() in text, command
 
 

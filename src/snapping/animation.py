@@ -211,9 +211,9 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     cb.set_label(r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
     t_snap = float(ds.attrs.get("t_snap_v", np.nan))
     text = ax.set_title("", fontsize=9, family="monospace", loc="left")
-    chi = ds.attrs.get("chi")
-    fig.suptitle(("falling chain" + (rf", $\chi$ = {float(chi):g}" if chi is not None else "")
-                  + f", N = {int(ds.attrs['N'])} (nondimensional)"), fontsize=10)
+    from .figures import run_label
+
+    fig.suptitle(f"falling chain, {run_label(ds)} (nondimensional)", fontsize=10)
 
     def label(i):
         s = f"t = {T[i]:.6f}"

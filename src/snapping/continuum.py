@@ -152,7 +152,8 @@ class Convergence:
                          + f" {float(ds.cpu_time[k]):7.2f}")
         lines.append(f"{'limit':>32} " + " ".join(f"{ds.attrs[q + '_limit']:13.8g}" for q in QUANTITIES))
         lines.append(f"{'+-':>32} " + " ".join(f"{ds.attrs[q + '_error']:13.2g}" for q in QUANTITIES))
-        lines.append(f"{'order':>32} " + " ".join(f"{ds.attrs[q + '_order']:13.3g}" for q in QUANTITIES))
+        lines.append(f"{'order':>32} " + " ".join(f"{ds.attrs[q + '_order']:13.3g}" if np.isfinite(ds.attrs[q + '_order'])
+                                                  else f"{'-':>13}" for q in QUANTITIES))  # (not measured: "-")
         lines.append(f"verdict: {ds.attrs['verdict']}")
         return "\n".join(lines)
 

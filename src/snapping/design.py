@@ -251,10 +251,28 @@ def _pct(e: float) -> str:
     return "no bound" if not math.isfinite(e) else ("exact" if e == 0 else f"+-{100 * e:.2g}%")
 
 
-def _fmt_intervals(iv: list, L: float) -> str:
+def _fmt_intervals(iv: list, L: float, span=None, what: str = "the table's range") -> str:
+    """The intervals in m and chi; an end that is an end of the scanned ``span`` (chi_lo, chi_hi)
+    is said to be one: the separations beyond it were not computed (it is no limit of the chain)."""
     if not iv:
         return "none"
-    return ", ".join(f"{a * L:.3g}-{b * L:.3g} m (chi {a:.3g}-{b:.3g})" for a, b in iv)
+    text = ", ".join(f"{a * L:.3g}-{b * L:.3g} m (chi {a:.3g}-{b:.3g})" for a, b in iv)
+    if span is not None:
+        ends = [f"{x * L:.3g} m" for x, e in ((iv[0][0], span[0]), (iv[-1][1], span[1]))
+                if math.isclose(x, e, rel_tol=1e-9)]
+        if ends:
+            text += (f" [{' and '.join(ends)}: {'the end' if len(ends) == 1 else 'the ends'} of {what}, "
+                     f"not {'a limit' if len(ends) == 1 else 'limits'} of the chain]")
+    return text
+
+
+def _span(res, tip) -> tuple | None:
+    """The (smallest, largest) chi scanned for tip mass ``tip`` (None if unknown)."""
+    for chi, *_ in res.curves.get(tip, {}).values():
+        chi = np.asarray(chi, float)
+        if chi.size:
+            return float(chi.min()), float(chi.max())
+    return None
 
 
 def print_design(res: DesignResult, file=None) -> None:
@@ -275,8 +293,9 @@ def print_design(res: DesignResult, file=None) -> None:
     print(file=out)
     for row in res.rows:
         print(f"  tip mass {row.tip_mass:g} x the chain's mass:", file=out)
-        print(f"    admissible: {_fmt_intervals(row.admissible, c.length)}", file=out)
-        print(f"    nominal:    {_fmt_intervals(row.nominal, c.length)}", file=out)
+        span, what = _span(res, row.tip_mass), "the runs' range" if res.source == "runs" else "the table's range"
+        print(f"    admissible: {_fmt_intervals(row.admissible, c.length, span, what)}", file=out)
+        print(f"    nominal:    {_fmt_intervals(row.nominal, c.length, span, what)}", file=out)
         for k, m in row.minimum.items():
             print(f"    smallest {LIMITS[k][3]}: {m['peak']:.4g} {LIMITS[k][2]} ({_pct(m['error'])}) at "
                   f"{m['chi'] * c.length:.3g} m", file=out)
@@ -384,7 +403,11 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     (heavy tip masses, whose peaks jump between the table's points, cost a second or so), and
     always for chains of at most :data:`FEW_LINKS` links (milliseconds); else the table's
     answer, with ``computed_note`` naming its bound (:func:`run_instead` decides). Outside
-    the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
+    the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it).
+
+    This is what ``snapping estimate --links`` prints; ``design_estimate(..., links=...)``
+    is the table's answer alone (``snapping estimate --table``), so where the table's bound
+    misses the targets the two differ: one run's peaks here, the interpolated ones there."""
     max_seconds = V.real("max_seconds", max_seconds)
     est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
                           tip_mass=tip_mass)

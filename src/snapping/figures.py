@@ -7,13 +7,15 @@ figures (Fig. 3 and 4) live in :mod:`snapping.scaling`.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from .estimates import Chain, PAPER_CHAIN
 
-__all__ = ["shapes", "pin_force", "profiles", "peak_speed_vs_N", "convergence_figure", "save"]
+__all__ = ["shapes", "pin_force", "profiles", "overview", "peak_speed_vs_N", "convergence_figure", "save",
+           "run_label"]
 
 
 def _plt():
@@ -91,6 +93,57 @@ def _snapshots_before(ds, n: int):
     return np.unique(np.round(np.linspace(0, last, n)).astype(int))
 
 
+def run_label(ds) -> str:
+    """A short title of a run that tells it from others: chi (or the start: supports, a shape
+    file), N, and what is not the paper's chain: tip mass, taper, held-end motion, gravity.
+
+    >>> import xarray as xr
+    >>> run_label(xr.Dataset(attrs={"chi": 0.25, "N": 1000}))
+    '$\\chi$ = 0.25, N = 1000'
+    """
+    import json
+    import math
+
+    a = ds.attrs
+    try:
+        prob = json.loads(a["problem"]) if a.get("problem") else {}
+    except (TypeError, ValueError):
+        prob = {}
+    start, chain, pin = prob.get("start", {}), prob.get("chain", {}), prob.get("pin", {})
+    chi = float(a.get("chi", start.get("chi", math.nan)))
+    parts = []
+    if start.get("kind") == "supports":
+        parts.append(f"supports ({start['dx']:g}, {start['dy']:g})")
+    elif start.get("kind") in ("curve", "nodes"):
+        name = str(start.get("name", ""))
+        parts.append(f"start {name.rsplit('/', 1)[-1] or start['kind']}")
+    elif math.isfinite(chi):
+        parts.append(rf"$\chi$ = {chi:g}")
+    parts.append(f"N = {int(a['N'])}" if "N" in a else "")
+    if chain.get("tip_mass"):
+        parts.append(f"tip mass {float(chain['tip_mass']):g}")
+    if chain.get("kind") == "taper":
+        power = float(chain.get("power", 1.0))
+        parts.append(f"taper {float(chain['ratio']):g}" + ("" if power == 1.0 else f":{power:g}"))
+    elif chain.get("kind") not in (None, "uniform", "paper"):
+        parts.append(f"{chain['kind']} links")
+    if pin.get("kind") in ("pull", "flick"):
+        ax, ay = pin.get("accel", (math.nan, math.nan))
+        T = pin.get("period" if pin["kind"] == "flick" else "duration")
+        parts.append(f"{pin['kind']} ({float(ax):g}, {float(ay):g})" + ("" if T is None else f" T {float(T):g}")
+                     + (f" from t {float(pin['t0']):g}" if pin.get("t0") else ""))
+    elif pin.get("kind") not in (None, "fixed"):
+        parts.append(f"held end: {pin['kind']}")
+    if "gravity" in prob and float(prob["gravity"]) != 1.0:
+        parts.append(f"gravity {float(prob['gravity']):g}")
+    return ", ".join(p for p in parts if p)
+
+
+def _held_end(sn, dist):
+    """The held end (the last node) of a snapshot, drawn as (x, height)."""
+    return dist(float(sn["x"].values[-1])), -dist(float(sn["y"].values[-1]))
+
+
 def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimensional"):
     """Fig. 1(b)-(d): chain shapes at several times up to the snap, one panel per run,
     coloured by time (a colour bar per panel).
@@ -103,10 +156,13 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
     runs = list(runs)
     fig, axes = plt.subplots(1, len(runs), figsize=(4.6 * len(runs), 4.4), squeeze=False)
     # fixed positions (a layout engine costs seconds per save): room for each panel's colour bar
-    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86, wspace=0.55)
+    titles = ["\n".join(textwrap.wrap(run_label(ds), 34)) for ds in runs]
+    lines = max(t.count("\n") for t in titles)  # (a general problem's title takes more lines)
+    fig.subplots_adjust(left=0.07 + 0.1 / len(runs), right=0.93, bottom=0.12, top=0.86 - 0.045 * lines,
+                        wspace=0.55)
     from matplotlib.colors import Normalize
 
-    for ax, ds in zip(axes[0], runs):
+    for ax, ds, title in zip(axes[0], runs, titles):
         idx = _snapshots_before(ds, n)
         ts = np.array([time(float(ds["t_snapshot"].values[int(i)])) for i in idx])
         norm = Normalize(0.0, max(float(ts.max()), 1e-300))
@@ -114,9 +170,9 @@ def shapes(runs, chain: Chain = PAPER_CHAIN, n: int = 8, units: str = "nondimens
         for tt, i in zip(ts, idx):
             sn = ds.isel(snapshot=int(i))
             ax.plot(dist(sn["x"].values), -dist(sn["y"].values), color=cmap(norm(tt)), lw=1.2)
-        ax.plot([0], [0], "ks", ms=5)
+            ax.plot(*_held_end(sn, dist), "s", color=cmap(norm(tt)), mec="k", ms=5, zorder=3)  # (it may move)
         ax.set_aspect("equal")
-        ax.set_title(rf"$\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}")
+        ax.set_title(title, fontsize=9 if "\n" in title else None)
         ax.set_xlabel(f"$x$  [{u['length']}]")
         ax.set_ylabel(f"height  [{u['length']}]")
         x0, x1 = ax.get_xlim()
@@ -151,8 +207,7 @@ def pin_force(ds, chain: Chain = PAPER_CHAIN, units: str = "nondimensional"):
     for a in (a1, a2):
         a.grid(alpha=0.3)
     what = f", chain {chain.length:g} m, {chain.mass:g} kg" if units == "si" else " (nondimensional)"
-    a1.set_title(rf"Force on the pin, $\chi$ = {float(ds.attrs['chi']):g}, N = {int(ds.attrs['N'])}{what}",
-                 fontsize=10)
+    a1.set_title(f"Force on the pin, {run_label(ds)}{what}", fontsize=10)
     return fig
 
 
@@ -180,8 +235,62 @@ def profiles(ds, n: int = 7):
         a.grid(alpha=0.3)
     # the speed grows towards the free end (s = 1): the upper left of panel (a) is free
     axes[0].legend(fontsize=7, loc="upper left", title=f"time [{u['time']}]", title_fontsize=7)
-    fig.suptitle(rf"Along the chain up to the snap: $\chi$ = {float(ds.attrs['chi']):g}, "
-                 f"N = {int(ds.attrs['N'])} (nondimensional)")
+    fig.suptitle(f"Along the chain up to the snap: {run_label(ds)} (nondimensional)")
+    return fig
+
+
+def overview(ds, n: int = 7):
+    """One run at a glance (``snapping plot``): (a) the chain's shapes at up to ``n``
+    snapshots up to the snap, the held end marked (it may move); (b) speed and (c) tension
+    along the chain at the same snapshots; (d) the maxima over the chain (speed,
+    acceleration, tension) against time, with the snapping time. Nondimensional.
+    Returns the Figure."""
+    plt = _plt()
+    u = _U["nondimensional"]
+    idx = _snapshots_before(ds, n)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8.4))
+    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.07, top=0.9, wspace=0.25, hspace=0.3)
+    (a_shape, a_speed), (a_tension, a_max) = axes
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(idx), 2)))
+    s_node, s_link = ds["s_node"].values, ds["s_link"].values
+    ident = lambda x: x  # noqa: E731
+    for c, i in zip(colors, idx):
+        sn = ds.isel(snapshot=int(i))
+        lab = f"t = {float(sn['t_snapshot']):.4f}"
+        a_shape.plot(sn["x"].values, -sn["y"].values, color=c, lw=1.2, label=lab)
+        a_shape.plot(*_held_end(sn, ident), "s", color=c, mec="k", ms=5, zorder=3)
+        a_speed.plot(s_node, sn["speed"].values, color=c, label=lab)
+        a_tension.plot(s_link, sn["tension"].values, color=c, label=lab)
+    a_shape.set_aspect("equal", adjustable="datalim")
+    a_shape.set_xlabel(f"$x$  [{u['length']}]")
+    a_shape.set_ylabel(f"height  [{u['length']}]")
+    a_shape.set_title("(a) shapes (square: the held end)", loc="left", fontsize=10)
+    a_speed.set_xlabel(f"arclength $s$ from the held end  [{u['length']}]")
+    a_speed.set_ylabel(f"speed $|v|$  [{u['speed']}]")
+    a_speed.set_title("(b) speed along the chain", loc="left", fontsize=10)
+    a_tension.set_xlabel(f"arclength $s$ from the held end  [{u['length']}]")
+    a_tension.set_ylabel(rf"tension $\sigma$  [{u['force']}]")
+    a_tension.set_title("(c) tension along the chain", loc="left", fontsize=10)
+    a_speed.legend(fontsize=7, loc="upper left", title=f"time [{u['time']}]", title_fontsize=7)
+    from .scaling.plots import thin_envelope
+
+    t = np.asarray(ds["t"].values, dtype=float)
+    for name, lab, c in (("v_max", rf"speed [{u['speed']}]", "C0"), ("a_max", rf"acceleration [{u['accel']}]", "C1"),
+                         ("sigma_max", rf"tension [{u['force']}]", "C2")):
+        y = np.asarray(ds[name].values, dtype=float)
+        k = thin_envelope(t, y)
+        a_max.semilogy(t[k], y[k], color=c, label=lab)
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    if np.isfinite(t_snap):
+        a_max.axvline(t_snap, color="k", lw=0.6, ls="--", label=f"snap, t = {t_snap:.5g}")
+    a_max.set_xlabel(f"time $t$  [{u['time']}]")
+    a_max.set_ylabel("maximum over the chain (units in the legend)")
+    a_max.set_title("(d) maxima against time", loc="left", fontsize=10)
+    a_max.legend(fontsize=7, loc="upper left")
+    for a in (a_speed, a_tension, a_max):
+        a.grid(alpha=0.3)
+    fig.suptitle(f"{run_label(ds)}: {ds.attrs.get('status', '')}, {ds.attrs.get('method', '')} "
+                 f"(nondimensional)")
     return fig
 
 
@@ -208,6 +317,25 @@ def peak_speed_vs_N(table):
     return fig
 
 
+def _order_text(order) -> str:
+    """The observed order of convergence for a legend (not a number where it was not measured)."""
+    order = float(order)
+    return f"order {order:.2f}" if np.isfinite(order) else "order not measured (not converging)"
+
+
+def _level_ticks(ax, frac) -> None:
+    """Major ticks of a log axis at ``frac`` (thinned to at most 6), labelled as plain numbers,
+    and no minor tick labels."""
+    from matplotlib.ticker import FixedLocator, NullFormatter
+
+    ticks = np.unique(np.asarray(frac, dtype=float))
+    if ticks.size > 6:
+        ticks = ticks[np.unique(np.round(np.linspace(0, ticks.size - 1, 6)).astype(int))]
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(lambda x, pos: f"{x:.3g}")
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
 def convergence_figure(ds, path=None, uniform=None, other=None):
     """The continuum limit (:func:`snapping.continuum.converge`): (a) each peak over its
     extrapolated limit against the resolution of the fold (``frac``), with the limit's
@@ -223,7 +351,7 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
     colors = ("C0", "C1", "C2")
     frac = np.asarray(ds.frac.values, dtype=float)
     a_cat = estimates.catenary_parameter(float(ds.attrs["chi"]))
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 5.2), constrained_layout=True)
     for (q, label), c in zip(quantities, colors):
         lim, err = float(ds.attrs[q + "_limit"]), float(ds.attrs[q + "_error"])
         vals = np.asarray(ds[q].values, dtype=float)
@@ -235,14 +363,14 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
                      label=f"{label} uniform N = " + ", ".join(str(int(u.attrs["N"])) for u in uniform))
         dist = np.abs(vals - lim) / abs(lim)
         ok = dist > 0
-        ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: order {float(ds.attrs[q + '_order']):.2f}")
+        ax2.loglog(frac[ok], dist[ok], "o-", color=c, label=f"{label}: {_order_text(ds.attrs[q + '_order'])}")
         if other is not None:
             fo, vo = np.asarray(other.frac.values, dtype=float), np.asarray(other[q].values, dtype=float)
             lump = other.attrs.get("lumping", "other")
             ax1.plot(fo, vo / lim, "^:", color=c, label=f"{label} graded, {lump} lumping")
             do = np.abs(vo - lim) / abs(lim)
             ax2.loglog(fo[do > 0], do[do > 0], "^:", color=c,
-                       label=f"{label}, {lump} lumping: order {float(other.attrs[q + '_order']):.2f}")
+                       label=f"{label}, {lump} lumping: {_order_text(other.attrs[q + '_order'])}")
     ax1.set_xscale("log")
     ax1.set_xlim(frac.min() / 1.5, max([frac.max(), *(1.0 / (int(u.attrs["N"]) * a_cat) for u in (uniform or []))])
                  * 1.5)
@@ -251,11 +379,15 @@ def convergence_figure(ds, path=None, uniform=None, other=None):
     ax1.set_ylabel("peak / extrapolated limit")
     ax1.set_title(f"(a) $\\chi$ = {float(ds.attrs['chi']):g}: peaks against resolution "
                   f"({ds.attrs.get('lumping', '')} lumping)")
-    ax1.legend(fontsize=7, loc="lower right")
     ax2.set_xlabel("link length on the fold / its radius of curvature")
     ax2.set_ylabel(r"$|$peak $-$ limit$|$ / limit")
     ax2.set_title("(b) distance to the limit")
-    ax2.legend(fontsize=8, loc="upper left")
+    for ax in (ax1, ax2):  # ticks at the levels' resolutions, plain numbers (log minor labels overlap)
+        _level_ticks(ax, frac)
+    # the legends below the panels: inside they hide points (the coarsest level's acceleration)
+    ax1.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1, frameon=False)
+    ax2.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2 if other is not None else 1,
+               frameon=False)
     if path is not None:
         from ._files import save_figure
 

@@ -9,7 +9,7 @@ one line on stderr and exits with status 2, without a traceback.
 
 The subcommands live in one module per group: ``estimate`` (ideal, estimate,
 design), ``simulate``, ``sweep`` (sweep, converge) and ``analysis`` (fit,
-reproduce, animate); ``_common`` holds what they share (printing, the SI
+reproduce, plot, animate); ``_common`` holds what they share (printing, the SI
 options). This module holds the parser, :func:`main` and the error handling.
 """
 
@@ -19,7 +19,7 @@ import argparse
 import sys
 
 from ._common import PLOT_BYTES, _formatter, print_json, print_table
-from .analysis import _add_animate, _add_fit, _add_reproduce
+from .analysis import _add_animate, _add_fit, _add_plot, _add_reproduce
 from .estimate import _add_design, _add_estimate, _add_ideal
 from .simulate import _add_simulate
 from .sweep import _add_converge, _add_sweep
@@ -31,14 +31,34 @@ EXIT_FAILED = 1  # a numerical failure or an I/O fault (e.g. a full disk)
 
 #: the subcommands' ``_add_<name>`` functions, in the order of the help
 _SUBCOMMANDS = (_add_ideal, _add_estimate, _add_design, _add_simulate, _add_sweep, _add_fit, _add_converge,
-                _add_reproduce, _add_animate)
+                _add_reproduce, _add_plot, _add_animate)
 
 
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
 
     def error(self, message: str):  # noqa: D401 - argparse API
+        import re
+
+        bad = re.match(r"argument <command>: invalid choice: '([^']*)'", message)
+        if bad:  # a mistyped subcommand: suggest the closest
+            import difflib
+
+            choices = next(a for a in self._actions if isinstance(a, argparse._SubParsersAction)).choices
+            close = difflib.get_close_matches(bad.group(1), list(choices), n=2, cutoff=0.5)
+            if close:
+                message += f"; did you mean {' or '.join(close)}?"
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+class _Version(argparse.Action):
+    """--version, reading the installed version only when asked (importlib.metadata is slow to import)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .. import __version__
+
+        print(f"snapping {__version__}")
+        parser.exit(0)
 
 
 # ---------------------------------------------------------------------------- main
@@ -48,8 +68,6 @@ def build_parser() -> argparse.ArgumentParser:
     >>> build_parser().parse_args(["estimate", "--chi", "0.25"]).chi
     0.25
     """
-    from .. import __version__
-
     parser = _Parser(
         prog="snapping",
         formatter_class=_formatter,
@@ -64,12 +82,13 @@ def build_parser() -> argparse.ArgumentParser:
             "  snapping estimate --chi 0.25 --links 229   # how big will the spike be?\n"
             "  snapping design --max-tension 20 --length 2 --mass 0.05 --links 100\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
+            "  snapping plot run.nc -o run.png     # shapes, profiles and maxima of one run\n"
             "  snapping fit run.nc --plot fit.png  # exponents near the snap\n"
             "  snapping reproduce --quick -o out   # every claim and figure of the paper\n"
             "  snapping <command> --help           # each command's options and examples"
         ),
     )
-    parser.add_argument("--version", action="version", version=f"snapping {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="<command>", parser_class=_Parser)
     for add in _SUBCOMMANDS:
         add(sub)
@@ -113,18 +132,26 @@ def main(argv: list[str] | None = None) -> int:
     """Run the ``snapping`` command on ``argv`` (default: ``sys.argv[1:]``); returns the exit status
     (0 done, 1 numerical failure or I/O fault, 2 bad input, 130 or 143 interrupted by SIGINT or SIGTERM)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:
+        print(_unknown_message(parser, getattr(args, "command", None), unknown), file=sys.stderr)
+        return EXIT_BAD_INPUT
     if not getattr(args, "func", None):
         parser.print_help()
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
+    restore = _on_sigterm_raise()
     try:
         return int(args.func(args) or 0)
+    except _Terminated:  # SIGTERM outside a run's loop (which saves a checkpoint on it itself)
+        print(f"snapping {args.command}: terminated by SIGTERM {_outside_run(args)}", file=sys.stderr)
+        return 143
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
-        print(f"snapping {args.command}: error: {_as_typed(parser, args.command, str(exc))}", file=sys.stderr)
+        print(f"snapping {args.command}: error: {_cli_words(_as_typed(parser, args.command, str(exc)))}",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        print(f"snapping {args.command}: interrupted", file=sys.stderr)
+        print(f"snapping {args.command}: interrupted by SIGINT {_outside_run(args)}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of stdout went away (`snapping ... | head`): stop quietly
         import os
@@ -135,6 +162,74 @@ def main(argv: list[str] | None = None) -> int:
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
         return EXIT_FAILED
+    finally:
+        restore()
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM received while no run loop had its own handler (starting up, compiling, writing)."""
+
+
+def _on_sigterm_raise():
+    """Make SIGTERM raise :class:`_Terminated` (the command then says so and exits 143 instead of
+    dying without a word); returns the function that restores the previous handler."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def handler(signum, frame):
+        raise _Terminated()
+
+    try:
+        old = signal.signal(signal.SIGTERM, handler)
+    except (ValueError, OSError):  # pragma: no cover - exotic embedding
+        return lambda: None
+    return lambda: signal.signal(signal.SIGTERM, old)
+
+
+def _outside_run(args) -> str:
+    """What an interruption outside a run's loop left behind (a run's loop says it itself)."""
+    import os
+
+    out = getattr(args, "output", None)
+    if args.command == "simulate" and out and not os.path.exists(out):
+        return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
+    return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"
+
+
+def _cli_words(msg: str) -> str:
+    """A library message in the words of the command line (``--overwrite``, not ``overwrite=True``)."""
+    for lib in ("overwrite=True (--overwrite)", "--overwrite (overwrite=True)", "overwrite=True"):
+        msg = msg.replace(lib, "--overwrite")
+    return msg
+
+
+def _unknown_message(parser, command, unknown: list[str]) -> str:
+    """The one-line error for arguments no option takes, naming the subcommand and suggesting
+    the closest options of that subcommand (difflib)."""
+    import difflib
+
+    sub = None
+    if command:
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices.get(command)
+    where = sub or parser
+    options = sorted({o for a in where._actions for o in a.option_strings if o.startswith("--")})
+    parts, after_option = [], False
+    for arg in unknown:
+        if arg.startswith("-") and len(arg) > 1 and not arg[1:2].isdigit():
+            name = arg.split("=", 1)[0]
+            close = difflib.get_close_matches(name, options, n=3, cutoff=0.6)
+            hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+            parts.append(f"{name}{hint}")
+            after_option = "=" not in arg
+        elif not after_option:  # (a value right after an unknown option is taken to be its value)
+            parts.append(repr(arg))
+        else:
+            after_option = False
+    prog = f"snapping {command}" if command else "snapping"
+    return f"{prog}: error: unrecognized argument{'s' if len(parts) > 1 else ''}: {', '.join(parts)}; see `{prog} --help`"
 
 
 def _explicit_dests(argv) -> set[str]:

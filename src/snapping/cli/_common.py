@@ -72,8 +72,8 @@ def print_table(rows, title: str | None = None) -> None:
     fmt_rows = []
     for r in rows:
         name, value = r[0], r[1]
-        if isinstance(value, float):
-            value = f"{value:.6g}"
+        if isinstance(value, float):  # (a count held as a float prints as an integer, not 1e+06)
+            value = str(int(value)) if value.is_integer() and 1e6 <= abs(value) < 1e15 else f"{value:.6g}"
         fmt_rows.append((str(name), str(value), *(str(c) for c in r[2:])))
     w0 = max(len(r[0]) for r in fmt_rows)
     w1 = max(len(r[1]) for r in fmt_rows)
@@ -137,7 +137,12 @@ def _print_si(scales, rows, title: str = "") -> None:
     from .. import units
 
     if scales is None:
-        print(f"  {units.NONDIMENSIONAL_NOTE}")
+        import textwrap
+
+        head, _, tail = units.NONDIMENSIONAL_NOTE.partition("; ")  # (tail: how to get SI, kept on one line)
+        print(textwrap.fill(head + (";" if tail else ""), width=100, initial_indent="  ", subsequent_indent="    "))
+        if tail:
+            print(f"    {tail}")
         return
 
     def fmt(v):

@@ -105,8 +105,8 @@ def _cmd_fit(args) -> int:
             raise SnappingInputError(f"{name}: {exc}") from None
     def run_line(ds) -> str:
         a = ds.attrs
-        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')}; "
-                f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
+        return (f"method {a.get('method', '?')}, chords {a.get('chords', '?')}, tol {a.get('tol', '?')};\n"
+                f"  units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
 
     if args.json:
         if len(results) == 1:
@@ -125,7 +125,7 @@ def _cmd_fit(args) -> int:
             title=f"{names[0]}: chi = {res.chi:g}, N = {res.N}",
         )
         print()
-        print_table(scaling.report_rows(res), title="Exponents y ~ A (t* - t)^beta")
+        _print_exponents(scaling.report_rows(res))
         if res.delta is not None:
             d = res.delta
             print()
@@ -138,7 +138,7 @@ def _cmd_fit(args) -> int:
         for line in dict.fromkeys(run_line(r) for r in runs):  # (each distinct one once)
             print(f"runs: {line}")
         print()
-        print_table(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
+        _print_columns(scaling.summary_rows(results), title="Exponents per run (t* = t*_chi)")
         if scales is None:
             _print_si(None, [])
         for name, res in zip(names, results):
@@ -155,6 +155,131 @@ def _cmd_fit(args) -> int:
         if not args.json:
             print("\nfigures: " + ", ".join(str(p) for p in paths))
     return 0
+
+
+def _print_columns(rows: list[tuple], title: str, keep: int = 2, width: int = 100) -> None:
+    """A table (first row: the headers) in blocks of columns that fit ``width``, each block
+    repeating the first ``keep`` columns (chi, N of a run)."""
+    print(title)
+    print("-" * len(title))
+    rows = [tuple(str(c).strip() for c in r) for r in rows]
+    w = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    blocks, cur = [], []
+    base = 2 + sum(w[:keep]) + 2 * keep
+    for i in range(keep, len(w)):
+        if cur and base + sum(w[j] + 2 for j in cur) + w[i] > width:
+            blocks.append(cur)
+            cur = []
+        cur.append(i)
+    blocks.append(cur)
+    for n, block in enumerate(blocks):
+        if n:
+            print()
+        for r in rows:
+            cells = [r[i].ljust(w[i]) for i in range(keep)] + [r[i].rjust(w[i]) for i in block]
+            print(("  " + "  ".join(cells)).rstrip())
+
+
+#: short headers of the exponent table's numeric columns (the text fits 100 columns)
+_EXPONENT_HEADERS = ("quantity", "beta, t*=t*_chi", "ref", "ideal", "window of t*-t", "beta, t* fitted",
+                     "A/A_ideal")
+
+
+def _print_exponents(rows: list[tuple], width: int = 100) -> None:
+    """The exponent table of one run (:func:`snapping.scaling.report_rows`) in ``width``
+    columns: the numbers on one line per quantity, its verdict and notes wrapped below it."""
+    import textwrap
+
+    title = "Exponents y ~ A (t* - t)^beta"
+    print(title)
+    print("-" * len(title))
+    body = [tuple(c.strip().replace(" ± ", " ±") for c in r) for r in rows[1:]]
+    table = [_EXPONENT_HEADERS] + [r[:7] for r in body]
+    w = [max(len(r[i]) for r in table) for i in range(7)]
+    for k, r in enumerate(table):
+        cells = [r[0].ljust(w[0])] + [c.rjust(w[i + 1]) for i, c in enumerate(r[1:])]
+        print(("  " + "  ".join(cells)).rstrip())
+        if k:
+            words = "; ".join(c for c in body[k - 1][7:] if c)
+            for line in textwrap.wrap(words, width=width - 6):
+                print(f"      {line}")
+    print("  (ideal: the exact folded string's exponent on the same window; z = (beta - ref) / uncertainty)")
+
+
+# ---------------------------------------------------------------------------- plot
+def _add_plot(sub) -> None:
+    p = sub.add_parser(
+        "plot",
+        help="one run at a glance: shapes, speed and tension along the chain, maxima against time",
+        formatter_class=_formatter,
+        description=(
+            "Draw one run file: (a) the chain's shapes at its snapshots up to the snap (the held end\n"
+            "marked: it may move), (b) speed and (c) tension along the chain at the same snapshots,\n"
+            "(d) the maxima over the chain against time, with the snapping time. Nondimensional.\n"
+            "The exponent fits are `snapping fit RUN.nc --plot`; an animation `snapping animate`."
+        ),
+        epilog=(
+            "examples (run.nc from e.g. snapping simulate --chi 0.25 --N 200 -o run.nc):\n"
+            "  snapping plot run.nc -o run.png\n"
+            "  snapping plot run.nc -o run.pdf --snapshots 5 --overwrite"
+        ),
+    )
+    p.add_argument("file", metavar="RUN.nc", help="run file (snapping simulate -o)")
+    p.add_argument("-o", "--output", required=True, metavar="PATH", help="figure file: .png, .pdf or .svg")
+    p.add_argument("--snapshots", type=int, default=7, metavar="N",
+                   help="at most N snapshots drawn, from t = 0 to the snap (default 7)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing output (default: refuse it)")
+    p.set_defaults(func=_cmd_plot)
+
+
+def _cmd_plot(args) -> int:
+    from .. import figures
+    from .._files import check_output, figure_format, save_figure
+    from .._validate import SnappingInputError
+    from ..simulate import load_run
+
+    figure_format(args.output, name="--output")
+    check_output(args.output, name="--output", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
+    if not 2 <= args.snapshots <= 50:
+        raise SnappingInputError(f"--snapshots {args.snapshots} is out of range: must lie in [2, 50]")
+    ds = load_run(args.file)
+    missing = [v for v in ("x", "y", "speed", "tension", "t_snapshot") if v not in ds]
+    if missing:
+        raise SnappingInputError(f"{args.file} has no profile snapshots (missing {missing}): nothing to plot; "
+                                 f"`snapping fit {args.file}` reads the maxima alone")
+    fig = figures.overview(ds, n=args.snapshots)
+    try:
+        save_figure(fig, args.output, dpi=120)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    print(f"wrote {args.output}: {figures.run_label(ds).replace('$', '').replace(chr(92), '')}")
+    return 0
+
+
+#: the most snapshots ``animate --frames`` asks a rerun for (each is a full profile in memory)
+MAX_RERUN_FRAMES = 2000
+
+
+def _dense_rerun(ds, frames: int, path: str):
+    """The run ``ds`` (from ``path``) run again with ``frames`` snapshots dense towards its snap."""
+    import math
+
+    from .. import animation
+    from .._validate import SnappingInputError
+    from ..simulate import rerun
+
+    if not 2 <= frames <= MAX_RERUN_FRAMES:
+        raise SnappingInputError(f"--frames {frames} is out of range: must lie in [2, {MAX_RERUN_FRAMES}]")
+    t_snap = float(ds.attrs.get("t_snap_v", math.nan))
+    if not (math.isfinite(t_snap) and t_snap > 0):
+        raise SnappingInputError(f"--frames {frames}: {path} has no snapping time (t_snap_v), so there is no snap "
+                                 f"to crowd the snapshots towards; use its own snapshots (leave out --frames)")
+    times = animation.dense_snapshot_times(t_snap, frames)[1:]  # (t = 0 is always taken)
+    print(f"snapping animate: rerunning {path} with {frames} snapshots dense towards the snap (t = {t_snap:.6g})",
+          file=sys.stderr)
+    return rerun(ds, snapshot_times=times, output=None, progress=None).dataset
 
 
 # ----------------------------------------------------------------------- reproduce
@@ -207,13 +332,15 @@ def _add_animate(sub) -> None:
         description=(
             "Draw the chain of every profile snapshot of RUN.nc as one frame, coloured by speed\n"
             "(log scale, colour bar), with the time and the time to the snap, nondimensional.\n"
-            "GIF through Pillow (always available); MP4 needs ffmpeg on PATH. A run with few\n"
-            "snapshots up to the snap gets a note with the command for a denser run\n"
-            "(--snapshot-times geometric in the time to the snap)."
+            "GIF through Pillow (always available); MP4 needs ffmpeg on PATH. A run has few\n"
+            "snapshots up to the snap unless asked for more: --frames K reruns it from its file\n"
+            "(same inputs, nothing written) with K snapshots dense towards the snap (geometric in\n"
+            "the time to the snap) and animates those."
         ),
         epilog=(
             "examples (run.nc from e.g. snapping simulate --chi 0.25 --N 200 -o run.nc):\n"
             "  snapping animate run.nc -o snap.gif\n"
+            "  snapping animate run.nc -o smooth.gif --frames 60    # rerun with 60 dense snapshots\n"
             "  snapping animate run.nc -o snap.gif --max-frames 30 --fps 5\n"
             "  snapping animate run.nc -o snap.mp4 --fps 12 --overwrite"
         ),
@@ -222,6 +349,9 @@ def _add_animate(sub) -> None:
     p.add_argument("-o", "--output", required=True, help="animation file: .gif or .mp4")
     p.add_argument("--fps", type=float, default=8.0, help="frames per second (default 8)")
     p.add_argument("--max-frames", type=int, default=None, help="at most this many frames (snapshots thinned evenly)")
+    p.add_argument("--frames", type=int, default=None, metavar="K",
+                   help=f"rerun the run with K snapshots dense towards the snap and animate them (2 to "
+                        f"{MAX_RERUN_FRAMES}; costs one more run)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output (default: refuse it)")
     p.set_defaults(func=_cmd_animate)
 
@@ -232,10 +362,14 @@ def _cmd_animate(args) -> int:
 
     animation.check_output(args.output, overwrite=args.overwrite)  # before reading the run
     ds = load_run(args.file)
+    if args.frames is not None:
+        ds = _dense_rerun(ds, args.frames, args.file)
     animation.frames_of(ds, args.max_frames)  # no snapshots: refused here
-    hint = animation.denser_run_hint(ds, args.file)
-    if hint:
-        print(f"snapping animate: note: {hint}", file=sys.stderr)
+    n_snap = animation.snapshots_before_snap(ds)
+    if args.frames is None and animation.denser_run_hint(ds, args.file):
+        print(f"snapping animate: note: only {n_snap} snapshots up to the snap; for a smoother animation add "
+              f"--frames 60 (reruns the run with that many snapshots dense towards the "
+              f"snap)", file=sys.stderr)
     out = animation.animate(ds, args.output, fps=args.fps, max_frames=args.max_frames, overwrite=args.overwrite)
     n = len(animation.frames_of(ds, args.max_frames))
     print(f"wrote {out}: {n} frames at {args.fps:g} fps")

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .. import _validate as V
 
@@ -38,6 +37,38 @@ def _log_sinhc(b: float) -> float:
     return math.log(math.sinh(b) / b)
 
 
+def _dlog_sinhc(b: float) -> float:
+    """d/db log(sinh(b)/b) = coth(b) - 1/b (> 0 for b > 0)."""
+    if b < 1e-4:
+        return b / 3.0 - b**3 / 45.0
+    if b > 20.0:
+        return 1.0 - 1.0 / b
+    return 1.0 / math.tanh(b) - 1.0 / b
+
+
+def _root_increasing(f, df, lo: float, hi: float, x0: float, rtol: float, maxiter: int = 500) -> float:
+    """The root of the increasing function ``f`` in [lo, hi] (f(lo) <= 0 <= f(hi)): Newton steps
+    kept inside a shrinking bracket, bisection where a step leaves it (no scipy: importing
+    scipy.optimize costs most of a second, more than a table query)."""
+    b = min(max(x0, lo), hi)
+    for _ in range(maxiter):
+        fb = f(b)
+        if fb == 0.0:
+            return b
+        if fb < 0.0:
+            lo = b
+        else:
+            hi = b
+        d = df(b)
+        nb = b - fb / d if d > 0.0 else math.nan
+        if not lo < nb < hi:
+            nb = 0.5 * (lo + hi)
+        if abs(nb - b) <= rtol * abs(nb) or hi - lo <= rtol * hi:
+            return nb
+        b = nb
+    return b
+
+
 def catenary_parameter(chi: float) -> float:
     """Catenary parameter ``a`` of a unit-length string with end separation ``chi``.
 
@@ -66,7 +97,8 @@ def catenary_parameter(chi: float) -> float:
     target = -math.log(chi)
     # log(sinh b / b) ~ b^2/6 for small b and ~ b - log(2b) for large b.
     hi = max(1.0, 2.0 * (target + math.log(2.0 * target + 2.0)) + 2.0)
-    b = brentq(lambda bb: _log_sinhc(bb) - target, 0.0, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    guess = math.sqrt(6.0 * target) if target < 1.0 else target + math.log(2.0 * target)
+    b = _root_increasing(lambda bb: _log_sinhc(bb) - target, _dlog_sinhc, 0.0, hi, guess, rtol=4 * np.finfo(float).eps)
     if b == 0.0:  # chi so close to 1 that the root underflows: use the series
         b = math.sqrt(6.0 * target)
     return chi / (2.0 * b)

@@ -112,7 +112,7 @@ def _chi_bar(fig, sm, cax, chis):
     ticks = sorted(set(float(c) for c in chis))
     if len(ticks) <= 8:
         cb.set_ticks(ticks)
-    cb.set_label(r"initial end separation $\chi$  [" + U_LENGTH + "]")
+    cb.set_label(r"initial end separation $\chi$ (fraction of the length)")
     return cb
 
 
@@ -527,7 +527,7 @@ def plot_delta(runs, results, path) -> Path:
                                  ("delta_kappa_m", "g^", r"$\delta_{\kappa_m}$ (from the run)")):
                 ax.semilogy(chis, [r.delta.predicted[key][q] for r in fitted], mk, mfc="none", label=lab)
             ax.semilogy(chis, [r.delta.computed[q] for r in fitted], "ko", label="computed")
-            ax.set_xlabel(r"initial end separation $\chi$  [" + U_LENGTH + "]")
+            ax.set_xlabel(r"initial end separation $\chi$ (fraction of the length)")
             ax.set_ylabel(tag[4:] + "  [" + unit + "]")
             ax.set_title(tag, loc="left", fontsize=10)
             ax.grid(True, which="both", alpha=0.3)

@@ -244,7 +244,8 @@ def run(
     overwrite : bool
         Replace ``output`` if it exists (default: refuse an existing file).
     progress : bool or None
-        tqdm progress bar on stderr (None: only on a terminal).
+        tqdm progress bar on stderr (None: the bar on a terminal, else a plain line every ~10 s,
+        :mod:`snapping.simulate.progress_lines`).
     max_energy_drift : float, optional
         The run fails when |E(t) - E(0)| exceeds this (default: no bound).
     dt_min : float
@@ -401,6 +402,13 @@ def expected_snap_time(inputs: dict) -> float | None:
     return float(max(T_STAR - 0.25 * chi ** 2, 0.5 * T_STAR))
 
 
+def _isatty(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
 def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
     """:func:`_drive` once the output (if any) is locked and checked.
 
@@ -412,7 +420,13 @@ def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall
     t_end = inputs["t_end"] or None
     N = eng.N
     bar = None
-    if progress or progress is None:
+    if progress is None and not _isatty(sys.stderr):  # a log or a pipe: lines every ~10 s, not a bar
+        from .progress_lines import LineProgress
+
+        expected = None if t_end else expected_snap_time(inputs)
+        bar = LineProgress(f"chain N={N} ({inputs['method']})", total=t_end or expected, initial=eng.t,
+                           estimated=not t_end)
+    elif progress or progress is None:
         from tqdm.auto import tqdm
 
         desc = f"chain N={N}" if M.method(inputs["method"]) is M.euler_richardson else \

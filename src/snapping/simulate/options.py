@@ -246,7 +246,7 @@ def check_memory(N: int, opts: RunOptions, *, chi=None, method: str = "fast") ->
     if avail is None or need["bytes"] <= MEMORY_MARGIN * avail:
         return need
     gib = 2.0 ** 30
-    inputs = ", ".join(f"{k}={v:g}" for k, v in (("N", N), ("chi", chi), ("tol", opts.tol), ("dt0", opts.dt0),
+    inputs = ", ".join(f"{k}={v if isinstance(v, int) else format(v, 'g')}" for k, v in (("N", N), ("chi", chi), ("tol", opts.tol), ("dt0", opts.dt0),
                                                     ("t_end", opts.t_end)) if v is not None)
     raise V.SnappingInputError(
         f"{inputs} ({method}): the run would need about {need['bytes'] / gib:.3g} GiB of memory (record: ~{need['records']:.3g} steps "

@@ -1,0 +1,57 @@
+"""Progress as plain lines, for a run whose stderr is not a terminal (a log file, a pipe,
+a batch job): the tqdm bar is off there, so without these lines a long run says nothing
+until it ends. A run shorter than :data:`EVERY` seconds prints nothing; a longer one prints a
+line every :data:`EVERY` seconds (the first says why) and one when it stops. The same calls as
+the tqdm bar (``update``, ``set_postfix_str``, ``close``)."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+#: seconds between two progress lines
+EVERY = 10.0
+
+
+class LineProgress:
+    """A progress "bar" that prints ``desc: t=..., <postfix>, <elapsed> s`` lines to ``file``."""
+
+    def __init__(self, desc: str, total=None, initial: float = 0.0, *, estimated: bool = False, every=None,
+                 file=None):
+        self.desc, self.total, self.n, self.estimated = desc, total, float(initial), estimated
+        self.every = EVERY if every is None else float(every)
+        self.file = file or sys.stderr
+        self.postfix = ""
+        self.t0 = self.last = time.monotonic()
+        self.printed = 0
+
+    def _print(self, text: str) -> None:
+        try:
+            print(f"{self.desc}: {text}", file=self.file, flush=True)
+        except (OSError, ValueError):  # a closed or full stderr: progress is not worth a failure
+            pass
+
+    def _line(self) -> str:
+        of = "" if not self.total else f"/{'~' if self.estimated else ''}{self.total:.4g}"
+        post = f", {self.postfix}" if self.postfix else ""
+        return f"t={self.n:.6g}{of}{post}, {time.monotonic() - self.t0:.0f} s"
+
+    def update(self, n: float = 1) -> None:
+        self.n += n
+        if self.estimated and self.total is not None and self.n > self.total:
+            self.total = self.n
+        now = time.monotonic()
+        if now - self.last >= self.every:
+            self.last = now
+            if not self.printed:
+                of = "" if not self.total else f" (of t={self.total:.4g}{', the estimated snap' if self.estimated else ''})"
+                self._print(f"running{of}; a line every {self.every:g} s (stderr is not a terminal: no progress bar)")
+            self.printed += 1
+            self._print(self._line())
+
+    def set_postfix_str(self, s: str = "", refresh: bool = True) -> None:
+        self.postfix = s
+
+    def close(self) -> None:
+        if self.printed:
+            self._print(f"stopped at {self._line()}")
