@@ -148,8 +148,12 @@ def float_array(name: str, value):
     if isinstance(value, (str, bytes, dict)):
         raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers")
     try:
+        if np.asarray(value).dtype.kind == "b":  # True/False are not numbers here (as in real)
+            raise SnappingInputError(f"{name}={_short(value)} holds True/False: expected real numbers")
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, SnappingInputError):
+            raise
         raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers") from None
     except OverflowError:  # an integer beyond the doubles (10**400)
         raise SnappingInputError(f"{name}={_short(value)} holds a number too large for a float (|x| < 1.8e308)") \
