@@ -41,6 +41,9 @@ __all__ = ["dense_snapshot_times", "frames_of", "animate", "DENSE_FRAMES", "SUFF
 #: Fewer snapshots than this up to the snap make a jerky animation: ``snapping animate`` says how to get more.
 DENSE_FRAMES = 24
 
+#: Frames per second accepted (a GIF frame lasts a whole number of milliseconds)
+FPS_RANGE = (0.01, 100.0)
+
 #: Output formats by suffix.
 SUFFIXES = (".gif", ".mp4")
 
@@ -76,6 +79,7 @@ def dense_snapshot_times(t_snap: float, n: int = 60, tau_min: float = 1e-4) -> l
 
 
 def _check_run(ds, name: str = "run"):
+    V.run_dataset(name, ds)
     missing = [v for v in _NEEDED if v not in ds.variables]
     if missing:
         raise V.SnappingInputError(f"{name} has no profile snapshots (missing {missing}): nothing to animate")
@@ -258,6 +262,11 @@ def animate(ds, output, *, fps: float = 8.0, max_frames: int | None = None, over
     from . import _files
 
     fps = V.positive("fps", fps)
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+        raise V.SnappingInputError(f"fps={fps!r} is out of range: must lie in [{FPS_RANGE[0]:g}, {FPS_RANGE[1]:g}] "
+                                   f"frames per second")
+    _check_run(ds)
+    frames_of(ds, max_frames)  # (max_frames checked before any work)
     p = check_output(output, overwrite=overwrite)
     _check_run(ds)
     import matplotlib.pyplot as plt

@@ -233,10 +233,10 @@ def _cmd_animate(args) -> int:
     animation.check_output(args.output, overwrite=args.overwrite)  # before reading the run
     ds = load_run(args.file)
     animation.frames_of(ds, args.max_frames)  # no snapshots: refused here
-    hint = animation.denser_run_hint(ds, args.file)
-    if hint:
-        print(f"snapping animate: note: {hint}", file=sys.stderr)
     out = animation.animate(ds, args.output, fps=args.fps, max_frames=args.max_frames, overwrite=args.overwrite)
     n = len(animation.frames_of(ds, args.max_frames))
     print(f"wrote {out}: {n} frames at {args.fps:g} fps")
+    hint = animation.denser_run_hint(ds, args.file)  # (after the work: never a hint before an error)
+    if hint:
+        print(f"snapping animate: note: {hint}", file=sys.stderr)
     return 0

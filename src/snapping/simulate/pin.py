@@ -58,8 +58,8 @@ class PinMotion:
                                        f"PinMotion.fixed, .pull, .flick, .from_table or .from_function)")
         accel = self._vector("accel", self.accel)
         t0 = V.real("t0", self.t0)
-        if not 0.0 <= t0 <= T_MAX:
-            raise V.SnappingInputError(f"t0={t0!r} is out of range: must lie in [0, {T_MAX:g}]")
+        if t0 < 0.0:
+            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
         d = self.duration
         if self.kind in ("pull", "flick") and not (self.kind == "pull" and isinstance(d, (int, float))
                                                    and d == math.inf):
