@@ -53,7 +53,7 @@ import threading
 
 from . import _validate as V
 
-__all__ = ["check_output", "check_output_dir", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
+__all__ = ["check_output", "check_output_dir", "output_dir", "check_own_files", "is_snapping_file", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
            "OutputBusyError", "lock_path", "describe_kind", "figure_format"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
@@ -205,6 +205,57 @@ def check_output_dir(path, *, name: str = "output") -> str:
     except OSError as exc:
         raise V.SnappingInputError(f"{name}={p!r}: the directory cannot be written ({exc.strerror or exc})") from None
     return p
+
+
+@contextlib.contextmanager
+def output_dir(path, *, name: str = "output"):
+    """:func:`check_output_dir` for the duration of a piece of work: the directories it makes are
+    removed again (when still empty) if the work is refused or fails, so that a refused sweep or
+    convergence study leaves nothing behind (no new empty ``-o`` directory)."""
+    p = V.file_path(name, path)
+    made, d = [], os.path.abspath(p)
+    while not os.path.lexists(d) and d != os.path.dirname(d):
+        made.append(d)
+        d = os.path.dirname(d)
+    out = check_output_dir(p, name=name)
+    try:
+        yield out
+    except BaseException:
+        for d in made:  # deepest first
+            try:
+                os.rmdir(d)
+            except OSError:
+                break
+        raise
+
+
+def is_snapping_file(path) -> bool:
+    """Whether ``path`` is a netCDF file that snapping wrote (global attributes ``snapping_version``
+    and ``status``, or ``snapping_version`` and a convergence study's ``grading``)."""
+    try:
+        import netCDF4
+
+        with netCDF4.Dataset(path) as nc:
+            names = set(nc.ncattrs())
+    except Exception:  # noqa: BLE001 - unreadable: not ours
+        return False
+    return ("status" in names and "snapping_version" in names) or "sweep_grid" in names or \
+        ("grading" in names and "ratio" in names)
+
+
+def check_own_files(paths, *, name: str = "output", overwrite: bool = False) -> None:
+    """Refuse, before any work, to replace a file at any of ``paths`` (the files a sweep or a
+    convergence study writes into its directory) that snapping did not write: another
+    program's file named like a run is never replaced without ``overwrite``."""
+    for path in paths:
+        p = os.fspath(path)
+        if not os.path.lexists(p):
+            continue
+        check_output(p, name=name, overwrite=True)  # a regular file (not a directory, device, ...)
+        if not overwrite and not is_snapping_file(p):
+            raise V.SnappingInputError(f"{name}={p!r} exists and is not a snapping run file (another program's "
+                                       f"file, or damaged): it is not replaced; move it away, or pass "
+                                       f"overwrite=True (--overwrite) to replace it")
 
 
 # ------------------------------------------------------------------------------- locks
