@@ -11,7 +11,7 @@ import math
 import numbers
 
 __all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer", "float_array", "file_path",
-           "run_dataset"]
+           "run_dataset", "nonnegative"]
 
 
 class SnappingInputError(ValueError):
@@ -90,6 +90,20 @@ def open_interval(name: str, value, lo: float, hi: float) -> float:
     if not lo < x < hi:
         raise SnappingInputError(f"{name}={x!r} is out of range: must lie in the open interval ({lo:g}, {hi:g})")
     return x
+
+
+def nonnegative(name: str, value) -> float:
+    """Return ``value`` as a float in [0, inf), or raise naming ``name``.
+
+    >>> nonnegative("max_seconds", -1)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: max_seconds=-1.0 is out of range: must be >= 0
+    """
+    x = _as_float(name, value)
+    if not x >= 0.0:
+        raise SnappingInputError(f"{name}={x!r} is out of range: must be >= 0")
+    return abs(x)  # (-0.0 is 0)
 
 
 #: the largest integer accepted when no maximum is given (a count beyond it cannot be meant)

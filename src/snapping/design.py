@@ -357,6 +357,7 @@ def run_instead(chi: float, links: int, tip_mass: float, errors: dict, *,
     them for chains of at most :data:`FEW_LINKS` links, and where a bound is above
     :data:`TARGETS` and the table says such a run costs at most ``max_seconds``; ``why`` is
     empty when the table's peaks meet the targets."""
+    max_seconds = V.nonnegative("max_seconds", max_seconds)
     over = {q: e for q, e in errors.items() if q in TARGETS and not e <= TARGETS[q]}
     few = links <= FEW_LINKS
     if not over and not few:
@@ -385,7 +386,7 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     always for chains of at most :data:`FEW_LINKS` links (milliseconds); else the table's
     answer, with ``computed_note`` naming its bound (:func:`run_instead` decides). Outside
     the table: :class:`snapping.table.OutsideTable` (``simulate_estimate`` runs it)."""
-    max_seconds = V.real("max_seconds", max_seconds)
+    max_seconds = V.nonnegative("max_seconds", max_seconds)
     est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
                           tip_mass=tip_mass)
     run, why = run_instead(est.nondim["chi"], est.links, est.tip_mass, est.computed_errors, max_seconds=max_seconds)
