@@ -214,7 +214,7 @@ def _failure_of(exc: BaseException, path: str) -> dict:
         msg = ds.attrs.get("stop_reason") if ds is not None and ds.attrs.get("stop_reason") else str(exc)
         return {"kind": exc.kind or "simulation", "message": _one_line(msg), "file": _existing(exc.path or path)}
     msg = _one_line(exc) or type(exc).__name__
-    if type(exc).__name__ == "BrokenProcessPool":
+    if type(exc).__name__ == "BrokenProcessPool" and not str(exc).startswith("a worker process could not run"):
         msg = ("a worker process died (killed, out of memory, or, in a script, a sweep not started under "
                "`if __name__ == \"__main__\":`, whose workers re-run the script)")
     return {"kind": type(exc).__name__, "message": msg, "file": _existing(path)}
