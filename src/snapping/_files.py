@@ -265,7 +265,7 @@ def lock_path(path: str) -> str:
     return os.path.join(d, f".{base}.lock")
 
 
-_held: dict[str, list] = {}  # realpath of the output -> [fd, depth] (locks held by this process)
+_held: dict[str, list] = {}  # realpath of the output -> [fd, depth, thread] (locks held by this process)
 _held_guard = threading.Lock()
 
 
@@ -316,7 +316,8 @@ def _acquire(path: str, name: str) -> int:
 
 @contextlib.contextmanager
 def locked(path, *, name: str = "output"):
-    """Hold the exclusive lock of output ``path`` (re-entrant in this process).
+    """Hold the exclusive lock of output ``path`` (re-entrant in the thread that holds it; another
+    thread of this process, like another process, gets :class:`OutputBusyError`).
 
     On taking it, temporary ``.NAME.*.part`` files that a killed writer left are removed.
     A second process gets :class:`OutputBusyError` naming the holder's PID.
@@ -332,10 +333,13 @@ def locked(path, *, name: str = "output"):
     p = os.path.realpath(_target(name, path))
     with _held_guard:
         entry = _held.get(p)
+        if entry is not None and entry[2] != threading.get_ident():  # (flock is per process: threads checked here)
+            raise OutputBusyError(f"{name}={os.fspath(path)!r} is being written by another thread of this process "
+                                  f"(PID {os.getpid()}): wait for it to finish, or choose another path")
         if entry is not None:
             entry[1] += 1
         else:
-            _held[p] = [_acquire(p, name), 1]
+            _held[p] = [_acquire(p, name), 1, threading.get_ident()]
             _remove_stale_parts(p)
     try:
         yield p
@@ -369,7 +373,16 @@ def write_atomic(path, write, *, name: str = "output", overwrite: bool = True, d
     umask). On any failure the temporary is removed and the previous file is untouched;
     a full disk raises :class:`OutputWriteError` saying so (carrying ``dataset``).
     """
-    p = check_output(path, name=name, overwrite=overwrite)
+    try:
+        p = check_output(path, name=name, overwrite=overwrite)
+    except V.SnappingInputError as exc:
+        held = os.path.realpath(_target(name, path)) in _held
+        if not held:
+            raise
+        # the output was checked before the work and is locked since: what changed (a directory made
+        # read-only, a file put in the way) is an I/O fault, not bad input
+        raise OutputWriteError(f"writing {name}={os.fspath(path)!r} failed: {exc}; nothing was replaced",
+                               path=os.fspath(path), dataset=dataset) from None
     d = os.path.dirname(os.path.abspath(p))
     with locked(p, name=name):
         fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)

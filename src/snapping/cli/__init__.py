@@ -135,6 +135,12 @@ def main(argv: list[str] | None = None) -> int:
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
         return EXIT_FAILED
+    except RuntimeError as exc:  # a numerical failure, or workers that died: one line, exit 1
+        if not any(c.__name__ in ("SimulationError", "BrokenExecutor") for c in type(exc).__mro__):
+            raise
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        print(f"snapping {args.command}: error: {first}", file=sys.stderr)
+        return EXIT_FAILED
 
 
 def _explicit_dests(argv) -> set[str]:
