@@ -132,6 +132,14 @@ def check_output(path, *, name: str = "output", overwrite: bool = False, need_by
         what = "is not a directory" if os.path.exists(parent) else "does not exist"
         raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} {what}")
     try:
+        parent.encode("utf-8")
+    except UnicodeEncodeError:  # (checked before the work: the file is written in this directory)
+        raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} has a name that is not valid "
+                                   f"UTF-8: files cannot be written there (netCDF takes UTF-8 paths)") from None
+    if len(os.fsencode(os.path.basename(p))) > 255:
+        raise V.SnappingInputError(f"{name}={given!r}: the file name is {len(os.fsencode(os.path.basename(p)))} "
+                                   f"bytes long; at most 255")
+    try:
         st = os.stat(p)
     except FileNotFoundError:
         st = None
@@ -149,7 +157,7 @@ def check_output(path, *, name: str = "output", overwrite: bool = False, need_by
     if not os.access(parent, os.W_OK | os.X_OK):
         raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} is not writable (permission denied)")
     try:  # the file is written next to itself and renamed: the directory must take a new file
-        fd, probe = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".probe", dir=parent)
+        fd, probe = tempfile.mkstemp(prefix=f"{_side(p)}.", suffix=".probe", dir=parent)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
@@ -259,10 +267,33 @@ def check_own_files(paths, *, name: str = "output", overwrite: bool = False) -> 
 
 
 # ------------------------------------------------------------------------------- locks
+#: longest base name (bytes) whose side files (lock, temporary, probe) are named after it in full
+_SIDE_NAME_MAX = 200
+
+
+def _side(path) -> str:
+    """The stem of the hidden side files of output ``path`` (lock, temporary, probe): ``.NAME``; for a
+    name too long to take their suffixes (any valid name, up to 255 bytes, is accepted) or one that is
+    not UTF-8 (netCDF writes only UTF-8 paths), a shortened UTF-8 name and a hash of the full one."""
+    base = os.path.basename(os.path.abspath(os.fspath(path)))
+    raw = os.fsencode(base)
+    try:
+        base.encode("utf-8")
+        ok = len(raw) <= _SIDE_NAME_MAX
+    except UnicodeEncodeError:
+        ok = False
+    if ok:
+        return f".{base}"
+    import hashlib
+
+    short = raw[:120].decode("utf-8", errors="ignore").encode("ascii", errors="ignore").decode()
+    return f".{short}~{hashlib.sha1(raw).hexdigest()[:16]}"
+
+
 def lock_path(path: str) -> str:
-    """The lock file of output ``path``: ``.NAME.lock`` in the same directory."""
-    d, base = os.path.split(os.path.abspath(path))
-    return os.path.join(d, f".{base}.lock")
+    """The lock file of output ``path``: ``.NAME.lock`` in the same directory (:func:`_side`)."""
+    d = os.path.dirname(os.path.abspath(path))
+    return os.path.join(d, f"{_side(path)}.lock")
 
 
 _held: dict[str, list] = {}  # realpath of the output -> [fd, depth, thread] (locks held by this process)
@@ -270,9 +301,9 @@ _held_guard = threading.Lock()
 
 
 def _remove_stale_parts(path: str) -> None:
-    d, base = os.path.split(os.path.abspath(path))
-    for part in glob.glob(os.path.join(glob.escape(d), f".{glob.escape(base)}.*.part")) + \
-            glob.glob(os.path.join(glob.escape(d), f".{glob.escape(base)}.*.probe")):
+    d, stem = os.path.dirname(os.path.abspath(path)), _side(path)
+    for part in glob.glob(os.path.join(glob.escape(d), f"{glob.escape(stem)}.*.part")) + \
+            glob.glob(os.path.join(glob.escape(d), f"{glob.escape(stem)}.*.probe")):
         with contextlib.suppress(OSError):
             os.unlink(part)
 
@@ -385,7 +416,7 @@ def write_atomic(path, write, *, name: str = "output", overwrite: bool = True, d
                                path=os.fspath(path), dataset=dataset) from None
     d = os.path.dirname(os.path.abspath(p))
     with locked(p, name=name):
-        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
+        fd, tmp = tempfile.mkstemp(prefix=f"{_side(p)}.", suffix=".part", dir=d)
         os.close(fd)
         try:
             write(tmp)
