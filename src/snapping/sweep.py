@@ -581,6 +581,18 @@ def _same(a, b) -> bool:
     return bool(np.all(a == b))
 
 
+def _problem_key(text) -> str:
+    """A run's problem description (its ``problem`` attribute) without what a grid varies (the
+    number of links, chi): what must agree between the runs of one combined sweep."""
+    try:
+        d = json.loads(str(text))
+        d.get("chain", {}).pop("N", None)
+        d.get("start", {}).pop("chi", None)
+        return json.dumps(d, sort_keys=True)
+    except (ValueError, AttributeError):
+        return str(text)
+
+
 def _run_piece(item, i: int):
     """(name, run Dataset) of one entry of :func:`combine`: a run file or a run Dataset,
     checked to be a completed run of the paper's problem (SnappingInputError if not)."""
@@ -639,6 +651,8 @@ def combine(paths) -> "xr.Dataset":
         keys = COMBINE_SAME_INPUTS + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
+        if "problem" in ds.attrs:  # a general problem's chain, held end and gravity: compared and kept too
+            inputs[-1]["problem"] = _problem_key(ds.attrs["problem"])
         names.append(name)
         chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
         summary = {
@@ -653,7 +667,7 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.expand_dims(chi=[chi], N=[N])
         ds.attrs = {}
         pieces.append(ds)
-    for k in COMBINE_SAME_INPUTS + ("dt0",):  # the method first: it decides whether dt0 is compared
+    for k in COMBINE_SAME_INPUTS + ("dt0", "problem"):  # the method first: it decides whether dt0 is compared
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue
