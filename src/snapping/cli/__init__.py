@@ -118,6 +118,18 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:  # (numpy/scipy warnings: held until the outcome)
+        status = _run(parser, args)
+    if status == 0:  # a warning of a command that worked is shown after its output; an error says it all
+        for w in caught:
+            print(warnings.formatwarning(w.message, w.category, w.filename, w.lineno).rstrip(), file=sys.stderr)
+    return status
+
+
+def _run(parser, args) -> int:
+    """``args.func(args)``, every exception mapped to one line on stderr and an exit status."""
     try:
         return int(args.func(args) or 0)
     except ValueError as exc:  # SnappingInputError and friends: one line, exit 2
