@@ -53,7 +53,8 @@ import threading
 
 from . import _validate as V
 
-__all__ = ["check_output", "check_output_dir", "output_dir", "check_own_files", "is_snapping_file", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
+__all__ = ["check_output", "check_output_dir", "output_dir", "check_own_files", "is_foreign_netcdf",
+           "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
            "OutputBusyError", "lock_path", "describe_kind", "figure_format"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
@@ -237,33 +238,35 @@ def output_dir(path, *, name: str = "output"):
         raise
 
 
-def is_snapping_file(path) -> bool:
-    """Whether ``path`` is a netCDF file that snapping wrote (global attributes ``snapping_version``
-    and ``status``, or ``snapping_version`` and a convergence study's ``grading``)."""
+def is_foreign_netcdf(path) -> bool:
+    """Whether ``path`` is a readable netCDF file that snapping did not write (none of the global
+    attributes of a run, a combined sweep or a convergence study). An unreadable file (a run
+    whose worker died while writing it) is not foreign: its own writer may replace it."""
     try:
         import netCDF4
 
         with netCDF4.Dataset(path) as nc:
             names = set(nc.ncattrs())
-    except Exception:  # noqa: BLE001 - unreadable: not ours
+    except Exception:  # noqa: BLE001 - not a readable netCDF file
         return False
-    return ("status" in names and "snapping_version" in names) or "sweep_grid" in names or \
+    ours = ("status" in names and "snapping_version" in names) or "sweep_grid" in names or \
         ("grading" in names and "ratio" in names)
+    return not ours
 
 
 def check_own_files(paths, *, name: str = "output", overwrite: bool = False) -> None:
     """Refuse, before any work, to replace a file at any of ``paths`` (the files a sweep or a
-    convergence study writes into its directory) that snapping did not write: another
-    program's file named like a run is never replaced without ``overwrite``."""
+    convergence study writes into its directory) that is another program's netCDF file
+    (:func:`is_foreign_netcdf`): it is never replaced without ``overwrite``."""
     for path in paths:
         p = os.fspath(path)
         if not os.path.lexists(p):
             continue
         check_output(p, name=name, overwrite=True)  # a regular file (not a directory, device, ...)
-        if not overwrite and not is_snapping_file(p):
-            raise V.SnappingInputError(f"{name}={p!r} exists and is not a snapping run file (another program's "
-                                       f"file, or damaged): it is not replaced; move it away, or pass "
-                                       f"overwrite=True (--overwrite) to replace it")
+        if not overwrite and is_foreign_netcdf(p):
+            raise V.SnappingInputError(f"{name}={p!r} exists and is another program's netCDF file (not a snapping "
+                                       f"run): it is not replaced; move it away, or pass overwrite=True "
+                                       f"(--overwrite) to replace it")
 
 
 # ------------------------------------------------------------------------------- locks
