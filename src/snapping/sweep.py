@@ -476,7 +476,7 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
                                    "the script)")
     from ._files import output_dir
 
-    if not isinstance(grid, Grid):  # (every input checked before the directory is made)
+    if not all(hasattr(grid, a) for a in ("points", "path", "paths", "options")):  # (checked before the directory)
         raise V.SnappingInputError(f"grid={V._short(grid)} is not a snapping.sweep.Grid (use Grid(chi=[...], "
                                    f"N=[...], options={{...}}))")
     if workers is not None:
