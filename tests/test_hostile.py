@@ -9,6 +9,7 @@ existed before is changed (its bytes are compared before and after).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +46,15 @@ def files(tmp_path_factory) -> dict[str, str]:
     except simulate.SimulationError:
         pass
     (d / "a_directory").mkdir()
+    # #25: a text row in the middle of a shape (not a header), a third column
+    (d / "shape_text_row.csv").write_text("x,y\n0,0\nabc,def\n0.1,0.1\n0.2,0.3\n0.3,0.5\n0.6,0.9\n")
+    (d / "shape_three_columns.csv").write_text("0,0,9\n0.1,0.1,9\n0.2,0.3,9\n0.3,0.5,9\n0.6,0.9,9\n")
+    # #25: two completed runs of different problems (tip masses): not one sweep
+    from snapping.simulate.problem import Links, Problem
+
+    for tip, N in ((0.2, 6), (0.3, 8)):
+        simulate.run(Problem.catenary(0.5, links=Links.uniform(N, tip_mass=tip)), t_end=0.01,
+                     output=d / f"tip{tip:g}.nc")
     out = {p.stem: str(p) for p in d.iterdir()}
     out["missing"] = str(d / "missing.nc")
     out["dir"] = out.pop("a_directory")
@@ -56,7 +66,8 @@ def files(tmp_path_factory) -> dict[str, str]:
 
 
 def _snapshot(root) -> dict[str, bytes]:
-    return {str(p): p.read_bytes() for p in Path(root).rglob("*") if p.is_file()}
+    """Every file's bytes and every directory (a refused command leaves no new empty directory)."""
+    return {str(p): p.read_bytes() if p.is_file() else b"<dir>" for p in Path(root).rglob("*")}
 
 
 @pytest.fixture
@@ -247,7 +258,55 @@ def _py_cases():
     add("reproduce(mode='x')", lambda F: reproduce(F["root"] + "/rep", "x", progress=False))
     add("reproduce(out=file)", lambda F: reproduce(F["garbage"], "quick", progress=False))
     add("reproduce(workers=0)", lambda F: reproduce(F["root"] + "/rep", "quick", workers=0, progress=False))
+    _py_cases_25(add)
     return c
+
+
+def _py_cases_25(add):
+    """#25 section 3: public functions without type checks, objects built directly, values
+    accepted silently, and the checks that came after the work."""
+    from snapping import animation, design, table, units
+    from snapping.simulate.problem import Links, PinMotion, Problem
+
+    # public functions without type checks (a path, None, a sweep or another program's Dataset)
+    for what, ds in (("path", lambda F: F["completed"]), ("None", lambda F: None),
+                     ("sweep", lambda F: S.combine([F["completed"]])),
+                     ("foreign", lambda F: xr.open_dataset(F["foreign"]).load())):
+        add(f"animate({what})", lambda F, ds=ds: animation.animate(ds(F), F["root"] + "/a.gif"))
+        add(f"summary({what})", lambda F, ds=ds: simulate.summary(ds(F)))
+    add("to_si(foreign)", lambda F: units.to_si(xr.open_dataset(F["foreign"]).load(), length=1.0, mass=1.0))
+    add("run_sweep('grid')", lambda F: S.run_sweep("grid", F["root"] + "/sw", progress=False))
+    add("Links.from_density(returns a list)", lambda F: Links.from_density([0.5, 0.5], lambda s: [1.0, 2.0]))
+    add("load_table(garbage)", lambda F: table.load_table(F["garbage"]))
+    add("load_table(hdf5_header)", lambda F: table.load_table(F["hdf5_header"]))
+    # objects built directly are checked as their constructors check them
+    add("PinMotion('bogus')", lambda F: PinMotion("bogus"))
+    add("PinMotion('pull', (nan, 0))", lambda F: PinMotion("pull", (NAN, 0.0)))
+    add("PinMotion('flick') without a period", lambda F: PinMotion("flick", (1.0, 0.0)))
+    add("PinMotion('table') without samples", lambda F: PinMotion("table"))
+    add("Links(h 3, m 2)", lambda F: Links(np.full(3, 1 / 3), np.ones(2)))
+    add("Links(tip_mass=nan)", lambda F: Links(np.full(2, 0.5), np.ones(2), NAN))
+    add("Problem(x of 3 nodes)", lambda F: Problem(Problem.catenary(0.3, 4).links, np.zeros(3), np.zeros(5),
+                                                   np.zeros(5), np.zeros(5)))
+    # silently accepted before
+    add("Links.explicit([True, True])", lambda F: Links.explicit([True, True], [1.0, 1.0]))
+    add("Links.explicit(m=[True, True])", lambda F: Links.explicit([0.5, 0.5], [True, False]))
+    add("PinMotion.from_table(x=1e300)", lambda F: PinMotion.from_table([0, 1, 2, 3], [0, 1e300, 0, 0], [0, 0, 0, 0]))
+    add("table values(links=100.5)", lambda F: table.load_table().values("v_peak", 0.3, 100.5))
+    add("table values(broadcast)", lambda F: table.load_table().values("v_peak", [0.3, 0.4], [100, 200, 300]))
+    add("table values(chi='abc')", lambda F: table.load_table().values("v_peak", "abc", 100))
+    add("computed_estimate(max_seconds=-1)", lambda F: design.computed_estimate(estimates.Chain(), chi=0.3, links=100,
+                                                                               max_seconds=-1.0))
+    add("run_instead(max_seconds=-1)", lambda F: design.run_instead(0.3, 100, 0.0, {}, max_seconds=-1.0))
+    add("combine(runs of different problems)", lambda F: S.combine([F["tip0.2"], F["tip0.3"]]))
+    add("run(snapshot_times after t_end)", lambda F: simulate.run(0.3, 6, t_end=0.01, snapshot_times=[0.5]))
+    # errors that blamed the wrong thing (the message must name the culprit: checked in test_25_names)
+    add("Links.taper(h=1e-300)", lambda F: Links.taper(2, 0.5, h=[1e-300, 1.0]))
+    add("Problem.nodes(vx nan)", lambda F: Problem.nodes([1.0, 0.5, 0.0], [0.0, 0.0, 0.0],
+                                                         vx=[0.0, NAN, 0.0]))
+    # hangs: no bound
+    add("dense_snapshot_times(n=10**9)", lambda F: animation.dense_snapshot_times(1.0, n=10**9))
+    add("converge(chi=1e-100)", lambda F: __import__("snapping.continuum").continuum.converge(1e-100))
 
 
 PY_CASES = _py_cases()
@@ -365,6 +424,19 @@ def _cli_cases():
     add("reproduce", "-o", "{proc}")
     add("reproduce", "-o", "{root}/rep", "--workers", "0")
     add("nosuchcommand")
+    # #25 section 3: silently accepted or dropped before
+    add("simulate", "--shape", "{shape_text_row}", "--N", "4", "--method", "fast", "--t-end", "0.01")
+    add("simulate", "--shape", "{shape_three_columns}", "--N", "4", "--method", "fast", "--t-end", "0.01")
+    add("simulate", "--supports", "0.4,0.2", "--N", "6", "--chords", "arclength", "--t-end", "0.01")
+    add("simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.01", "--snapshot-times", "0.5", "-o", "{root}/new.nc")
+    add("design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--plot", "")
+    for v in ("1e308", "5e-324", "0"):
+        add("animate", "{completed}", "-o", "{root}/a.gif", "--fps", v)
+    add("converge", "--chi", "1e-100", "-o", "{root}/conv")
+    # a refused sweep or converge leaves no new -o directory (the untouched check sees directories)
+    add("sweep", "--chi", "0.3", "--N", "10", "--workers", "0", "-o", "{root}/new/sw")
+    add("sweep", "--chi", "0.3,0.4", "--N", "10", "--method", "fast", "--ensemble", "0", "-o", "{root}/sw")
+    add("converge", "--chi", "0.3", "--workers", "0", "-o", "{root}/conv")
     return c
 
 
@@ -389,3 +461,222 @@ def test_catalogue_size():
     n = len(PY_CASES) + len(CLI_CASES)
     print(f"hostile inputs: {len(PY_CASES)} Python calls + {len(CLI_CASES)} command lines = {n}")
     assert n >= 300
+
+
+# ------------------------------------------------------------------ #25 section 3: behaviours
+# (the refusals of #25 are in the catalogues above: _py_cases_25 and the end of _cli_cases)
+def _cli(argv, capsys):
+    try:
+        status = main([str(a) for a in argv])
+    except SystemExit as exc:
+        status = exc.code
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def _interrupted_checkpoint(path, **kw):
+    """A run stopped (as by SIGINT) at its second chunk and saved as a checkpoint at ``path``."""
+    import signal
+
+    from snapping.simulate import driver
+
+    calls = [0]
+
+    def stop(eng):
+        calls[0] += 1
+        return int(signal.SIGINT) if calls[0] == 2 else None
+
+    driver._chunk_hook = stop
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            simulate.run(output=path, **kw)
+    finally:
+        driver._chunk_hook = None
+    return path
+
+
+def test_25_resume_of_a_run_that_then_fails_reports_it(tmp_path, monkeypatch, capsys):
+    """Tracebacks: a resumed run that fails numerically printed a TypeError (its chi was None)."""
+    with pytest.raises(simulate.SimulationError) as info:
+        simulate.run(0.5, 10, method="euler-richardson-fixed", dt0=0.05, max_link_error=1e-3)
+    failure = info.value
+
+    def failing_resume(*a, **k):
+        raise failure
+
+    monkeypatch.setattr(simulate, "resume", failing_resume)
+    ck = tmp_path / "ck.nc"
+    ck.write_bytes(b"")  # (never read: the resume is the failing one above)
+    status, out, err = _cli(["simulate", "--resume", ck], capsys)
+    assert status == 1 and "Traceback" not in err, err
+    assert err.strip().splitlines() == [err.strip()] and "error" in err, err
+    assert "N=10" in out  # the stored run's summary, titled with its N
+
+
+def test_25_worker_that_cannot_start_gives_its_reason_not_a_traceback(tmp_path, monkeypatch, capfd):
+    """Tracebacks: workers that cannot import what they run printed multiprocessing tracebacks
+    before the failure table; now the failure says why, and nothing else is printed."""
+    import multiprocessing.spawn as spawn
+    import sys
+
+    from snapping import _workers
+
+    mod = tmp_path / "only_here"
+    mod.mkdir()
+    (mod / "snapping_test_only_here.py").write_text("def f(x):\n    return x\n")
+    monkeypatch.syspath_prepend(str(mod))
+    import snapping_test_only_here as only
+
+    prep = spawn.get_preparation_data
+
+    def without(name):  # the workers do not see the module's directory
+        d = prep(name)
+        d["sys_path"] = [p for p in d["sys_path"] if p != str(mod)]
+        return d
+
+    monkeypatch.setattr(spawn, "get_preparation_data", without)
+    got = []
+
+    def collect(args, result):
+        try:
+            got.append(result())
+        except Exception as exc:  # noqa: BLE001
+            got.append(str(exc))
+
+    _workers.run_all(1, only.f, [(1,)], collect)
+    sys.modules.pop("snapping_test_only_here", None)
+    out, err = capfd.readouterr()
+    assert "Traceback" not in err and "Traceback" not in out, err
+    assert len(got) == 1 and "could not run" in got[0] and "snapping_test_only_here" in got[0], got
+
+
+def test_25_messages_name_the_culprit(files, tmp_path, capsys):
+    """Unclear: errors that blamed the wrong thing."""
+    from snapping.simulate.problem import Links, PinMotion, Problem
+
+    with pytest.raises(SnappingInputError, match=r"^h\[0\]=1e-300"):  # not a node mass
+        Links.taper(2, 0.5, h=[1e-300, 1.0])
+    with pytest.raises(SnappingInputError, match=r"vx\[1\]=nan is not finite"):  # not "11 numbers; got 11"
+        Problem.nodes([1.0, 0.5, 0.0], [0.0, 0.0, 0.0], vx=[0.0, NAN, 0.0])
+    with pytest.raises(SnappingInputError, match="accel"):  # not 101 rejected steps
+        Problem.catenary(0.3, 6, pin=PinMotion("pull", (NAN, 0.0)))
+    status, out, err = _cli(["animate", files["completed"], "-o", tmp_path / "a.gif", "--fps", "5e-324"], capsys)
+    assert status == 2 and "--fps" in err and "output" not in err.split("--fps")[0], err  # not an output failure
+
+
+def test_25_long_and_undecodable_output_names_are_written(tmp_path):
+    """Unclear: valid names of 240-255 bytes were refused (the lock and temporary names added
+    16 bytes); an undecodable name failed after the run. Both are written, nothing left beside."""
+    names = ["a" * 237 + ".nc", "b" * 252 + ".nc", os.fsdecode(b"bad\xff.nc")]
+    for name in names:
+        simulate.run(0.5, 6, t_end=0.01, output=tmp_path / name)
+    assert sorted(os.listdir(tmp_path)) == sorted(names)
+    with pytest.raises(SnappingInputError, match="256 bytes"):
+        simulate.run(0.5, 6, t_end=0.01, output=tmp_path / ("c" * 253 + ".nc"))
+
+
+def test_25_output_unwritable_mid_run_is_an_io_fault(tmp_path, capsys):
+    """Unclear: an output that stopped being writable during the run exited 2 (bad input), not 1
+    (an I/O fault). Here a directory takes the output's place while the run works (the same path
+    as a directory made read-only: the output's check at the end fails)."""
+    from snapping.simulate import driver
+
+    out = tmp_path / "run.nc"
+
+    def block(eng):
+        if not out.exists():
+            out.mkdir()
+
+    driver._chunk_hook = block
+    try:
+        status, _, err = _cli(["simulate", "--chi", "0.5", "--N", "12", "-o", out], capsys)
+    finally:
+        driver._chunk_hook = None
+    assert status == 1 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert out.is_dir() and not any(out.iterdir())
+
+
+def test_25_two_threads_cannot_write_one_output(tmp_path):
+    """Damage: two threads of one process writing one output both succeeded (the lock was
+    re-entrant per process); the second now gets OutputBusyError, and the holder re-enters."""
+    import threading
+
+    from snapping import _files
+
+    p = tmp_path / "run.nc"
+    held, release, seen = threading.Event(), threading.Event(), []
+
+    def holder():
+        with _files.locked(p):
+            with _files.locked(p):  # re-entrant in its own thread
+                held.set()
+                release.wait(10)
+
+    t = threading.Thread(target=holder)
+    t.start()
+    held.wait(10)
+    try:
+        with pytest.raises(_files.OutputBusyError, match="another thread"):
+            with _files.locked(p):
+                seen.append("both")
+    finally:
+        release.set()
+        t.join()
+    assert not seen
+    with _files.locked(p):  # released: free again
+        pass
+
+
+def test_25_foreign_files_named_like_runs_or_levels_are_kept(tmp_path, capsys):
+    """Damage: another program's netCDF named like a run of a sweep, or a level of converge, was
+    replaced without --overwrite."""
+    for argv, name in ((["sweep", "--chi", "0.3", "--N", "10", "-o", tmp_path / "sw"], "run_chi0.3_N10.nc"),
+                       (["converge", "--chi", "0.3", "-o", tmp_path / "cv"], "level1.nc")):
+        d = Path(argv[-1])
+        d.mkdir()
+        xr.Dataset({"temperature": ("time", [280.0, 281.5])}).to_netcdf(d / name)
+        before = _snapshot(d)
+        status, _, err = _cli(argv, capsys)
+        assert status == 2 and name in err and "--overwrite" in err, err
+        assert _snapshot(d) == before
+
+
+def test_25_resume_refuses_inputs_edited_and_resealed(tmp_path):
+    """Silently accepted: a checkpoint whose attributes were edited and sealed again continued
+    the stored dynamics under the new label; the stored inputs must give the stored start."""
+    from snapping.simulate.dataset import load_run, save, seal
+
+    ck = _interrupted_checkpoint(tmp_path / "ck.nc", chi=0.3, N=20, method="euler-richardson",
+                                 chords="arclength", tol=1e-6)
+    ds = load_run(ck)
+    edited = ds.copy()
+    edited.attrs["chi"] = 0.5
+    save(seal(edited), tmp_path / "edited.nc")
+    with pytest.raises(SnappingInputError, match="attributes were changed"):
+        simulate.resume(tmp_path / "edited.nc")
+    assert simulate.resume(ck).dataset.attrs["status"] == "completed"  # the honest file continues
+
+
+def test_25_warnings_are_held_until_the_outcome(monkeypatch, capsys):
+    """Unclear: numpy/scipy warnings were printed before our error. A refused command prints
+    its one line only; one that works shows its warnings after its output."""
+    import warnings
+
+    from snapping.cli import estimate as cli_estimate
+
+    def refused(args):
+        warnings.warn("overflow encountered in a library", RuntimeWarning)
+        raise SnappingInputError("--chi=2.0 is out of range")
+
+    monkeypatch.setattr(cli_estimate, "_cmd_estimate", refused)
+    status, _, err = _cli(["estimate", "--chi", "2"], capsys)
+    assert status == 2 and err.strip().splitlines() == ["snapping estimate: error: --chi=2.0 is out of range"], err
+
+    def works(args):
+        warnings.warn("a library's note", UserWarning)
+        print("answer")
+        return 0
+
+    monkeypatch.setattr(cli_estimate, "_cmd_estimate", works)
+    status, out, err = _cli(["estimate", "--chi", "0.3"], capsys)
+    assert status == 0 and out.strip() == "answer" and "a library's note" in err

@@ -34,7 +34,7 @@ from contextlib import contextmanager
 import numpy as np
 import pytest
 
-from snapping import SnappingInputError, continuum, design, estimates, ideal, scaling, shape_estimates, simulate, table
+from snapping import SnappingInputError, animation, continuum, design, estimates, ideal, scaling, shape_estimates, simulate, table
 from snapping.cli import main
 from snapping.simulate.problem import Links, PinMotion, Problem
 
@@ -263,7 +263,7 @@ SPECS = {
                       ["x", "y", "vx", "vy"]),
     "Problem.run": (_problem_run, {}, ["gravity"], []),
     # simulate.run and friends
-    "simulate.run": (_sim, {}, ["chi", "N", "tol", "dt0", "t_end", "stop_fraction", "t_end_max", "record_thin",
+    "simulate.run": (_sim, {"snapshot_times": [0.0, 5e-4, 1e-3]}, ["chi", "N", "tol", "dt0", "t_end", "stop_fraction", "t_end_max", "record_thin",
                                 "max_link_error", "max_energy_drift", "dt_min", "max_rejections", "checkpoint_every"],
                      ["snapshot_times"]),
     "simulate.run(fixed)": (_fixed, {}, ["dt0", "t_end"], []),
@@ -275,6 +275,14 @@ SPECS = {
     "simulate.initial_state": (lambda F, **k: simulate.initial_state(**k), {"chi": 0.3, "N": 10}, ["chi", "N"], []),
     "simulate.node_arclength": (lambda F, **k: simulate.node_arclength(**k), {"N": 10}, ["N"], []),
     "simulate.link_arclength": (lambda F, **k: simulate.link_arclength(**k), {"N": 10}, ["N"], []),
+    # #25: the animation's inputs, the design's run budget
+    "animation.dense_snapshot_times": (lambda F, **k: animation.dense_snapshot_times(**k), {"t_snap": 1.0},
+                                       ["t_snap", "n", "tau_min"], []),
+    "animation.animate": (lambda F, **k: animation.animate(F["ds"], F["root"] + "/anim.gif", **k), {},
+                          ["fps", "max_frames"], []),
+    "design.computed_estimate": (lambda F, **k: design.computed_estimate(estimates.Chain(length=2.0, mass=0.05),
+                                                                         chi=0.3, links=100, **k), {},
+                                 ["max_seconds"], []),
     "simulate.integrate_fixed": (lambda F, **k: simulate.integrate_fixed(simulate.initial_state(0.3, 10), **k),
                                  {"dt": 1e-4, "n_steps": 3}, ["dt", "n_steps"], []),
 }
@@ -341,7 +349,7 @@ VALID = {
     "Problem.run": {"gravity=zero", "gravity=tiny"},
     "simulate.run": {"dt0=none", "max_energy_drift=none", "checkpoint_every=none", "checkpoint_every=zero",
                      "checkpoint_every=tiny", "checkpoint_every=huge", "max_rejections=zero",
-                     "snapshot_times=zero", "snapshot_times=tiny", "snapshot_times=huge", "snapshot_times=empty",
+                     "snapshot_times=zero", "snapshot_times=tiny", "snapshot_times=empty",
                      "snapshot_times=none", "record_thin=zero", "record_thin=tiny", "stop_fraction=tiny",
                      "max_link_error=tiny", "max_energy_drift=huge", "dt_min=tiny",
                      "tol=none"},  # (tol=None: the method's default tolerance)
@@ -351,6 +359,10 @@ VALID = {
     "simulate.memory_need": {"chi=none", "dt0=none", "t_end=none", "dt0=tiny", "dt0=huge", "t_end=tiny", "t_end=huge",
                              "t_end_max=tiny", "t_end_max=huge"},
 }
+VALID.update({
+    "animation.dense_snapshot_times": {"t_snap=tiny", "t_snap=huge", "tau_min=tiny"},
+    "design.computed_estimate": {"max_seconds=zero", "max_seconds=tiny", "max_seconds=huge"},
+})
 #: a bound that cannot be met: the run fails by design (a one-line SimulationError)
 FAILS = {"simulate.run": {"max_energy_drift=tiny"}}
 
@@ -362,6 +374,7 @@ NOT_RUN = {
     "simulate.run(fixed)": {"t_end=none"},
     "simulate.run(fast)": {"t_end=none"},
     "simulate.run_ensemble": {"t_end=none"},
+    "animation.animate": {"max_frames=none"},  # (all the snapshots: a whole animation)
 }
 
 #: the message must name this parameter instead (the user's name for an input passed inside another)
@@ -471,6 +484,7 @@ CLI_SPECS = {
     "converge": (["converge", "--chi", "0.3", "-o", "{root}/converge"], ["--chi", "--levels", "--ratio", "--first",
                                                                           "--tol", "--workers"]),
     "reproduce": (["reproduce", "-o", "{root}/reproduce"], ["--workers"]),
+    "animate": (["animate", "{run_nc}", "-o", "{root}/anim.gif"], ["--fps", "--max-frames"]),
 }
 
 #: (command, option, value) that are legitimately valid: exit 0 and a finite JSON answer

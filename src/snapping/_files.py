@@ -53,7 +53,8 @@ import threading
 
 from . import _validate as V
 
-__all__ = ["check_output", "check_output_dir", "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
+__all__ = ["check_output", "check_output_dir", "output_dir", "check_own_files", "is_foreign_netcdf",
+           "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
            "OutputBusyError", "lock_path", "describe_kind", "figure_format"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
@@ -132,6 +133,14 @@ def check_output(path, *, name: str = "output", overwrite: bool = False, need_by
         what = "is not a directory" if os.path.exists(parent) else "does not exist"
         raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} {what}")
     try:
+        parent.encode("utf-8")
+    except UnicodeEncodeError:  # (checked before the work: the file is written in this directory)
+        raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} has a name that is not valid "
+                                   f"UTF-8: files cannot be written there (netCDF takes UTF-8 paths)") from None
+    if len(os.fsencode(os.path.basename(p))) > 255:
+        raise V.SnappingInputError(f"{name}={given!r}: the file name is {len(os.fsencode(os.path.basename(p)))} "
+                                   f"bytes long; at most 255")
+    try:
         st = os.stat(p)
     except FileNotFoundError:
         st = None
@@ -149,7 +158,7 @@ def check_output(path, *, name: str = "output", overwrite: bool = False, need_by
     if not os.access(parent, os.W_OK | os.X_OK):
         raise V.SnappingInputError(f"{name}={given!r}{via}: directory {parent!r} is not writable (permission denied)")
     try:  # the file is written next to itself and renamed: the directory must take a new file
-        fd, probe = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".probe", dir=parent)
+        fd, probe = tempfile.mkstemp(prefix=f"{_side(p)}.", suffix=".probe", dir=parent)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
@@ -207,21 +216,97 @@ def check_output_dir(path, *, name: str = "output") -> str:
     return p
 
 
+@contextlib.contextmanager
+def output_dir(path, *, name: str = "output"):
+    """:func:`check_output_dir` for the duration of a piece of work: the directories it makes are
+    removed again (when still empty) if the work is refused or fails, so that a refused sweep or
+    convergence study leaves nothing behind (no new empty ``-o`` directory)."""
+    p = V.file_path(name, path)
+    made, d = [], os.path.abspath(p)
+    while not os.path.lexists(d) and d != os.path.dirname(d):
+        made.append(d)
+        d = os.path.dirname(d)
+    out = check_output_dir(p, name=name)
+    try:
+        yield out
+    except BaseException:
+        for d in made:  # deepest first
+            try:
+                os.rmdir(d)
+            except OSError:
+                break
+        raise
+
+
+def is_foreign_netcdf(path) -> bool:
+    """Whether ``path`` is a readable netCDF file that snapping did not write (none of the global
+    attributes of a run, a combined sweep or a convergence study). An unreadable file (a run
+    whose worker died while writing it) is not foreign: its own writer may replace it."""
+    try:
+        import netCDF4
+
+        with netCDF4.Dataset(path) as nc:
+            names = set(nc.ncattrs())
+    except Exception:  # noqa: BLE001 - not a readable netCDF file
+        return False
+    ours = ("status" in names and "snapping_version" in names) or "sweep_grid" in names or \
+        ("grading" in names and "ratio" in names)
+    return not ours
+
+
+def check_own_files(paths, *, name: str = "output", overwrite: bool = False) -> None:
+    """Refuse, before any work, to replace a file at any of ``paths`` (the files a sweep or a
+    convergence study writes into its directory) that is another program's netCDF file
+    (:func:`is_foreign_netcdf`): it is never replaced without ``overwrite``."""
+    for path in paths:
+        p = os.fspath(path)
+        if not os.path.lexists(p):
+            continue
+        check_output(p, name=name, overwrite=True)  # a regular file (not a directory, device, ...)
+        if not overwrite and is_foreign_netcdf(p):
+            raise V.SnappingInputError(f"{name}={p!r} exists and is another program's netCDF file (not a snapping "
+                                       f"run): it is not replaced; move it away, or pass overwrite=True "
+                                       f"(--overwrite) to replace it")
+
+
 # ------------------------------------------------------------------------------- locks
+#: longest base name (bytes) whose side files (lock, temporary, probe) are named after it in full
+_SIDE_NAME_MAX = 200
+
+
+def _side(path) -> str:
+    """The stem of the hidden side files of output ``path`` (lock, temporary, probe): ``.NAME``; for a
+    name too long to take their suffixes (any valid name, up to 255 bytes, is accepted) or one that is
+    not UTF-8 (netCDF writes only UTF-8 paths), a shortened UTF-8 name and a hash of the full one."""
+    base = os.path.basename(os.path.abspath(os.fspath(path)))
+    raw = os.fsencode(base)
+    try:
+        base.encode("utf-8")
+        ok = len(raw) <= _SIDE_NAME_MAX
+    except UnicodeEncodeError:
+        ok = False
+    if ok:
+        return f".{base}"
+    import hashlib
+
+    short = raw[:120].decode("utf-8", errors="ignore").encode("ascii", errors="ignore").decode()
+    return f".{short}~{hashlib.sha1(raw).hexdigest()[:16]}"
+
+
 def lock_path(path: str) -> str:
-    """The lock file of output ``path``: ``.NAME.lock`` in the same directory."""
-    d, base = os.path.split(os.path.abspath(path))
-    return os.path.join(d, f".{base}.lock")
+    """The lock file of output ``path``: ``.NAME.lock`` in the same directory (:func:`_side`)."""
+    d = os.path.dirname(os.path.abspath(path))
+    return os.path.join(d, f"{_side(path)}.lock")
 
 
-_held: dict[str, list] = {}  # realpath of the output -> [fd, depth] (locks held by this process)
+_held: dict[str, list] = {}  # realpath of the output -> [fd, depth, thread] (locks held by this process)
 _held_guard = threading.Lock()
 
 
 def _remove_stale_parts(path: str) -> None:
-    d, base = os.path.split(os.path.abspath(path))
-    for part in glob.glob(os.path.join(glob.escape(d), f".{glob.escape(base)}.*.part")) + \
-            glob.glob(os.path.join(glob.escape(d), f".{glob.escape(base)}.*.probe")):
+    d, stem = os.path.dirname(os.path.abspath(path)), _side(path)
+    for part in glob.glob(os.path.join(glob.escape(d), f"{glob.escape(stem)}.*.part")) + \
+            glob.glob(os.path.join(glob.escape(d), f"{glob.escape(stem)}.*.probe")):
         with contextlib.suppress(OSError):
             os.unlink(part)
 
@@ -265,7 +350,8 @@ def _acquire(path: str, name: str) -> int:
 
 @contextlib.contextmanager
 def locked(path, *, name: str = "output"):
-    """Hold the exclusive lock of output ``path`` (re-entrant in this process).
+    """Hold the exclusive lock of output ``path`` (re-entrant in the thread that holds it; another
+    thread of this process, like another process, gets :class:`OutputBusyError`).
 
     On taking it, temporary ``.NAME.*.part`` files that a killed writer left are removed.
     A second process gets :class:`OutputBusyError` naming the holder's PID.
@@ -281,10 +367,13 @@ def locked(path, *, name: str = "output"):
     p = os.path.realpath(_target(name, path))
     with _held_guard:
         entry = _held.get(p)
+        if entry is not None and entry[2] != threading.get_ident():  # (flock is per process: threads checked here)
+            raise OutputBusyError(f"{name}={os.fspath(path)!r} is being written by another thread of this process "
+                                  f"(PID {os.getpid()}): wait for it to finish, or choose another path")
         if entry is not None:
             entry[1] += 1
         else:
-            _held[p] = [_acquire(p, name), 1]
+            _held[p] = [_acquire(p, name), 1, threading.get_ident()]
             _remove_stale_parts(p)
     try:
         yield p
@@ -318,10 +407,19 @@ def write_atomic(path, write, *, name: str = "output", overwrite: bool = True, d
     umask). On any failure the temporary is removed and the previous file is untouched;
     a full disk raises :class:`OutputWriteError` saying so (carrying ``dataset``).
     """
-    p = check_output(path, name=name, overwrite=overwrite)
+    try:
+        p = check_output(path, name=name, overwrite=overwrite)
+    except V.SnappingInputError as exc:
+        held = os.path.realpath(_target(name, path)) in _held
+        if not held:
+            raise
+        # the output was checked before the work and is locked since: what changed (a directory made
+        # read-only, a file put in the way) is an I/O fault, not bad input
+        raise OutputWriteError(f"writing {name}={os.fspath(path)!r} failed: {exc}; nothing was replaced",
+                               path=os.fspath(path), dataset=dataset) from None
     d = os.path.dirname(os.path.abspath(p))
     with locked(p, name=name):
-        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(p)}.", suffix=".part", dir=d)
+        fd, tmp = tempfile.mkstemp(prefix=f"{_side(p)}.", suffix=".part", dir=d)
         os.close(fd)
         try:
             write(tmp)

@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer", "float_array", "file_path"]
+__all__ = ["SnappingInputError", "real", "positive", "open_interval", "integer", "float_array", "file_path",
+           "run_dataset", "nonnegative"]
 
 
 class SnappingInputError(ValueError):
@@ -91,6 +92,20 @@ def open_interval(name: str, value, lo: float, hi: float) -> float:
     return x
 
 
+def nonnegative(name: str, value) -> float:
+    """Return ``value`` as a float in [0, inf), or raise naming ``name``.
+
+    >>> nonnegative("max_seconds", -1)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: max_seconds=-1.0 is out of range: must be >= 0
+    """
+    x = _as_float(name, value)
+    if not x >= 0.0:
+        raise SnappingInputError(f"{name}={x!r} is out of range: must be >= 0")
+    return abs(x)  # (-0.0 is 0)
+
+
 #: the largest integer accepted when no maximum is given (a count beyond it cannot be meant)
 MAX_INTEGER = 2**53
 
@@ -148,8 +163,12 @@ def float_array(name: str, value):
     if isinstance(value, (str, bytes, dict)):
         raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers")
     try:
+        if np.asarray(value).dtype.kind == "b":  # True/False are not numbers here (as in real)
+            raise SnappingInputError(f"{name}={_short(value)} holds True/False: expected real numbers")
         return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, SnappingInputError):
+            raise
         raise SnappingInputError(f"{name}={_short(value)} is not an array of real numbers") from None
     except OverflowError:  # an integer beyond the doubles (10**400)
         raise SnappingInputError(f"{name}={_short(value)} holds a number too large for a float (|x| < 1.8e308)") \
@@ -200,3 +219,38 @@ def si_scales(length, mass, g) -> tuple[float, float, float]:
                                      f"(beyond, the SI values leave the doubles)")
         out.append(x)
     return tuple(out)
+
+
+def run_dataset(name: str, ds, *, sweep: bool = False):
+    """``ds`` if it is a snapping run Dataset (with ``sweep=True``: or a combined sweep of runs,
+    over ``chi`` and ``N``); else SnappingInputError saying what it is instead: not a Dataset
+    (a path: open it with ``snapping.simulate.load_run``), another program's Dataset (no time
+    ``t`` along ``step`` or no attributes ``method`` and ``N``), or a sweep where one run is
+    expected. One check for every public function that takes a run.
+
+    >>> run_dataset("ds", "run.nc")
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: ds='run.nc' is a path, not a run Dataset: open it with snapping.simulate.load_run
+    """
+    import os
+
+    import xarray as xr
+
+    if isinstance(ds, (str, bytes, os.PathLike)):
+        raise SnappingInputError(f"{name}={_short(ds)} is a path, not a run Dataset: open it with "
+                                 f"snapping.simulate.load_run")
+    if not isinstance(ds, xr.Dataset):
+        raise SnappingInputError(f"{name}={_short(ds) if ds is None else type(ds).__name__} is not a run Dataset "
+                                 f"(expected an xarray.Dataset from snapping.simulate)")
+    is_sweep = "chi" in ds.dims and "N" in ds.dims
+    if is_sweep and not sweep:
+        raise SnappingInputError(f"{name} is a combined sweep (dimensions chi={ds.sizes['chi']}, N={ds.sizes['N']}), "
+                                 f"not one run: give one run (its file, opened with snapping.simulate.load_run)")
+    if is_sweep:
+        return ds
+    has_t = "t" in ds.variables and "step" in ds["t"].dims
+    if not has_t or "method" not in ds.attrs or "N" not in ds.attrs:
+        raise SnappingInputError(f"{name} is not a snapping run Dataset (no time 't' along 'step' or no attributes "
+                                 f"'method' and 'N'; variables: {sorted(map(str, ds.variables))[:6]})")
+    return ds

@@ -97,14 +97,61 @@ def run_all(n: int, fn, calls, collect) -> None:
     finishes (``result()`` returns its value or raises its exception). An interruption
     (SIGINT) or an exception in ``collect`` stops the pool (:func:`stop_pool`: nothing
     queued starts, runs in progress save their checkpoints) and propagates."""
+    import sys
+    import tempfile
+
     pool, stop = local_pool(n)
     futures = {}
+    # the workers' stderr goes to a file: a worker that cannot start (e.g. cannot import snapping)
+    # prints a multiprocessing traceback there, and its last line becomes the failure's reason
+    err = tempfile.TemporaryFile()
     try:
-        futures = {pool.submit(fn, *args): args for args in calls}
+        with _stderr_to(err):  # (the workers are spawned by the first submit, and inherit it)
+            futures = {pool.submit(fn, *args): args for args in calls}
         for fut in as_completed(futures):
-            collect(futures[fut], fut.result)
+            collect(futures[fut], lambda fut=fut: _result(fut, err))
     except BaseException:
         stop_pool(stop, futures)
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+        text = _read(err)
+        err.close()
+        if text and "Traceback" not in text:  # what a working worker printed (warnings): passed on
+            sys.stderr.write(text)
+
+
+def _stderr_to(fh):
+    import contextlib
+    import sys
+
+    @contextlib.contextmanager
+    def redirect():
+        sys.stderr.flush()
+        saved = os.dup(2)
+        try:
+            os.dup2(fh.fileno(), 2)
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+    return redirect()
+
+
+def _read(err) -> str:
+    """What the workers wrote so far (pread: the offset they share with us is not moved)."""
+    return os.pread(err.fileno(), 1 << 20, 0).decode(errors="replace")
+
+
+def _result(fut, err):
+    """``fut.result()``; a dead pool's error says why its worker died, when the worker said it."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    try:
+        return fut.result()
+    except BrokenProcessPool as exc:
+        lines = [ln.strip() for ln in _read(err).splitlines() if ln.strip()]
+        if lines and "Traceback" in "".join(lines):
+            raise BrokenProcessPool(f"a worker process could not run: {lines[-1][:200]}") from exc
+        raise

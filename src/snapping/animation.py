@@ -41,6 +41,12 @@ __all__ = ["dense_snapshot_times", "frames_of", "animate", "DENSE_FRAMES", "SUFF
 #: Fewer snapshots than this up to the snap make a jerky animation: ``snapping animate`` says how to get more.
 DENSE_FRAMES = 24
 
+#: Most snapshot times of :func:`dense_snapshot_times` (each is a whole profile in the run file)
+MAX_TIMES = 100_000
+
+#: Frames per second accepted (a GIF frame lasts a whole number of milliseconds)
+FPS_RANGE = (0.01, 100.0)
+
 #: Output formats by suffix.
 SUFFIXES = (".gif", ".mp4")
 
@@ -68,7 +74,7 @@ def dense_snapshot_times(t_snap: float, n: int = 60, tau_min: float = 1e-4) -> l
         Increasing times, the first 0; the last is ``t_snap (1 - tau_min)``.
     """
     t_snap = V.positive("t_snap", t_snap)
-    n = V.integer("n", n, 2)
+    n = V.integer("n", n, 2, MAX_TIMES)
     if not (isinstance(tau_min, (int, float)) and 0.0 < tau_min < 1.0):
         raise V.SnappingInputError(f"tau_min={tau_min!r} must be in (0, 1)")
     tau = np.geomspace(1.0, tau_min, n) * t_snap
@@ -76,6 +82,7 @@ def dense_snapshot_times(t_snap: float, n: int = 60, tau_min: float = 1e-4) -> l
 
 
 def _check_run(ds, name: str = "run"):
+    V.run_dataset(name, ds)
     missing = [v for v in _NEEDED if v not in ds.variables]
     if missing:
         raise V.SnappingInputError(f"{name} has no profile snapshots (missing {missing}): nothing to animate")
@@ -258,6 +265,11 @@ def animate(ds, output, *, fps: float = 8.0, max_frames: int | None = None, over
     from . import _files
 
     fps = V.positive("fps", fps)
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+        raise V.SnappingInputError(f"fps={fps!r} is out of range: must lie in [{FPS_RANGE[0]:g}, {FPS_RANGE[1]:g}] "
+                                   f"frames per second")
+    _check_run(ds)
+    frames_of(ds, max_frames)  # (max_frames checked before any work)
     p = check_output(output, overwrite=overwrite)
     _check_run(ds)
     import matplotlib.pyplot as plt

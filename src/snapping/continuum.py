@@ -29,6 +29,7 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import time
@@ -198,7 +199,7 @@ def _level_row(ds, h, cpu_time) -> dict:
 def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0, lumping: str = "shared",
              free_end: str | None = None, tol: float = 1e-7, output=None, workers: int = 1,
              progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
-             h_max0: float = H_MAX0) -> Convergence:
+             h_max0: float = H_MAX0, overwrite: bool = False) -> Convergence:
     """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
     peaks to the continuum (the string).
 
@@ -237,6 +238,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         Levels run in parallel in this many processes.
     progress : bool or None
         One line per finished level on stderr.
+    overwrite : bool
+        Replace files in ``output`` named like a level (or ``convergence.nc``) that snapping did
+        not write (default: refuse them before any run).
 
     Returns
     -------
@@ -257,44 +261,53 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     first = V.integer("first", first, -20, 100)
     params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)
     paths = [None] * len(params)
-    if output is not None:
-        from ._files import check_output_dir
-
-        out = check_output_dir(output, name="output")
-        paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
-    jobs = [(chi, p, lumping, free_end, tol, path) for p, path in zip(params, paths)]
     # check every level's chain before any runs (bad input raises here, nothing written)
     from .simulate import Links, grading
-    from .simulate.options import RunOptions
+    from .simulate.options import RunOptions, check_memory
 
-    RunOptions(tol=tol)
-    for p in params:
-        Links.graded(grading.fold_following(chi, **p), lumping=lumping, free_end=free_end)
-    t0 = time.perf_counter()
-    rows = [None] * len(jobs)
-    if workers == 1 or len(jobs) == 1:
-        for k, job in enumerate(jobs):
-            rows[k], _ = _run_level(job)
-            if progress:
-                print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} ({rows[k]['n_links']} links) done in "
-                      f"{rows[k]['wall_time']:.1f} s", file=sys.stderr, flush=True)
-    else:
-        from . import _workers
+    opts = RunOptions(tol=tol)
+    for k, p in enumerate(params):
+        h = grading.fold_following(chi, **p)
+        Links.graded(h, lumping=lumping, free_end=free_end)
+        try:  # (what simulate refuses: a level that would not fit in memory, e.g. at chi = 1e-100)
+            check_memory(h.size, opts, chi=chi, method="fast")
+        except V.SnappingInputError as exc:
+            raise V.SnappingInputError(f"chi={chi!r}: level {first + k} of the study cannot run: {exc}") from None
+    if not isinstance(overwrite, bool):
+        raise V.SnappingInputError(f"overwrite={overwrite!r} must be True or False")
+    from ._files import check_own_files, output_dir
 
-        def collect(args, result):
-            k = jobs.index(args[0])
-            rows[k], _ = result()
-            if progress:
-                print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} done", file=sys.stderr, flush=True)
+    with contextlib.ExitStack() as stack:  # a new -o directory is removed again if the study fails before a file
+        if output is not None:
+            out = stack.enter_context(output_dir(output, name="output"))
+            paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
+            check_own_files(paths + [os.path.join(out, "convergence.nc")], name="output", overwrite=overwrite)
+        jobs = [(chi, p, lumping, free_end, tol, path) for p, path in zip(params, paths)]
+        t0 = time.perf_counter()
+        rows = [None] * len(jobs)
+        if workers == 1 or len(jobs) == 1:
+            for k, job in enumerate(jobs):
+                rows[k], _ = _run_level(job)
+                if progress:
+                    print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} ({rows[k]['n_links']} links) done in "
+                          f"{rows[k]['wall_time']:.1f} s", file=sys.stderr, flush=True)
+        else:
+            from . import _workers
 
-        # (workers leave with this process)
-        _workers.run_all(min(workers, len(jobs)), _run_level, [(job,) for job in jobs], collect)
-    ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
-    if output is not None:
-        from .simulate import save
+            def collect(args, result):
+                k = jobs.index(args[0])
+                rows[k], _ = result()
+                if progress:
+                    print(f"converge chi={chi:g}: level {k + 1}/{len(jobs)} done", file=sys.stderr, flush=True)
 
-        save(ds, os.path.join(out, "convergence.nc"), overwrite=True)  # the directory's own summary
-    return Convergence(ds, [p for p in paths if p is not None])
+            # (workers leave with this process)
+            _workers.run_all(min(workers, len(jobs)), _run_level, [(job,) for job in jobs], collect)
+        ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
+        if output is not None:
+            from .simulate import save
+
+            save(ds, os.path.join(out, "convergence.nc"), overwrite=True)  # the directory's own summary
+        return Convergence(ds, [p for p in paths if p is not None])
 
 
 def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Dataset:

@@ -376,6 +376,7 @@ def run_instead(chi: float, links: int, tip_mass: float, errors: dict, *,
     them for chains of at most :data:`FEW_LINKS` links, and where a bound is above
     :data:`TARGETS` and the table says such a run costs at most ``max_seconds``; ``why`` is
     empty when the table's peaks meet the targets."""
+    max_seconds = V.nonnegative("max_seconds", max_seconds)
     over = {q: e for q, e in errors.items() if q in TARGETS and not e <= TARGETS[q]}
     few = links <= FEW_LINKS
     if not over and not few:
@@ -408,7 +409,7 @@ def computed_estimate(chain: Chain, *, chi: float | None = None, separation: flo
     This is what ``snapping estimate --links`` prints; ``design_estimate(..., links=...)``
     is the table's answer alone (``snapping estimate --table``), so where the table's bound
     misses the targets the two differ: one run's peaks here, the interpolated ones there."""
-    max_seconds = V.real("max_seconds", max_seconds)
+    max_seconds = V.nonnegative("max_seconds", max_seconds)
     est = design_estimate(chain, chi=chi, separation=separation, curvature=curvature, links=links,
                           tip_mass=tip_mass)
     run, why = run_instead(est.nondim["chi"], est.links, est.tip_mass, est.computed_errors, max_seconds=max_seconds)

@@ -214,7 +214,7 @@ def _failure_of(exc: BaseException, path: str) -> dict:
         msg = ds.attrs.get("stop_reason") if ds is not None and ds.attrs.get("stop_reason") else str(exc)
         return {"kind": exc.kind or "simulation", "message": _one_line(msg), "file": _existing(exc.path or path)}
     msg = _one_line(exc) or type(exc).__name__
-    if type(exc).__name__ == "BrokenProcessPool":
+    if type(exc).__name__ == "BrokenProcessPool" and not str(exc).startswith("a worker process could not run"):
         msg = ("a worker process died (killed, out of memory, or, in a script, a sweep not started under "
                "`if __name__ == \"__main__\":`, whose workers re-run the script)")
     return {"kind": type(exc).__name__, "message": msg, "file": _existing(path)}
@@ -412,7 +412,7 @@ class SweepFailed(RuntimeError):
 
 
 def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None, progress: bool = True,
-              ensemble: int | None = None, log=None) -> list[Path]:
+              ensemble: int | None = None, log=None, overwrite: bool = False) -> list[Path]:
     """Run every point of ``grid`` not yet done in ``out_dir``; return all run paths.
 
     Parameters
@@ -439,6 +439,10 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
         bit for bit but ``wall_time``. Ensembles are not checkpointed: an interrupted
         one restarts. They save processes, not time (measured 1.1-1.2x the cost of
         single runs).
+    overwrite : bool
+        Replace files in ``out_dir`` named like a run of the grid that snapping did not write
+        (default: refuse them before any run; snapping's own, failed or checkpointed runs are
+        rerun or resumed).
 
     Returns
     -------
@@ -470,22 +474,36 @@ def run_sweep(grid: Grid, out_dir, *, workers: int | None = None, scheduler=None
         raise V.SnappingInputError("run_sweep was called inside one of its own worker processes: a script that runs "
                                    "a sweep must start it under `if __name__ == \"__main__\":` (the workers import "
                                    "the script)")
-    out = _check_out_dir(out_dir)
-    with locked(out / "sweep.nc", name="out_dir"):  # one sweep at a time in a directory
-        return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, ensemble=ensemble,
-                          log=log)
+    from ._files import output_dir
 
-
-def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, ensemble, log) -> list[Path]:
-    """:func:`run_sweep` once its directory is checked and locked."""
-    from tqdm.auto import tqdm
-
-    out = Path(out_dir)
+    if not all(hasattr(grid, a) for a in ("points", "path", "paths", "options")):  # (checked before the directory)
+        raise V.SnappingInputError(f"grid={V._short(grid)} is not a snapping.sweep.Grid (use Grid(chi=[...], "
+                                   f"N=[...], options={{...}}))")
     if workers is not None:
         workers = V.integer("workers", workers, 1)
     size = _check_ensemble(grid, ensemble)
+    if not isinstance(overwrite, bool):
+        raise V.SnappingInputError(f"overwrite={overwrite!r} must be True or False")
+    if scheduler is not None and not isinstance(scheduler, str) and type(scheduler).__name__ != "Client":
+        raise V.SnappingInputError(f"scheduler={V._short(scheduler)} is not a Dask scheduler address or a "
+                                   f"dask.distributed.Client")
+    with output_dir(out_dir, name="out_dir") as out:  # (a new directory is removed again if the sweep is refused)
+        out = Path(out)
+        with locked(out / "sweep.nc", name="out_dir"):  # one sweep at a time in a directory
+            return _run_sweep(grid, out, workers=workers, scheduler=scheduler, progress=progress, size=size,
+                              log=log, overwrite=overwrite)
+
+
+def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, size, log, overwrite=False) -> list[Path]:
+    """:func:`run_sweep` once its inputs are checked and its directory made and locked."""
+    from tqdm.auto import tqdm
+
+    from ._files import check_own_files
+
+    out = Path(out_dir)
     todo = [(p, str(grid.path(out, p["chi"], p["N"]))) for p in grid.points()]
     todo = [(p, path) for p, path in todo if not is_complete_run(path)]
+    check_own_files([path for _, path in todo], name="output", overwrite=overwrite)  # another program's: kept
     _check_room(out, todo)
     tasks = _groups(todo, size)
     bar = tqdm(total=len(grid.points()), initial=len(grid.points()) - len(todo), desc="runs", unit="run", disable=not progress)
@@ -563,6 +581,18 @@ def _same(a, b) -> bool:
     return bool(np.all(a == b))
 
 
+def _problem_key(text) -> str:
+    """A run's problem description (its ``problem`` attribute) without what a grid varies (the
+    number of links, chi): what must agree between the runs of one combined sweep."""
+    try:
+        d = json.loads(str(text))
+        d.get("chain", {}).pop("N", None)
+        d.get("start", {}).pop("chi", None)
+        return json.dumps(d, sort_keys=True)
+    except (ValueError, AttributeError):
+        return str(text)
+
+
 def _run_piece(item, i: int):
     """(name, run Dataset) of one entry of :func:`combine`: a run file or a run Dataset,
     checked to be a completed run of the paper's problem (SnappingInputError if not)."""
@@ -621,6 +651,8 @@ def combine(paths) -> "xr.Dataset":
         keys = COMBINE_SAME_INPUTS + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
+        if "problem" in ds.attrs:  # a general problem's chain, held end and gravity: compared and kept too
+            inputs[-1]["problem"] = _problem_key(ds.attrs["problem"])
         names.append(name)
         chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
         summary = {
@@ -635,7 +667,7 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.expand_dims(chi=[chi], N=[N])
         ds.attrs = {}
         pieces.append(ds)
-    for k in COMBINE_SAME_INPUTS + ("dt0",):  # the method first: it decides whether dt0 is compared
+    for k in COMBINE_SAME_INPUTS + ("dt0", "problem"):  # the method first: it decides whether dt0 is compared
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue

@@ -319,6 +319,7 @@ def to_si(ds, length=None, mass=None, g: float = G_STANDARD, *, scales: Scales |
 
     if not isinstance(ds, xr.Dataset):
         raise V.SnappingInputError(f"ds={type(ds).__name__} is not an xarray.Dataset")
+    V.run_dataset("ds", ds, sweep=True)  # (another program's Dataset: refused, not converted)
     if ds.attrs.get("units_system") == "SI":
         raise V.SnappingInputError("ds is already in SI (its attribute units_system is 'SI')")
     s = _scales(scales, length, mass, g)

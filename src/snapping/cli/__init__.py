@@ -140,7 +140,22 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
+    import warnings
+
     restore = _on_sigterm_raise()
+    try:
+        with warnings.catch_warnings(record=True) as caught:  # (numpy/scipy warnings: held until the outcome)
+            status = _run(parser, args)
+    finally:
+        restore()
+    if status == 0:  # a warning of a command that worked is shown after its output; an error says it all
+        for w in caught:
+            print(warnings.formatwarning(w.message, w.category, w.filename, w.lineno).rstrip(), file=sys.stderr)
+    return status
+
+
+def _run(parser, args) -> int:
+    """``args.func(args)``, every exception mapped to one line on stderr and an exit status."""
     try:
         return int(args.func(args) or 0)
     except _Terminated:  # SIGTERM outside a run's loop (which saves a checkpoint on it itself)
@@ -162,8 +177,12 @@ def main(argv: list[str] | None = None) -> int:
         what = "" if type(exc).__name__ == "OutputWriteError" else "I/O error: "
         print(f"snapping {args.command}: error: {what}{exc}", file=sys.stderr)
         return EXIT_FAILED
-    finally:
-        restore()
+    except RuntimeError as exc:  # a numerical failure, or workers that died: one line, exit 1
+        if not any(c.__name__ in ("SimulationError", "BrokenExecutor") for c in type(exc).__mro__):
+            raise
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        print(f"snapping {args.command}: error: {first}", file=sys.stderr)
+        return EXIT_FAILED
 
 
 class _Terminated(KeyboardInterrupt):

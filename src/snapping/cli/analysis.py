@@ -365,12 +365,12 @@ def _cmd_animate(args) -> int:
     if args.frames is not None:
         ds = _dense_rerun(ds, args.frames, args.file)
     animation.frames_of(ds, args.max_frames)  # no snapshots: refused here
-    n_snap = animation.snapshots_before_snap(ds)
-    if args.frames is None and animation.denser_run_hint(ds, args.file):
-        print(f"snapping animate: note: only {n_snap} snapshots up to the snap; for a smoother animation add "
-              f"--frames 60 (reruns the run with that many snapshots dense towards the "
-              f"snap)", file=sys.stderr)
     out = animation.animate(ds, args.output, fps=args.fps, max_frames=args.max_frames, overwrite=args.overwrite)
     n = len(animation.frames_of(ds, args.max_frames))
     print(f"wrote {out}: {n} frames at {args.fps:g} fps")
+    # (after the work: never a hint before an error)
+    if args.frames is None and animation.denser_run_hint(ds, args.file):
+        print(f"snapping animate: note: only {animation.snapshots_before_snap(ds)} snapshots up to the snap; for a "
+              f"smoother animation add --frames 60 (reruns the run with that many snapshots dense towards the "
+              f"snap)", file=sys.stderr)
     return 0

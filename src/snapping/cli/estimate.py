@@ -186,17 +186,17 @@ def _cmd_design(args) -> int:
     from .._files import figure_format
 
     chain = _chain_of(args)
-    if args.plot:
+    if args.plot is not None:  # (an empty name is refused, not ignored)
         figure_format(args.plot, name="--plot")
         check_writable(args.plot, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
     res = design.design(chain, args.links, max_tension=args.max_tension, max_speed=args.max_speed,
                         max_acceleration=args.max_acceleration, tip_mass=args.tip_mass)
-    if args.plot:
+    if args.plot is not None:
         design.plot_design(res, args.plot, overwrite=args.overwrite)
     if args.json:
         print_json({**res.to_dict(), "plot": args.plot})
     else:
         design.print_design(res)
-        if args.plot:
+        if args.plot is not None:
             print(f"wrote {args.plot}")
     return 0

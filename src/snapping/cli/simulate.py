@@ -185,6 +185,10 @@ def _cmd_simulate(args) -> int:
         return exc.exit_status
     except simulate.SimulationError as exc:
         summary, failed = simulate.summary(exc.dataset), exc
+        if args.resume is not None:  # the stored run's chi and N (not given with --resume), for the title
+            args.chi, args.N = summary.get("chi"), summary.get("N")
+            if args.chi is None or str(exc.dataset.attrs.get("initial")) == "problem":
+                problem = True
     if args.output:
         summary["output"] = args.output
     bad = _nonfinite(summary)

@@ -47,7 +47,8 @@ def _add_sweep(sub) -> None:
                    help="run up to K chi of one N together in one ensemble kernel (needs --method fast or dop853)")
     p.add_argument("-o", "--output", required=True, help="output directory")
     p.add_argument("--overwrite", action="store_true",
-                   help="replace DIR/sweep.nc even if it holds another grid's runs (default: refuse)")
+                   help="replace DIR/sweep.nc even if it holds another grid's runs, and files named like its runs "
+                        "that snapping did not write (default: refuse)")
     p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
     _add_si_options(p)
     p.set_defaults(func=_cmd_sweep)
@@ -66,7 +67,7 @@ def _cmd_sweep(args) -> int:
     failed = None
     try:
         paths = sweep.run_sweep(grid, args.output, workers=args.workers, scheduler=args.scheduler,
-                                progress=sys.stderr.isatty(), ensemble=args.ensemble)
+                                progress=sys.stderr.isatty(), ensemble=args.ensemble, overwrite=args.overwrite)
     except KeyboardInterrupt:
         print(f"snapping sweep: interrupted; finished and checkpointed runs are kept in {args.output}: "
               "run the same command again to resume only the missing runs", file=sys.stderr)
@@ -168,7 +169,9 @@ def _add_converge(sub) -> None:
     p.add_argument("--workers", type=int, default=1, help="levels run in parallel (default 1)")
     p.add_argument("-o", "--output", default=None, metavar="DIR", help="keep the levels' run files here")
     p.add_argument("--plot", default=None, metavar="PATH", help="draw the convergence figure (.png, .pdf, .svg)")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file (default: refuse it)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an existing --plot file, and files in -o named like a level that snapping did not "
+                        "write (default: refuse them)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     _add_si_options(p)
     p.set_defaults(func=_cmd_converge)
@@ -190,7 +193,7 @@ def _cmd_converge(args) -> int:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
                              free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
-                             progress=None if not args.json else False)
+                             progress=None if not args.json else False, overwrite=args.overwrite)
     if args.plot is not None:
         res.plot(args.plot)
     if args.json:

@@ -78,6 +78,7 @@ def summary(ds: xr.Dataset) -> dict:
     A snapping time whose peak was at the run's last step is None too. Files written
     before ``snap_reached`` existed have none and are summarised as they are.
     """
+    V.run_dataset("ds", ds)
     out = {}
     for k in SUMMARY_KEYS:
         if k in ds.attrs:

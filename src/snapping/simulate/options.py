@@ -86,6 +86,10 @@ class RunOptions:
             raise V.SnappingInputError(f"dt0={self.dt0!r} is out of range: must lie in [dt_min={dt_min:g}, "
                                        f"{T_MAX:g}]")
         put("snapshot_times", _times(self.snapshot_times))
+        if self.snapshot_times and end is not None and self.snapshot_times[-1] > end:  # never reached: refused
+            raise V.SnappingInputError(f"snapshot_times contains {self.snapshot_times[-1]!r}, after the run's end "
+                                       f"{'t_end' if self.t_end is not None else 't_end_max'}={end:g}: it would "
+                                       f"never be recorded")
         thin = V.real("record_thin", self.record_thin)
         if not 0.0 <= thin < 1.0:
             raise V.SnappingInputError(f"record_thin={thin!r} is out of range: must lie in [0, 1)")

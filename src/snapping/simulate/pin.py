@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _validate as V
+from .._validate import _short
 from . import general as G
 
 __all__ = ["PinMotion", "parse_pin_motion", "PIN_KINDS"]
@@ -32,6 +33,8 @@ MIN_DURATION = 1e-9
 #: largest acceleration of a preset (units of g) and latest time of a sampled motion
 ACCEL_MAX = 1e6
 T_MAX = 1e6
+#: largest coordinate of a sampled motion (chain lengths)
+POSITION_MAX = 1e6
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,6 +51,31 @@ class PinMotion:
     t0: float = 0.0
     duration: float = math.inf
     table: tuple | None = None  # (t, x, y) samples
+
+    def __post_init__(self):  # built directly too (PinMotion("pull", ...)): checked as the constructors check
+        if not isinstance(self.kind, str) or self.kind not in PIN_KINDS:
+            raise V.SnappingInputError(f"kind={self.kind!r} is not one of {PIN_KINDS} (build a PinMotion with "
+                                       f"PinMotion.fixed, .pull, .flick, .from_table or .from_function)")
+        accel = self._vector("accel", self.accel)
+        t0 = V.real("t0", self.t0)
+        if t0 < 0.0:
+            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be >= 0")
+        d = self.duration
+        if self.kind in ("pull", "flick") and not (self.kind == "pull" and isinstance(d, (int, float))
+                                                   and d == math.inf):
+            d = V.positive("period" if self.kind == "flick" else "duration", d)
+            if d < MIN_DURATION:
+                raise V.SnappingInputError(f"{'period' if self.kind == 'flick' else 'duration'}={d!r} is out of "
+                                           f"range: must be >= {MIN_DURATION:g}")
+        table = self.table
+        if self.kind == "table" or table is not None:
+            if self.kind != "table" or not isinstance(table, tuple) or len(table) != 3:
+                raise V.SnappingInputError(f"table={_short(table)} must be the samples (t, x, y) of a PinMotion of "
+                                           f"kind 'table' (use PinMotion.from_table)")
+            table = self._checked_table(*table)
+            d = float(table[0][-1])
+        for name, v in (("accel", accel), ("t0", t0), ("duration", float(d)), ("table", table)):
+            object.__setattr__(self, name, v)
 
     @classmethod
     def fixed(cls) -> "PinMotion":
@@ -120,6 +148,11 @@ class PinMotion:
     def from_table(cls, t, x, y) -> "PinMotion":
         """The motion through samples ``(t_i, x_i, y_i)``, t_0 = 0 and (x_0, y_0) = (0, 0),
         t increasing, at least 4 samples (a not-a-knot cubic spline through them)."""
+        t, x, y = cls._checked_table(t, x, y)
+        return cls("table", (0.0, 0.0), 0.0, float(t[-1]), (t, x, y))
+
+    @staticmethod
+    def _checked_table(t, x, y):
         t = np.asarray(V.float_array("t", t), dtype=float).ravel()
         x = np.asarray(V.float_array("x", x), dtype=float).ravel()
         y = np.asarray(V.float_array("y", y), dtype=float).ravel()
@@ -132,6 +165,11 @@ class PinMotion:
                 raise V.SnappingInputError(f"pin motion {name}[{i}]={a[i]!r} is not finite")
         if t[0] != 0.0 or not np.all(np.diff(t) > 0.0):
             raise V.SnappingInputError(f"pin table times must start at 0 and increase; got t[0]={t[0]!r}")
+        for name, a, hi in (("t", t, T_MAX), ("x", x, POSITION_MAX), ("y", y, POSITION_MAX)):
+            if np.abs(a).max() > hi:
+                i = int(np.argmax(np.abs(a)))
+                raise V.SnappingInputError(f"pin motion {name}[{i}]={float(a[i])!r} is out of range: must lie in "
+                                           f"[-{hi:g}, {hi:g}]" + (" (chain lengths)" if name != "t" else ""))
         scale = max(1.0, float(np.abs(np.concatenate([x, y])).max()))
         if abs(x[0]) > 1e-12 * scale or abs(y[0]) > 1e-12 * scale:
             raise V.SnappingInputError(f"x[0], y[0] = ({float(x[0])!r}, {float(y[0])!r}): the held end must start "
@@ -139,7 +177,7 @@ class PinMotion:
         x = x.copy()
         y = y.copy()
         x[0] = y[0] = 0.0
-        return cls("table", (0.0, 0.0), 0.0, float(t[-1]), (t.copy(), x, y))
+        return t.copy(), x, y
 
     @staticmethod
     def _vector(name, v):

@@ -75,10 +75,15 @@ def _positive_array(name: str, a, n: int | None = None, bounds: tuple | None = N
 def _call(name: str, fn, args) -> np.ndarray:
     """A user function's values at ``args`` as floats, or SnappingInputError naming it."""
     try:
-        return np.asarray([np.asarray(fn(float(v)), dtype=float) for v in args], dtype=float)
+        vals = [np.asarray(fn(float(v)), dtype=float) for v in args]
     except Exception as exc:  # noqa: BLE001 - any failure of the user's function
         raise V.SnappingInputError(f"{name}({float(args[0])!r}) ... failed or did not return numbers "
                                    f"({type(exc).__name__}: {str(exc)[:120]})") from None
+    for v, a in zip(args, vals):
+        if a.ndim != 0:
+            raise V.SnappingInputError(f"{name}({float(v)!r}) returned {a.size} values of shape {a.shape}: it must "
+                                       f"return one number for each s")
+    return np.asarray(vals, dtype=float)
 
 
 #: node masses are kept within this factor of the unit (the tension solve's leading minors are
@@ -124,6 +129,17 @@ def _links_count(name: str, N) -> int:
     return N
 
 
+def _node_values(name: str, v, n: int) -> None:
+    """SnappingInputError unless ``v`` holds ``n`` finite numbers (one per node), naming the first bad one."""
+    a = np.asarray(V.float_array(name, v), dtype=float).ravel()
+    if a.size != n:
+        raise V.SnappingInputError(f"{name} must be {n} finite numbers (one per node); got {a.size} numbers")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise V.SnappingInputError(f"{name}[{bad[0]}]={float(a[bad[0]])!r} is not finite: {name} must be {n} finite "
+                                   f"numbers (one per node)")
+
+
 def _check_links(links) -> None:
     if not isinstance(links, Links):
         raise V.SnappingInputError(f"links={links!r} is not a snapping.simulate.Links (use Links.uniform, "
@@ -148,6 +164,13 @@ class Links:
     kind: str = "explicit"
     params: dict = field(default_factory=dict)
     link_mass: np.ndarray | None = None
+
+    def __post_init__(self):  # built directly too: h and m one per link, in range (the constructors check more)
+        h = _positive_array("h", self.h, bounds=LENGTH_RANGE)
+        m = _positive_array("m", self.m, h.size, bounds=(1.0 / MASS_RANGE, MASS_RANGE))
+        lm = None if self.link_mass is None else _positive_array("link_mass", self.link_mass, h.size)
+        for name, v in (("h", h), ("m", m), ("link_mass", lm), ("tip_mass", _tip(self.tip_mass))):
+            object.__setattr__(self, name, v)
 
     @property
     def N(self) -> int:
@@ -200,7 +223,7 @@ class Links:
         power = V.positive("power", power)
         if not 1e-3 <= power <= 100.0:
             raise V.SnappingInputError(f"power={power!r} is out of range: must lie in [0.001, 100]")
-        h = np.full(N, 1.0 / N) if h is None else _positive_array("h", h, N)
+        h = np.full(N, 1.0 / N) if h is None else _positive_array("h", h, N, bounds=LENGTH_RANGE)
         L = float(h.sum())
         c = 1.0 - ratio ** (1.0 / power)
 
@@ -321,6 +344,13 @@ class Problem:
     chords: str | None = None
     #: what the line is made of (bending, damping, drag, a clamp): None, or an active Body
     body: Body | None = None
+
+    def __post_init__(self):  # built directly too: a chain, a PinMotion and finite values, one per node
+        _check_links(self.links)
+        if not isinstance(self.pin, PinMotion):
+            raise V.SnappingInputError(f"pin={type(self.pin).__name__} is not a PinMotion")
+        for name in ("x", "y", "vx", "vy"):
+            _node_values(name, getattr(self, name), self.links.N + 1)
 
     @property
     def N(self) -> int:
@@ -482,8 +512,7 @@ class Problem:
         vx = np.full(N + 1, pvx) if vx is None else np.array(V.float_array("vx", vx), dtype=float).ravel()
         vy = np.full(N + 1, pvy) if vy is None else np.array(V.float_array("vy", vy), dtype=float).ravel()
         for name, v in (("vx", vx), ("vy", vy)):
-            if v.size != N + 1 or not np.all(np.isfinite(v)):
-                raise V.SnappingInputError(f"{name} must be {N + 1} finite numbers (one per node); got {v.size}")
+            _node_values(name, v, N + 1)
             if np.abs(v).max() > SPEED_MAX:
                 j = int(np.argmax(np.abs(v)))
                 raise V.SnappingInputError(f"{name}[{j}]={float(v[j])!r} is out of range: initial speeds must be "
@@ -593,9 +622,15 @@ def read_shape(path) -> tuple[np.ndarray, np.ndarray]:
             first = (str(exc).strip().splitlines() or [""])[-1][:160]
             raise V.SnappingInputError(f"shape={p!r}: cannot read it as CSV of two columns x, y ({first})") from None
         a = np.atleast_2d(a)
-        if a.ndim != 2 or a.shape[1] < 2 or a.shape[0] == 0:
-            raise V.SnappingInputError(f"shape={p!r}: expected two comma-separated columns x, y")
-        a = a[~np.all(np.isnan(a[:, :2]), axis=1)]  # a header line reads as NaN
+        if a.ndim != 2 or a.shape[1] != 2 or a.shape[0] == 0:
+            raise V.SnappingInputError(f"shape={p!r}: expected two comma-separated columns x, y; got "
+                                       f"{a.shape[1] if a.ndim == 2 else 0} columns")
+        if np.all(np.isnan(a[0])):  # a header line reads as NaN: only the first row may be one
+            a = a[1:]
+        bad = np.flatnonzero(np.any(np.isnan(a), axis=1))
+        if bad.size:
+            raise V.SnappingInputError(f"shape={p!r}: data row {int(bad[0]) + 1} is not two numbers x, y (only the "
+                                       f"first line may be a header)")
         x, y = a[:, 0], a[:, 1]
     if x.size < 2 or not np.all(np.isfinite(x) & np.isfinite(y)):
         raise V.SnappingInputError(f"shape={p!r}: needs at least 2 finite points (x, y); got {x.size}")
@@ -622,6 +657,9 @@ def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shap
     if len(starts) != 1:
         raise V.SnappingInputError(f"give exactly one start: --chi, --supports DX,DY or --shape FILE (got "
                                    f"{starts or 'none'})")
+    if chords != "exact" and chi is None:  # (the other starts place their nodes at exact chords)
+        raise V.SnappingInputError(f"chords={chords!r} applies to the catenary start of chi only: the {starts[0]} "
+                                   f"start places its nodes at exact chords")
     N = _links_count("N", N)
     if taper is not None:
         tv = [taper] if np.ndim(taper) == 0 else list(taper)

@@ -90,6 +90,20 @@ def _mismatch(kw: dict, expected: dict) -> str | None:
     return None
 
 
+def _check_start(fresh: np.ndarray, stored: np.ndarray, path: str) -> None:
+    """The digest proves only that the file is as sealed: a file whose inputs were edited and
+    sealed again would continue the stored state under the new inputs' name. The first recorded
+    step of the stored run must be the start that its stored inputs give (``fresh``)."""
+    if fresh.ndim != 2 or stored.ndim != 2 or not fresh.shape[0] or not stored.shape[0]:
+        return
+    a, b = fresh[0], stored[0]
+    if a.shape != b.shape or not np.allclose(a, b, rtol=1e-9, atol=1e-12, equal_nan=True):
+        raise V.SnappingInputError(f"path={path!r}: the inputs stored in the checkpoint (chi, N, chords, the "
+                                   f"problem) do not give the start of its stored run (its first recorded step "
+                                   f"differs): the file's attributes were changed after the run was written; "
+                                   f"start the run again")
+
+
 def is_resumable(path, **expected) -> bool:
     """True if ``path`` is a checkpoint :func:`resume` can continue and, for each keyword
     given (``chi``, ``N``, ``tol``, any input of :func:`run`), its input equals that value.
@@ -180,11 +194,13 @@ def resume(path, *, output=None, progress: bool | None = False,
         out = check_writable(out, overwrite=True if own else overwrite, need_bytes=need["file_bytes"])
         inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
                                                    initial=kw.get("initial"), problem=kw.get("problem"))
+        fresh = np.array(eng.records(), dtype=float, copy=True)  # the start the stored inputs describe
         try:
             eng.restore(ds)
         except (KeyError, ValueError, TypeError) as exc:
             if isinstance(exc, V.SnappingInputError):
                 raise V.SnappingInputError(f"path={p!r}: {exc}") from None
             raise V.SnappingInputError(f"path={p!r}: the checkpoint is damaged ({exc})") from None
+        _check_start(fresh, np.asarray(eng.records(), dtype=float), p)
         return D._drive(eng, inputs, output=out, progress=progress, checkpoint_every=checkpoint_every,
                         wall_before=float(ds.attrs["checkpoint_wall_time"]), overwrite=True if own else overwrite)

@@ -208,7 +208,16 @@ class Table:
     def check(self, chi, links, tip_mass=0.0) -> None:
         """Raise :class:`OutsideTable` (naming the input and the range) unless the point is inside."""
         r = self.ranges
-        chi_a, N_a, tip_a = (np.atleast_1d(np.asarray(v, float)) for v in (chi, links, tip_mass))
+        chi_a, N_a, tip_a = (np.atleast_1d(V.float_array(n, v)) for n, v in (("chi", chi), ("links", links),
+                                                                              ("tip_mass", tip_mass)))
+        try:
+            np.broadcast_shapes(chi_a.shape, N_a.shape, tip_a.shape)
+        except ValueError:
+            raise V.SnappingInputError(f"chi, links and tip_mass do not broadcast together: shapes {chi_a.shape}, "
+                                       f"{N_a.shape} and {tip_a.shape}") from None
+        frac = N_a[np.isfinite(N_a) & (N_a != np.round(N_a))]
+        if frac.size:  # a chain has a whole number of links: never interpolated between two
+            raise V.SnappingInputError(f"links={float(frac[0])!r} is not an integer (a number of links)")
         for name, a, (lo, hi) in (("chi", chi_a, r["chi"]), ("links", N_a, r["N"]),
                                   ("tip_mass", tip_a, r["tip_mass"])):
             bad = a[~((a >= lo) & (a <= hi))]
@@ -326,7 +335,14 @@ def _load(path: str) -> Table:
     from .._files import check_input
 
     path = check_input(path, name="table")
-    return Table(_NetcdfFile(path), path)
+    try:
+        return Table(_NetcdfFile(path), path)
+    except (OSError, ValueError, KeyError, IndexError, RuntimeError) as exc:  # not a table file: named, one line
+        if isinstance(exc, V.SnappingInputError):
+            raise
+        why = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:160]
+        raise V.SnappingInputError(f"table={path!r} cannot be read as a snapping table (netCDF4 with chi, N and "
+                                   f"the peaks): {type(exc).__name__}: {why}") from None
 
 
 def load_table(path=None) -> Table:
