@@ -111,10 +111,12 @@ class Grid:
 
         if "output" in self.options:
             raise V.SnappingInputError("options must not contain 'output': the sweep names each run's file")
+        if "body" in self.options:  # a line's body, the same at every grid point: kept as its description
+            self.options = {**self.options, "body": _body_description(self.options["body"])}
 
         for chi in self.chi:  # every run's inputs, checked before any starts
             for N in self.N:
-                check_inputs(chi, N, **self.options)
+                check_inputs(**_run_kwargs(dict(chi=chi, N=N, **self.options)))
 
     def points(self) -> list[dict]:
         """One dict of run keywords per grid point."""
@@ -134,6 +136,36 @@ class Grid:
         return [self.path(out_dir, p["chi"], p["N"]) for p in self.points()]
 
 
+def _body_description(body) -> dict:
+    """The description (:meth:`snapping.simulate.Body.describe`) of a sweep's body (a Body or
+    a description), checked to be one that every chain of the grid can take."""
+    from .simulate import Body
+
+    if isinstance(body, dict):
+        body = Body.from_describe(body)
+    if not isinstance(body, Body):
+        raise V.SnappingInputError(f"options['body']={type(body).__name__} is not a snapping.simulate.Body")
+    d = body.describe()
+    if any(isinstance(v, (list, dict)) for k, v in d.items() if k not in ("wind", "clamp")):
+        raise V.SnappingInputError("options['body']: a sweep's body takes numbers (the same at every N), not "
+                                   "per-node arrays or functions of s; run such bodies one by one")
+    return d
+
+
+def _run_kwargs(params: dict) -> dict:
+    """The keywords of :func:`snapping.simulate.run` for one grid point: with a ``body``, the
+    problem ``Problem.catenary(chi, N, chords=..., body=...)`` in place of chi, N and chords."""
+    if "body" not in params:
+        return params
+    from .simulate import Body, Problem
+
+    kw = dict(params)
+    body = Body.from_describe(kw.pop("body"))
+    chi, N, chords = kw.pop("chi"), kw.pop("N"), kw.pop("chords", None)
+    kw["problem"] = Problem.catenary(chi, N, chords=chords or "exact", body=body)
+    return kw
+
+
 def _run_one(params: dict, path: str) -> str:
     """Worker: run one simulation, checkpointed to ``path`` and saved there atomically.
 
@@ -144,10 +176,10 @@ def _run_one(params: dict, path: str) -> str:
     """
     from . import simulate
 
-    if simulate.is_resumable(path, **params):
+    if simulate.is_resumable(path, **{k: v for k, v in params.items() if k != "body"}):
         simulate.resume(path, **{k: params[k] for k in ("checkpoint_every",) if k in params})
     else:
-        simulate.run(**params, output=path, overwrite=True)  # the sweep owns its run files
+        simulate.run(**_run_kwargs(params), output=path, overwrite=True)  # the sweep owns its run files
     return path
 
 
@@ -618,7 +650,7 @@ def combine(paths) -> "xr.Dataset":
     pieces, names, inputs = [], [], []
     for i, item in enumerate(items):
         name, ds = _run_piece(item, i)
-        keys = COMBINE_SAME_INPUTS + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
+        keys = COMBINE_SAME_INPUTS + ("body",) + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
         names.append(name)
@@ -635,7 +667,7 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.expand_dims(chi=[chi], N=[N])
         ds.attrs = {}
         pieces.append(ds)
-    for k in COMBINE_SAME_INPUTS + ("dt0",):  # the method first: it decides whether dt0 is compared
+    for k in COMBINE_SAME_INPUTS + ("body", "dt0"):  # (body: a line's body, its JSON) the method first: it decides whether dt0 is compared
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue
