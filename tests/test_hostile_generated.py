@@ -464,6 +464,11 @@ CLI_SPECS = {
                         "--max-rejections"]),
     "simulate(fast)": (_FAST, ["--tip-mass", "--gravity", "--taper", "--pin-motion=pull:{},0",
                                "--pin-motion=flick:1,0,{}", "--supports={},0.2"]),
+    "simulate(body)": (_FAST, ["--bending", "--bending-damping", "--drag-normal", "--drag-tangential", "--tip-drag",
+                               "--wind={},0", "--drag-linear"]),
+    "simulate(body SI)": (_FAST + ["--length", "2", "--mass", "0.02", "--diameter", "1e-3"],
+                          ["--ei", "--diameter", "--air-density", "--cd-normal", "--cd-tangential", "--tip-drag-area",
+                           "--wind-si={},0"]),
     "fit": (["fit", "{run_nc}", "--json", "--no-joint"], ["--tol", "--min-width", "--window=v_max={},1e-2",
                                                           "--window=v_max=1e-4,{}"]),
     "sweep": (["sweep", "--chi", "0.3", "--N", "10", "-o", "{root}/sweep"], ["--chi", "--N", "--tol", "--workers",
@@ -490,7 +495,12 @@ CLI_VALID = {
     ("design", "--tip-mass", "0"), ("design", "--tip-mass", "5e-324"), ("design", "--max-tension", "1e308"),
     ("design", "--max-speed", "1e308"), ("design", "--max-acceleration", "1e308"),
     ("fit", "--window=v_max={},1e-2", "5e-324"), ("fit", "--window=v_max=1e-4,{}", "1e308"),
-}
+    # a line's body (issue 21): zero is no body, the smallest subnormal a valid (negligible) one, a wind any sign
+    *{("simulate(body)", o, v) for o in ("--bending", "--bending-damping", "--drag-normal", "--drag-tangential",
+                                         "--tip-drag", "--wind={},0", "--drag-linear") for v in ("0", "5e-324")},
+    *{("simulate(body SI)", o, v) for o in ("--ei", "--diameter", "--air-density", "--cd-normal", "--cd-tangential",
+                                            "--tip-drag-area", "--wind-si={},0") for v in ("0", "5e-324")},
+}  # (a wind "-1,0" typed as a separate word is argparse's refusal, naming the option: --wind=-1,0 is the way)
 #: a bound that cannot be met: the run fails by design (exit 1, one line on stderr)
 CLI_FAILS = {("simulate", "--max-energy-drift", "5e-324")}
 #: valid values that would start a long computation (converge's --first: level_parameters checks it)

@@ -337,8 +337,7 @@ def _check_room(out: Path, todo: list) -> None:
     from ._files import _size
     from .simulate.driver import check_inputs
 
-    need = sum(check_inputs(p["chi"], p["N"], **{k: v for k, v in p.items() if k not in ("chi", "N")})["file_bytes"]
-               for p, _ in todo)
+    need = sum(check_inputs(**_run_kwargs(p))["file_bytes"] for p, _ in todo)
     free = shutil.disk_usage(out).free
     if need > free:
         raise V.SnappingInputError(f"out_dir={str(out)!r}: the {len(todo)} run files to write need about "

@@ -584,7 +584,7 @@ def body_numbers(length, mass, g: float = G_STANDARD, *, ei=0.0, bending_damping
     if drag_given or air_density is not None:
         rho = AIR_DENSITY if air_density is None else V.real("air_density", air_density)
         if not (math.isfinite(rho) and 0.0 <= rho <= 1e5):
-            raise V.SnappingInputError(f"air_density={rho!r} is out of range: must be finite and >= 0 (kg/m^3)")
+            raise V.SnappingInputError(f"air_density={rho!r} is out of range: must be finite, in [0, 1e5] (kg/m^3)")
     if diameter is not None:
         cn = CD_NORMAL if cd_normal is None else V.real("cd_normal", cd_normal)
         ct = CD_TANGENTIAL if cd_tangential is None else V.real("cd_tangential", cd_tangential)

@@ -150,7 +150,20 @@ def _si_numbers(args, si: dict) -> dict:
         raise SnappingInputError(msg) from None
     made = {"ei": ("bending",), "diameter": ("drag_normal", "drag_tangential"), "tip_drag_area": ("tip_drag",),
             "wind_si": ("wind",)}
-    return {d: out[d] for k, dests in made.items() if k in si for d in dests}
+    kw = {d: out.get(d, 0.0) for k, dests in made.items() if k in si for d in dests}
+    from ..simulate import Body
+
+    for k, dests in made.items():  # the numbers in range (a huge EI makes a beta beyond the doubles' use)
+        if k in si:
+            try:
+                Body(**{d: kw[d] for d in dests})
+            except SnappingInputError as exc:
+                raise SnappingInputError(f"--{k.replace('_', '-')}={args_text(si[k])} gives {exc}") from None
+    return kw
+
+
+def args_text(v) -> str:
+    return ",".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v:g}"
 
 
 def si_summary(si: dict | None) -> dict | None:
