@@ -206,11 +206,12 @@ class Body:
         return cls(kw.pop("bending"), drag_linear_normal=drag_linear_normal,
                    drag_linear_tangential=drag_linear_tangential, clamp=clamp, **kw)
 
-    def numbers(self) -> dict:
+    def numbers(self, h=None) -> dict:
         """The body's nondimensional numbers, compactly, for a summary: every entry that is
-        not zero (a profile that varies: its range ``[min, max]`` over the nodes it was given
-        at, or the name of its function), ``beta`` for the bending number."""
-        return summarize(self.describe())
+        not zero (a profile that varies: its range ``[min, max]`` over the nodes; a function
+        of s: over the nodes of a chain with links ``h``, else its name), ``beta`` for the
+        bending number."""
+        return summarize(self.describe(h))
 
     @staticmethod
     def taper_profile(B0: float, ratio: float, power: float = 1.0):
@@ -262,9 +263,9 @@ class Body:
         nodes ``x, y`` (index N the held end) leaves the held end."""
         if not (isinstance(self.clamp, str) and self.clamp == "start"):
             return self
-        d = self.describe()
-        d["clamp"] = math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1]))
-        return Body.from_describe(d)
+        kw = {k: getattr(self, k) for k in _PROFILES if k != "bending"}  # (functions of s kept as they are)
+        return Body(self.bending, wind=self.wind, tip_drag=self.tip_drag,
+                    clamp=math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1])), **kw)
 
     def model(self, mdl, h, theta0: float):
         """The compiled model (:func:`snapping.simulate.forced.make_body_model`) from the general
