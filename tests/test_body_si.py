@@ -219,3 +219,12 @@ def test_converge_with_bending_converges_to_the_rod_at_second_order():
     assert a["v_peak_limit"] == pytest.approx(5.909, abs=0.01)
     with pytest.raises(SnappingInputError, match="n0"):
         continuum.converge(0.25, levels=3, n0=50, ratio=0.3, body=Body(1e-4))
+
+
+def test_clamp_at_the_start_keeps_profiles_given_as_functions():
+    b = Body.from_si(L, M, ei=lambda s: 1e-3 * (1.0 - 0.5 * s / L), diameter=lambda s: 1e-3, clamp="start")
+    p = Problem.catenary(0.3, 12, body=b)
+    assert isinstance(p.body.clamp, float) and callable(p.body.bending)
+    beta = p.body.node_values("bending", p.links.h)
+    assert beta[-1] == pytest.approx(1e-3 / (LAM * G * L ** 3)) and beta[0] == pytest.approx(beta[-1] / 2)
+    assert p.body.numbers(p.links.h)["beta"] == pytest.approx([beta[0], beta[-1]])
