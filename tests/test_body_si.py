@@ -228,3 +228,31 @@ def test_clamp_at_the_start_keeps_profiles_given_as_functions():
     beta = p.body.node_values("bending", p.links.h)
     assert beta[-1] == pytest.approx(1e-3 / (LAM * G * L ** 3)) and beta[0] == pytest.approx(beta[-1] / 2)
     assert p.body.numbers(p.links.h)["beta"] == pytest.approx([beta[0], beta[-1]])
+
+
+def test_cli_converge_with_a_body(capsys):
+    status = main(["converge", "--chi", "0.3", "--levels", "3", "--bending", "1e-3", "--drag-normal", "0.5", "--n0",
+                   "10", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0 and out["body"] == {"beta": 1e-3, "drag_normal": 0.5} and out["grading"] == "uniform"
+    assert out["levels"]["n_links"] == [10, 20, 40]
+
+
+@pytest.mark.parametrize("argv, opt", [
+    (["converge", "--chi", "0.3", "--n0", "10"], "--n0"),  # no body: fold-following levels
+    (["converge", "--chi", "0.3", "--bending", "1e-3", "--n0", "0"], "n0"),
+    (["converge", "--chi", "0.3", "--bending=-1"], "--bending"),
+    (["converge", "--chi", "0.3", "--ei", "1"], "--ei"),
+    (["sweep", "--chi", "0.3", "--N", "10", "-o", "unused_dir", "--drag-normal", "nan"], "--drag-normal"),
+    (["sweep", "--chi", "0.3", "--N", "10", "-o", "unused_dir", "--length", "1", "--mass", "0.01", "--diameter=-1"],
+     "--diameter"),
+])
+def test_cli_sweep_and_converge_bad_body_option(argv, opt, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    try:
+        status = main(argv)
+    except SystemExit as exc:
+        status = exc.code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and opt in err[0], err
+    assert not (tmp_path / "unused_dir").exists() or not any((tmp_path / "unused_dir").glob("*.nc"))
