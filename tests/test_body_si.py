@@ -256,3 +256,16 @@ def test_cli_sweep_and_converge_bad_body_option(argv, opt, capsys, tmp_path, mon
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and opt in err[0], err
     assert not (tmp_path / "unused_dir").exists() or not any((tmp_path / "unused_dir").glob("*.nc"))
+
+
+def test_api_bad_body_of_sweep_and_converge_is_refused_by_name():
+    from snapping import continuum, sweep
+
+    with pytest.raises(SnappingInputError, match=r"^body=str"):
+        continuum.converge(0.3, body="x")
+    with pytest.raises(SnappingInputError, match="numbers"):
+        continuum.converge(0.3, body=Body(np.full(11, 1e-3)))
+    with pytest.raises(SnappingInputError, match=r"options\['body'\]=int"):
+        sweep.Grid(chi=[0.3], N=[10], options={"body": 3})
+    c = continuum.converge(0.5, levels=3, first=-2, body=Body())  # a body that changes nothing: the string's study
+    assert c.dataset.attrs["grading"] == "fold" and "body" not in c.dataset.attrs

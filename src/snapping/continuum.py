@@ -303,7 +303,12 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     if body is not None:
         from .sweep import _body_description
 
-        body_d = _body_description(body)
+        from .simulate import Body
+
+        body_d = _body_description(body, "body")
+        if not Body.from_describe(body_d).active:  # (a body that changes nothing: the string's study)
+            body_d = None
+    if body_d is not None:
         params = _uniform_levels(levels, ratio, n0, first)
     else:
         params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)

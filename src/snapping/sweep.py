@@ -136,7 +136,7 @@ class Grid:
         return [self.path(out_dir, p["chi"], p["N"]) for p in self.points()]
 
 
-def _body_description(body) -> dict:
+def _body_description(body, name: str = "options['body']") -> dict:
     """The description (:meth:`snapping.simulate.Body.describe`) of a sweep's body (a Body or
     a description), checked to be one that every chain of the grid can take."""
     from .simulate import Body
@@ -144,11 +144,11 @@ def _body_description(body) -> dict:
     if isinstance(body, dict):
         body = Body.from_describe(body)
     if not isinstance(body, Body):
-        raise V.SnappingInputError(f"options['body']={type(body).__name__} is not a snapping.simulate.Body")
+        raise V.SnappingInputError(f"{name}={type(body).__name__} is not a snapping.simulate.Body")
     d = body.describe()
     if any(isinstance(v, (list, dict)) for k, v in d.items() if k not in ("wind", "clamp")):
-        raise V.SnappingInputError("options['body']: a sweep's body takes numbers (the same at every N), not "
-                                   "per-node arrays or functions of s; run such bodies one by one")
+        raise V.SnappingInputError(f"{name}: a body refined or swept over N takes numbers (the same at every N), "
+                                   f"not per-node arrays or functions of s; run such bodies one by one")
     return d
 
 
