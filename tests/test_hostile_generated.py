@@ -239,6 +239,10 @@ SPECS = {
                               {"h": [0.1, 0.05, 0.025, 0.0125], "q": [3.02, 3.005, 3.00125, 3.0003125]}, [], ["h", "q"]),
     "continuum.converge": (lambda F, **k: continuum.converge(**k), {"chi": 0.3},
                            ["chi", "levels", "ratio", "first", "tol", "workers", "frac0", "h_min0", "h_max0"], []),
+    # a line's body in SI (issue 21)
+    "Body.from_si": (lambda F, **k: simulate.Body.from_si(**k), {"length": 2.0, "mass": 0.02, "diameter": 1e-3},
+                     ["ei", "bending_damping", "diameter", "air_density", "cd_normal", "cd_tangential",
+                      "tip_drag_area"], []),
     # simulate: the constructors
     "Links.uniform": (lambda F, **k: Links.uniform(**k), {"N": 10}, ["N", "tip_mass"], []),
     "Links.taper": (lambda F, **k: Links.taper(**k), {"N": 10, "ratio": 0.5}, ["N", "ratio", "power", "tip_mass"],
@@ -326,6 +330,10 @@ VALID = {
     "scaling.fit_run": {"tol=tiny", "tol=huge"},
     "continuum.level_parameters": {"first=zero", "first=neg"},
     "continuum.extrapolate": {"q=neg", "q=zero", "q=tiny", "q=huge"},
+    # zero and the smallest subnormal are valid (negligible) bodies; None: no drag, or the defaults
+    "Body.from_si": {f"{p}={t}" for p in ("ei", "bending_damping", "diameter", "air_density", "cd_normal",
+                                           "cd_tangential", "tip_drag_area") for t in ("zero", "tiny")}
+    | {"diameter=none", "air_density=none", "cd_normal=none", "cd_tangential=none", "tip_drag_area=none"},
     "Links.uniform": {"tip_mass=zero", "tip_mass=tiny"},
     "Links.taper": {"tip_mass=zero", "tip_mass=tiny"},
     "Links.explicit": {"tip_mass=zero", "tip_mass=tiny"},

@@ -523,7 +523,7 @@ def _si_profile(name, v, factor, length):
                                        f"({BODY_SI_INPUTS[name][0] or 'dimensionless'})")
         return x * factor
     a = np.asarray(V.float_array(name, v), dtype=float)
-    if a.ndim != 1 or not np.all(np.isfinite(a)) or (name != "curvature" and np.any(a < 0.0)):
+    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)) or (name != "curvature" and np.any(a < 0.0)):
         raise V.SnappingInputError(f"{name} must be one finite value >= 0 per node (a 1-D array); got shape "
                                    f"{a.shape}")
     return a * factor
@@ -577,7 +577,12 @@ def body_numbers(length, mass, g: float = G_STANDARD, *, ei=0.0, bending_damping
     f_eta = dimensionless(Q(1.0, "N m**2 s") / (lam_q * g_q * L_q ** 3 * (L_q / g_q) ** 0.5))
     out["damping"] = _si_profile("bending_damping", bending_damping, f_eta, L)
     out["curvature"] = _si_profile("curvature", curvature, dimensionless(Q(1.0, "1/m") * L_q), L)
-    drag_given = diameter is not None or tip_drag_area
+    tip_area = 0.0
+    if tip_drag_area is not None:
+        tip_area = V.real("tip_drag_area", tip_drag_area)
+        if not (math.isfinite(tip_area) and tip_area >= 0.0):
+            raise V.SnappingInputError(f"tip_drag_area={tip_area!r} is out of range: must be finite and >= 0 (m^2)")
+    drag_given = diameter is not None or tip_area > 0.0
     if not drag_given and (cd_normal is not None or cd_tangential is not None):
         raise V.SnappingInputError("cd_normal/cd_tangential need diameter (m): the drag per length is "
                                    "0.5 rho C d |v| v")
@@ -596,11 +601,8 @@ def body_numbers(length, mass, g: float = G_STANDARD, *, ei=0.0, bending_damping
         f_t = dimensionless(0.5 * rho_q * ct * math.pi * Q(1.0, "m") * L_q / lam_q)
         out["drag_normal"] = _si_profile("diameter", diameter, f_n, L)
         out["drag_tangential"] = _si_profile("diameter", diameter, f_t, L)
-    if tip_drag_area:
-        a = V.real("tip_drag_area", tip_drag_area)
-        if not (math.isfinite(a) and a >= 0.0):
-            raise V.SnappingInputError(f"tip_drag_area={a!r} is out of range: must be finite and >= 0 (m^2)")
-        out["tip_drag"] = dimensionless(0.5 * Q(rho, "kg/m**3") * Q(a, "m**2") * L_q / M_q)
+    if tip_area > 0.0:
+        out["tip_drag"] = dimensionless(0.5 * Q(rho, "kg/m**3") * Q(tip_area, "m**2") * L_q / M_q)
     if wind is not None:
         import numpy as np
 

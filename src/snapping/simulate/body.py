@@ -200,9 +200,20 @@ class Body:
         """
         from ..units import body_numbers
 
-        kw = body_numbers(length, mass, g, ei=ei, bending_damping=bending_damping, curvature=curvature,
-                          diameter=diameter, air_density=air_density, cd_normal=cd_normal,
-                          cd_tangential=cd_tangential, tip_drag_area=tip_drag_area, wind=wind)
+        si = {"ei": ei, "bending_damping": bending_damping, "curvature": curvature, "diameter": diameter,
+              "tip_drag_area": tip_drag_area, "wind": wind}
+        kw = body_numbers(length, mass, g, air_density=air_density, cd_normal=cd_normal, cd_tangential=cd_tangential,
+                          **si)
+        made = {"ei": ("bending",), "bending_damping": ("damping",), "curvature": ("curvature",),
+                "diameter": ("drag_normal", "drag_tangential"), "tip_drag_area": ("tip_drag",), "wind": ("wind",)}
+        for name, keys in made.items():  # a number out of the body's range is named by its SI input
+            if all(k in kw for k in keys):
+                try:
+                    cls(**{k: kw[k] for k in keys})
+                except V.SnappingInputError as exc:
+                    v = si[name]
+                    text = f"{v!r}" if np.ndim(v) == 0 and not callable(v) else "(its values)"
+                    raise V.SnappingInputError(f"{name}={text} gives {exc}") from None
         return cls(kw.pop("bending"), drag_linear_normal=drag_linear_normal,
                    drag_linear_tangential=drag_linear_tangential, clamp=clamp, **kw)
 
