@@ -92,7 +92,10 @@ class Grid:
     """A grid of runs: every combination of ``chi`` and ``N``, with the same ``options``
     (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``); what
     ``options`` leaves out takes :func:`snapping.simulate.run`'s default (method ``fast``,
-    chords ``exact``, the method's tol).
+    chords ``exact``, the method's tol). ``options["body"]``: a line's body
+    (:class:`snapping.simulate.Body` with numbers, not per-node profiles), the same at every
+    point: each run is ``Problem.catenary(chi, N, chords=..., body=...)``; it is kept as its
+    description (:meth:`~snapping.simulate.Body.describe`), which names the run files.
     """
 
     chi: list
