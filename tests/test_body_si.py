@@ -43,7 +43,8 @@ def test_body_numbers_against_hand_computed_values():
 def test_defaults_air_density_and_coefficients():
     n = units.body_numbers(L, M, diameter=1e-3)
     assert n["drag_normal"] == pytest.approx(0.5 * units.AIR_DENSITY * units.CD_NORMAL * 1e-3 * L / LAM)
-    assert n["drag_tangential"] == pytest.approx(0.5 * units.AIR_DENSITY * units.CD_TANGENTIAL * math.pi * 1e-3 * L / LAM)
+    ct = 0.5 * units.AIR_DENSITY * units.CD_TANGENTIAL * math.pi * 1e-3 * L / LAM
+    assert n["drag_tangential"] == pytest.approx(ct)
     assert units.AIR_DENSITY == 1.2 and units.CD_NORMAL == 1.2 and units.CD_TANGENTIAL == 0.01
     assert "drag_normal" not in units.body_numbers(L, M, ei=1.0)  # no diameter: no drag
 

@@ -652,7 +652,8 @@ def combine(paths) -> "xr.Dataset":
     pieces, names, inputs = [], [], []
     for i, item in enumerate(items):
         name, ds = _run_piece(item, i)
-        keys = COMBINE_SAME_INPUTS + ("body",) + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
+        keys = COMBINE_SAME_INPUTS + ("body",) + (
+            ("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
         names.append(name)
@@ -669,7 +670,8 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.expand_dims(chi=[chi], N=[N])
         ds.attrs = {}
         pieces.append(ds)
-    for k in COMBINE_SAME_INPUTS + ("body", "dt0"):  # (body: a line's body, its JSON) the method first: it decides whether dt0 is compared
+    # the method first: it decides whether dt0 is compared; body: a line's body (its JSON)
+    for k in COMBINE_SAME_INPUTS + ("body", "dt0"):
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue

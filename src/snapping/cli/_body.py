@@ -110,7 +110,8 @@ def body_si_inputs(args) -> dict | None:
         return None
     opts = ", ".join("--" + k.replace("_", "-") for k in given)
     if getattr(args, "length", None) is None or getattr(args, "mass", None) is None:
-        raise SnappingInputError(f"{opts} need{'s' if len(given) == 1 else ''} --length METERS and --mass KG: the line's body in SI is made "
+        verb = "needs" if len(given) == 1 else "need"
+        raise SnappingInputError(f"{opts} {verb} --length METERS and --mass KG: the line's body in SI is made "
                                  f"nondimensional with the chain's length and mass per length")
     twins = {"ei": ("bending",), "diameter": ("drag_normal", "drag_tangential"), "tip_drag_area": ("tip_drag",),
              "wind_si": ("wind",)}
