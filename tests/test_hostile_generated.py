@@ -239,6 +239,10 @@ SPECS = {
                               {"h": [0.1, 0.05, 0.025, 0.0125], "q": [3.02, 3.005, 3.00125, 3.0003125]}, [], ["h", "q"]),
     "continuum.converge": (lambda F, **k: continuum.converge(**k), {"chi": 0.3},
                            ["chi", "levels", "ratio", "first", "tol", "workers", "frac0", "h_min0", "h_max0"], []),
+    # a line's body in SI (issue 21)
+    "Body.from_si": (lambda F, **k: simulate.Body.from_si(**k), {"length": 2.0, "mass": 0.02, "diameter": 1e-3},
+                     ["ei", "bending_damping", "diameter", "air_density", "cd_normal", "cd_tangential",
+                      "tip_drag_area"], []),
     # simulate: the constructors
     "Links.uniform": (lambda F, **k: Links.uniform(**k), {"N": 10}, ["N", "tip_mass"], []),
     "Links.taper": (lambda F, **k: Links.taper(**k), {"N": 10, "ratio": 0.5}, ["N", "ratio", "power", "tip_mass"],
@@ -334,6 +338,10 @@ VALID = {
     "scaling.fit_run": {"tol=tiny", "tol=huge"},
     "continuum.level_parameters": {"first=zero", "first=neg"},
     "continuum.extrapolate": {"q=neg", "q=zero", "q=tiny", "q=huge"},
+    # zero and the smallest subnormal are valid (negligible) bodies; None: no drag, or the defaults
+    "Body.from_si": {f"{p}={t}" for p in ("ei", "bending_damping", "diameter", "air_density", "cd_normal",
+                                           "cd_tangential", "tip_drag_area") for t in ("zero", "tiny")}
+    | {"diameter=none", "air_density=none", "cd_normal=none", "cd_tangential=none", "tip_drag_area=none"},
     "Links.uniform": {"tip_mass=zero", "tip_mass=tiny"},
     "Links.taper": {"tip_mass=zero", "tip_mass=tiny"},
     "Links.explicit": {"tip_mass=zero", "tip_mass=tiny"},
@@ -477,6 +485,11 @@ CLI_SPECS = {
                         "--max-rejections"]),
     "simulate(fast)": (_FAST, ["--tip-mass", "--gravity", "--taper", "--pin-motion=pull:{},0",
                                "--pin-motion=flick:1,0,{}", "--supports={},0.2"]),
+    "simulate(body)": (_FAST, ["--bending", "--bending-damping", "--drag-normal", "--drag-tangential", "--tip-drag",
+                               "--wind={},0", "--drag-linear"]),
+    "simulate(body SI)": (_FAST + ["--length", "2", "--mass", "0.02", "--diameter", "1e-3"],
+                          ["--ei", "--diameter", "--air-density", "--cd-normal", "--cd-tangential", "--tip-drag-area",
+                           "--wind-si={},0"]),
     "fit": (["fit", "{run_nc}", "--json", "--no-joint"], ["--tol", "--min-width", "--window=v_max={},1e-2",
                                                           "--window=v_max=1e-4,{}"]),
     "sweep": (["sweep", "--chi", "0.3", "--N", "10", "-o", "{root}/sweep"], ["--chi", "--N", "--tol", "--workers",
@@ -504,7 +517,12 @@ CLI_VALID = {
     ("design", "--tip-mass", "0"), ("design", "--tip-mass", "5e-324"), ("design", "--max-tension", "1e308"),
     ("design", "--max-speed", "1e308"), ("design", "--max-acceleration", "1e308"),
     ("fit", "--window=v_max={},1e-2", "5e-324"), ("fit", "--window=v_max=1e-4,{}", "1e308"),
-}
+    # a line's body (issue 21): zero is no body, the smallest subnormal a valid (negligible) one, a wind any sign
+    *{("simulate(body)", o, v) for o in ("--bending", "--bending-damping", "--drag-normal", "--drag-tangential",
+                                         "--tip-drag", "--wind={},0", "--drag-linear") for v in ("0", "5e-324")},
+    *{("simulate(body SI)", o, v) for o in ("--ei", "--diameter", "--air-density", "--cd-normal", "--cd-tangential",
+                                            "--tip-drag-area", "--wind-si={},0") for v in ("0", "5e-324")},
+}  # (a wind "-1,0" typed as a separate word is argparse's refusal, naming the option: --wind=-1,0 is the way)
 #: a bound that cannot be met: the run fails by design (exit 1, one line on stderr)
 CLI_FAILS = {("simulate", "--max-energy-drift", "5e-324")}
 #: valid values that would start a long computation (converge's --first: level_parameters checks it)

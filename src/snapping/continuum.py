@@ -30,6 +30,7 @@ Example
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import os
 import time
@@ -139,12 +140,19 @@ class Convergence:
 
     def summary(self) -> dict:
         a = self.dataset.attrs
-        return {k: (v.item() if isinstance(v, np.generic) else v) for k, v in a.items()}
+        out = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in a.items()}
+        if out.get("body"):  # a line's body: its numbers (beta, drag, ...)
+            from .simulate.body import summarize
+
+            out["body"] = summarize(str(out["body"]))
+        return out
 
     def table(self) -> str:
         ds = self.dataset
         lines = [f"continuum limit, chi = {ds.attrs['chi']:g} ({ds.attrs['lumping']} lumping, "
-                 f"free end {ds.attrs['free_end']}):",
+                 f"free end {ds.attrs['free_end']}"
+                 + (f"; uniform chains with the body {self.summary()['body']}" if ds.attrs.get("body") else "")
+                 + "):",
                  f"{'level':>5} {'links':>7} {'frac':>8} {'h_min':>8} " + " ".join(f"{q:>13}" for q in QUANTITIES)
                  + f" {'wall s':>7} {'CPU s':>7}"]
         for k in range(ds.sizes["level"]):
@@ -165,20 +173,48 @@ class Convergence:
         return convergence_figure(self.dataset, path)
 
 
-def _run_level(args):
-    """One level's run (in a worker process): the graded chain, its peaks and cost."""
-    chi, params, lumping, free_end, tol, path = args
-    from .simulate import Links, Problem, load_run, run
+def _level_links(chi, params):
+    """The link lengths of a level: fold-following (``frac``, ``h_min``, ``h_max``) or, with a
+    body, ``n_links`` uniform links."""
+    if "n_links" in params:
+        return np.full(int(params["n_links"]), 1.0 / int(params["n_links"]))
     from .simulate import grading
 
-    h = grading.fold_following(chi, **params)
-    problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact")
+    return grading.fold_following(chi, **params)
+
+
+def _uniform_levels(levels: int, ratio: float, n0: int, first: int) -> list[dict]:
+    """Uniform chains of ``n0 / ratio**k`` links (k = first, ...): whole numbers at a constant ratio."""
+    levels = V.integer("levels", levels, 1, MAX_LEVELS)
+    ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
+    n0 = V.integer("n0", n0, 1, 10**7)
+    out = []
+    for k in range(first, first + levels):
+        x = n0 / ratio ** k
+        n = int(round(x))
+        if n < 1 or abs(n - x) > 1e-9 * x or n > 10**7:
+            raise V.SnappingInputError(f"n0={n0}, ratio={ratio!r}, first={first}: level {k} would have {x:.6g} "
+                                       f"links; with a body the levels are uniform chains of n0/ratio**k links, "
+                                       f"whole numbers from 1 to 1e7 (e.g. ratio 0.5)")
+        out.append({"n_links": n, "frac": 1.0 / n, "h_min": 1.0 / n, "h_max": 1.0 / n})
+    return out
+
+
+def _run_level(args):
+    """One level's run (in a worker process): the graded chain, its peaks and cost."""
+    chi, params, lumping, free_end, tol, path, body = args
+    from .simulate import Body, Links, Problem, load_run, run
+
+    h = _level_links(chi, params)
+    problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact",
+                               body=None if body is None else Body.from_describe(body))
     if path is not None and os.path.isfile(path):
         try:
             ds = load_run(path)
             if (ds.attrs.get("status") == "completed" and "link_length" in ds.variables
                     and np.array_equal(ds.link_length.values, h) and float(ds.attrs["tol"]) == tol
-                    and np.array_equal(ds.node_mass.values[:-1], problem.links.m)):
+                    and np.array_equal(ds.node_mass.values[:-1], problem.links.m)
+                    and (json.loads(ds.attrs["body"]) if ds.attrs.get("body") else None) == body):
                 return _level_row(ds, h, float("nan")), path  # resumed: this level is done (its CPU time unknown)
         except V.SnappingInputError:
             pass
@@ -199,7 +235,7 @@ def _level_row(ds, h, cpu_time) -> dict:
 def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0, lumping: str = "shared",
              free_end: str | None = None, tol: float = 1e-7, output=None, workers: int = 1,
              progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
-             h_max0: float = H_MAX0, overwrite: bool = False) -> Convergence:
+             h_max0: float = H_MAX0, overwrite: bool = False, body=None, n0: int = 50) -> Convergence:
     """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
     peaks to the continuum (the string).
 
@@ -241,6 +277,15 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     overwrite : bool
         Replace files in ``output`` named like a level (or ``convergence.nc``) that snapping did
         not write (default: refuse them before any run).
+    body : Body, optional
+        A line's body (:class:`snapping.simulate.Body`: bending stiffness, drag; numbers, the
+        same at every level): the limit is then the rod's, whose fold has a finite radius
+        (about sqrt(B/T)), and the levels are uniform chains of ``n0 / ratio**k`` links
+        (k = ``first``, ...; the fold-following grading resolves the string's singular fold,
+        whose smallest links a bending wave's explicit step could not afford). The
+        resolution ``frac`` is then the link length 1/N.
+    n0 : int
+        Links of level 0 with a body (default 50).
 
     Returns
     -------
@@ -259,7 +304,19 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
     chi = check_chi(chi)
     workers = V.integer("workers", workers, 1)
     first = V.integer("first", first, -20, 100)
-    params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)
+    body_d = None
+    if body is not None:
+        from .sweep import _body_description
+
+        from .simulate import Body
+
+        body_d = _body_description(body, "body")
+        if not Body.from_describe(body_d).active:  # (a body that changes nothing: the string's study)
+            body_d = None
+    if body_d is not None:
+        params = _uniform_levels(levels, ratio, n0, first)
+    else:
+        params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)
     paths = [None] * len(params)
     # check every level's chain before any runs (bad input raises here, nothing written)
     from .simulate import Links, grading
@@ -267,7 +324,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
 
     opts = RunOptions(tol=tol)
     for k, p in enumerate(params):
-        h = grading.fold_following(chi, **p)
+        h = _level_links(chi, p) if body_d is not None else grading.fold_following(chi, **p)
         Links.graded(h, lumping=lumping, free_end=free_end)
         try:  # (what simulate refuses: a level that would not fit in memory, e.g. at chi = 1e-100)
             check_memory(h.size, opts, chi=chi, method="fast")
@@ -282,7 +339,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             out = stack.enter_context(output_dir(output, name="output"))
             paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
             check_own_files(paths + [os.path.join(out, "convergence.nc")], name="output", overwrite=overwrite)
-        jobs = [(chi, p, lumping, free_end, tol, path) for p, path in zip(params, paths)]
+        jobs = [(chi, p, lumping, free_end, tol, path, body_d) for p, path in zip(params, paths)]
         t0 = time.perf_counter()
         rows = [None] * len(jobs)
         if workers == 1 or len(jobs) == 1:
@@ -303,6 +360,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             # (workers leave with this process)
             _workers.run_all(min(workers, len(jobs)), _run_level, [(job,) for job in jobs], collect)
         ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
+        if body_d is not None:
+            ds.attrs["grading"] = "uniform"
+            ds.attrs["body"] = json.dumps(body_d, sort_keys=True)
         if output is not None:
             from .simulate import save
 

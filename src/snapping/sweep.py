@@ -92,7 +92,10 @@ class Grid:
     """A grid of runs: every combination of ``chi`` and ``N``, with the same ``options``
     (any other keyword of :func:`snapping.simulate.run`, e.g. ``tol``, ``method``); what
     ``options`` leaves out takes :func:`snapping.simulate.run`'s default (method ``fast``,
-    chords ``exact``, the method's tol).
+    chords ``exact``, the method's tol). ``options["body"]``: a line's body
+    (:class:`snapping.simulate.Body` with numbers, not per-node profiles), the same at every
+    point: each run is ``Problem.catenary(chi, N, chords=..., body=...)``; it is kept as its
+    description (:meth:`~snapping.simulate.Body.describe`), which names the run files.
     """
 
     chi: list
@@ -111,10 +114,12 @@ class Grid:
 
         if "output" in self.options:
             raise V.SnappingInputError("options must not contain 'output': the sweep names each run's file")
+        if "body" in self.options:  # a line's body, the same at every grid point: kept as its description
+            self.options = {**self.options, "body": _body_description(self.options["body"])}
 
         for chi in self.chi:  # every run's inputs, checked before any starts
             for N in self.N:
-                check_inputs(chi, N, **self.options)
+                check_inputs(**_run_kwargs(dict(chi=chi, N=N, **self.options)))
 
     def points(self) -> list[dict]:
         """One dict of run keywords per grid point."""
@@ -134,6 +139,36 @@ class Grid:
         return [self.path(out_dir, p["chi"], p["N"]) for p in self.points()]
 
 
+def _body_description(body, name: str = "options['body']") -> dict:
+    """The description (:meth:`snapping.simulate.Body.describe`) of a sweep's body (a Body or
+    a description), checked to be one that every chain of the grid can take."""
+    from .simulate import Body
+
+    if isinstance(body, dict):
+        body = Body.from_describe(body)
+    if not isinstance(body, Body):
+        raise V.SnappingInputError(f"{name}={type(body).__name__} is not a snapping.simulate.Body")
+    d = body.describe()
+    if any(isinstance(v, (list, dict)) for k, v in d.items() if k not in ("wind", "clamp")):
+        raise V.SnappingInputError(f"{name}: a body refined or swept over N takes numbers (the same at every N), "
+                                   f"not per-node arrays or functions of s; run such bodies one by one")
+    return d
+
+
+def _run_kwargs(params: dict) -> dict:
+    """The keywords of :func:`snapping.simulate.run` for one grid point: with a ``body``, the
+    problem ``Problem.catenary(chi, N, chords=..., body=...)`` in place of chi, N and chords."""
+    if "body" not in params:
+        return params
+    from .simulate import Body, Problem
+
+    kw = dict(params)
+    body = Body.from_describe(kw.pop("body"))
+    chi, N, chords = kw.pop("chi"), kw.pop("N"), kw.pop("chords", None)
+    kw["problem"] = Problem.catenary(chi, N, chords=chords or "exact", body=body)
+    return kw
+
+
 def _run_one(params: dict, path: str) -> str:
     """Worker: run one simulation, checkpointed to ``path`` and saved there atomically.
 
@@ -144,10 +179,10 @@ def _run_one(params: dict, path: str) -> str:
     """
     from . import simulate
 
-    if simulate.is_resumable(path, **params):
+    if simulate.is_resumable(path, **{k: v for k, v in params.items() if k != "body"}):
         simulate.resume(path, **{k: params[k] for k in ("checkpoint_every",) if k in params})
     else:
-        simulate.run(**params, output=path, overwrite=True)  # the sweep owns its run files
+        simulate.run(**_run_kwargs(params), output=path, overwrite=True)  # the sweep owns its run files
     return path
 
 
@@ -305,8 +340,7 @@ def _check_room(out: Path, todo: list) -> None:
     from ._files import _size
     from .simulate.driver import check_inputs
 
-    need = sum(check_inputs(p["chi"], p["N"], **{k: v for k, v in p.items() if k not in ("chi", "N")})["file_bytes"]
-               for p, _ in todo)
+    need = sum(check_inputs(**_run_kwargs(p))["file_bytes"] for p, _ in todo)
     free = shutil.disk_usage(out).free
     if need > free:
         raise V.SnappingInputError(f"out_dir={str(out)!r}: the {len(todo)} run files to write need about "
@@ -648,7 +682,8 @@ def combine(paths) -> "xr.Dataset":
     pieces, names, inputs = [], [], []
     for i, item in enumerate(items):
         name, ds = _run_piece(item, i)
-        keys = COMBINE_SAME_INPUTS + (("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
+        keys = COMBINE_SAME_INPUTS + ("body",) + (
+            ("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
         if "problem" in ds.attrs:  # a general problem's chain, held end and gravity: compared and kept too
@@ -667,7 +702,8 @@ def combine(paths) -> "xr.Dataset":
         ds = ds.expand_dims(chi=[chi], N=[N])
         ds.attrs = {}
         pieces.append(ds)
-    for k in COMBINE_SAME_INPUTS + ("dt0", "problem"):  # the method first: it decides whether dt0 is compared
+    # the method first: it decides whether dt0 is compared; body: a line's body (its JSON)
+    for k in COMBINE_SAME_INPUTS + ("body", "dt0", "problem"):
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue

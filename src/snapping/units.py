@@ -48,7 +48,8 @@ from . import _validate as V
 from . import schema
 
 __all__ = ["Scales", "KIND_UNITS", "VARIABLE_KINDS", "VALUE_KINDS", "G_STANDARD", "NONDIMENSIONAL_NOTE",
-           "kind_of", "to_si", "from_si", "summary_to_si", "values_to_si", "si_rows", "fit_rows", "fit_to_si"]
+           "kind_of", "to_si", "from_si", "summary_to_si", "values_to_si", "si_rows", "fit_rows", "fit_to_si",
+           "AIR_DENSITY", "CD_NORMAL", "CD_TANGENTIAL", "body_numbers"]
 
 #: the default gravity, m s-2 (what ``snapping estimate`` has always used)
 G_STANDARD = 9.81
@@ -478,3 +479,140 @@ def fit_rows(fit: dict, scales: Scales) -> list[tuple[str, object, object, str]]
 def fit_to_si(fit: dict, scales: Scales) -> dict:
     """``{name: {"value": SI value, "units": CF string}}`` of the rows of :func:`fit_rows`."""
     return {k: {"value": si, "units": u} for k, _, si, u in fit_rows(fit, scales)}
+
+
+# ------------------------------------------------------------------ a line's body in SI
+#: air density at sea level and about 20 C, kg m-3 (the default of the SI drag options)
+AIR_DENSITY = 1.2
+#: cross-flow drag coefficient of a long circular cylinder at subcritical Reynolds numbers
+#: (about 1e3 to 2e5: a fly line, a whip, a cable in a breeze), on the projected area d per length
+CD_NORMAL = 1.2
+#: skin-friction coefficient of the tangential (axial) drag, on the wetted area pi d per length
+#: (an estimate: fly-line and mooring-line models use 0.01 or less)
+CD_TANGENTIAL = 0.01
+
+#: the body's SI inputs: (dimension as a pint unit, meaning)
+BODY_SI_INPUTS = {
+    "ei": ("N m**2", "bending stiffness EI"),
+    "bending_damping": ("N m**2 s", "Kelvin-Voigt bending damping (moment per curvature rate)"),
+    "curvature": ("1/m", "natural curvature"),
+    "diameter": ("m", "diameter of the line (drag)"),
+    "air_density": ("kg/m**3", "air density"),
+    "cd_normal": ("", "cross-flow drag coefficient (on the projected area d per length)"),
+    "cd_tangential": ("", "skin-friction coefficient (on the wetted area pi d per length)"),
+    "tip_drag_area": ("m**2", "drag area C_d A of the tip body"),
+    "wind": ("m/s", "uniform wind velocity (wx, wy), y downward"),
+}
+
+
+def _si_profile(name, v, factor, length):
+    """A body profile given in SI (a number, one value per node, or a function of the
+    arclength s in m from the held end) times ``factor``: the nondimensional profile
+    (a function of the nondimensional s = s_SI / L)."""
+    import numpy as np
+
+    if callable(v):
+        def f(s, _v=v):
+            return factor * float(_v(s * length))
+
+        f.__name__ = f"{getattr(v, '__name__', 'function')} (SI) x {factor:.6g}"
+        return f
+    if np.ndim(v) == 0:
+        x = V.real(name, v)
+        if not (math.isfinite(x) and (x >= 0.0 or name == "curvature")):
+            raise V.SnappingInputError(f"{name}={x!r} is out of range: must be finite and >= 0 "
+                                       f"({BODY_SI_INPUTS[name][0] or 'dimensionless'})")
+        return x * factor
+    a = np.asarray(V.float_array(name, v), dtype=float)
+    if a.ndim != 1 or a.size == 0 or not np.all(np.isfinite(a)) or (name != "curvature" and np.any(a < 0.0)):
+        raise V.SnappingInputError(f"{name} must be one finite value >= 0 per node (a 1-D array); got shape "
+                                   f"{a.shape}")
+    return a * factor
+
+
+def body_numbers(length, mass, g: float = G_STANDARD, *, ei=0.0, bending_damping=0.0, curvature=0.0,
+                 diameter=None, air_density: float | None = None, cd_normal: float | None = None,
+                 cd_tangential: float | None = None, tip_drag_area: float = 0.0, wind=None) -> dict:
+    """The nondimensional numbers of a line's body (the keywords of
+    :class:`snapping.simulate.Body`) from its SI description, for a chain of ``length`` L [m]
+    and ``mass`` M [kg] (mean mass per length ``lambda = M/L``) under ``g`` [m s-2].
+
+    The conversions (each checked dimensionless by pint; the force per length unit is
+    ``lambda g``, the speed unit ``sqrt(g L)``):
+
+    * bending number ``beta = EI / (lambda g L^3)`` (``ei`` in N m^2);
+    * bending damping ``eta / (lambda g L^3 sqrt(L/g))`` (``bending_damping`` in N m^2 s);
+    * natural curvature ``kappa0 L`` (``curvature`` in 1/m);
+    * quadratic normal drag: the force per length ``0.5 rho C_n d |v_n| v_n`` (cylinder
+      cross-flow, on the projected area d per length; Morison's drag term, as MoorDyn and
+      OrcaFlex write it) gives ``drag_normal = 0.5 rho C_n d L / lambda``;
+    * quadratic tangential drag: ``0.5 rho C_t (pi d) |v_t| v_t`` (skin friction on the wetted
+      area pi d per length, MoorDyn's convention for its axial drag) gives
+      ``drag_tangential = 0.5 rho C_t pi d L / lambda``;
+    * the tip body: ``0.5 rho (C_d A) |v| v`` gives ``tip_drag = 0.5 rho C_d A L / M``;
+    * wind ``w / sqrt(g L)``.
+
+    ``diameter`` (m) turns on the line's drag with ``cd_normal`` (default :data:`CD_NORMAL`)
+    and ``cd_tangential`` (default :data:`CD_TANGENTIAL`); ``air_density`` defaults to
+    :data:`AIR_DENSITY`. ``ei``, ``bending_damping``, ``curvature`` and ``diameter`` may be
+    numbers, one value per node (index 0 the free end) or functions of the arclength s in m
+    from the held end (a taper).
+
+    >>> n = body_numbers(2.0, 0.02, ei=1e-3, diameter=1e-3)   # 2 m, 10 g/m, EI 1e-3 N m^2, 1 mm
+    >>> round(n["bending"], 8), round(n["drag_normal"], 6), round(n["drag_tangential"], 8)
+    (0.00127421, 0.144, 0.00376991)
+    """
+    ureg = registry()
+    s = Scales(length, mass, g)
+    L, M, gg = s.length, s.mass, s.g
+    lam = M / L
+    Q = ureg.Quantity
+    lam_q, L_q, g_q, M_q = Q(lam, "kg/m"), Q(L, "m"), Q(gg, "m/s**2"), Q(M, "kg")
+
+    def dimensionless(q) -> float:  # pint: a wrong formula raises DimensionalityError here
+        return float(q.to("dimensionless").magnitude)
+
+    out: dict = {}
+    f_bend = dimensionless(Q(1.0, "N m**2") / (lam_q * g_q * L_q ** 3))
+    out["bending"] = _si_profile("ei", ei, f_bend, L)
+    f_eta = dimensionless(Q(1.0, "N m**2 s") / (lam_q * g_q * L_q ** 3 * (L_q / g_q) ** 0.5))
+    out["damping"] = _si_profile("bending_damping", bending_damping, f_eta, L)
+    out["curvature"] = _si_profile("curvature", curvature, dimensionless(Q(1.0, "1/m") * L_q), L)
+    tip_area = 0.0
+    if tip_drag_area is not None:
+        tip_area = V.real("tip_drag_area", tip_drag_area)
+        if not (math.isfinite(tip_area) and tip_area >= 0.0):
+            raise V.SnappingInputError(f"tip_drag_area={tip_area!r} is out of range: must be finite and >= 0 (m^2)")
+    drag_given = diameter is not None or tip_area > 0.0
+    if not drag_given and (cd_normal is not None or cd_tangential is not None):
+        raise V.SnappingInputError("cd_normal/cd_tangential need diameter (m): the drag per length is "
+                                   "0.5 rho C d |v| v")
+    if drag_given or air_density is not None:
+        rho = AIR_DENSITY if air_density is None else V.real("air_density", air_density)
+        if not (math.isfinite(rho) and 0.0 <= rho <= 1e5):
+            raise V.SnappingInputError(f"air_density={rho!r} is out of range: must be finite, in [0, 1e5] (kg/m^3)")
+    if diameter is not None:
+        cn = CD_NORMAL if cd_normal is None else V.real("cd_normal", cd_normal)
+        ct = CD_TANGENTIAL if cd_tangential is None else V.real("cd_tangential", cd_tangential)
+        for name, c in (("cd_normal", cn), ("cd_tangential", ct)):
+            if not (math.isfinite(c) and 0.0 <= c <= 1e3):
+                raise V.SnappingInputError(f"{name}={c!r} is out of range: a drag coefficient, finite, in [0, 1000]")
+        rho_q = Q(rho, "kg/m**3")
+        f_n = dimensionless(0.5 * rho_q * cn * Q(1.0, "m") * L_q / lam_q)
+        f_t = dimensionless(0.5 * rho_q * ct * math.pi * Q(1.0, "m") * L_q / lam_q)
+        out["drag_normal"] = _si_profile("diameter", diameter, f_n, L)
+        out["drag_tangential"] = _si_profile("diameter", diameter, f_t, L)
+    if tip_area > 0.0:
+        out["tip_drag"] = dimensionless(0.5 * Q(rho, "kg/m**3") * Q(tip_area, "m**2") * L_q / M_q)
+    if wind is not None:
+        import numpy as np
+
+        try:
+            w = np.asarray(wind, dtype=float)
+        except (TypeError, ValueError):
+            w = np.zeros(0)
+        if w.shape != (2,) or not np.all(np.isfinite(w)):
+            raise V.SnappingInputError(f"wind={wind!r} must be two finite numbers (wx, wy) in m/s")
+        f_w = dimensionless(Q(1.0, "m/s") / (g_q * L_q) ** 0.5)
+        out["wind"] = (float(w[0]) * f_w, float(w[1]) * f_w)
+    return out

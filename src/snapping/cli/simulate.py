@@ -56,6 +56,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
             "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
             "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
+            "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
@@ -191,6 +192,11 @@ def _cmd_simulate(args) -> int:
                 problem = True
     if args.output:
         summary["output"] = args.output
+    from ._body import body_si_inputs, si_summary
+
+    body_si = si_summary(body_si_inputs(args)) if args.resume is None else None
+    if body_si:
+        summary["body_si"] = body_si  # the SI inputs the body's numbers ("body") were made from
     bad = _nonfinite(summary)
     if bad and failed is None:  # a completed run whose results are not numbers: not a result
         where = f" (the run file is {args.output})" if args.output else ""
@@ -203,7 +209,7 @@ def _cmd_simulate(args) -> int:
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         rows = []
         for k, v in summary.items():
-            if k in ("snap_note", "peaks"):
+            if k in ("snap_note", "peaks", "body", "body_si"):
                 continue
             note = note_units.get(k)
             if v is None and k in precise:
@@ -218,11 +224,27 @@ def _cmd_simulate(args) -> int:
         )
         if not reached and summary.get("snap_note"):
             print(f"  note: {summary['snap_note']}")
+        _print_body(summary)
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
     return 0
+
+
+def _print_body(summary) -> None:
+    """The body's nondimensional numbers (and the SI inputs they were made from) under the table."""
+    body = summary.get("body")
+    if not body:
+        return
+    from ._body import BODY_NOTES
+
+    rows = [(f"body: {k}", v if not isinstance(v, list) else ", ".join(f"{x:.6g}" for x in v), BODY_NOTES.get(k))
+            for k, v in body.items()]
+    for k, q in (summary.get("body_si") or {}).items():
+        rows.append((f"  from SI: {k}", q["value"] if not isinstance(q["value"], list) else
+                     ", ".join(f"{x:.6g}" for x in q["value"]), q["units"]))
+    print_table(rows)
 
 
 # ------------------------------------------------------------------ --resume
@@ -231,7 +253,8 @@ _RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "s
                 "chords", "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
 #: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
 _PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity", "bending", "damping",
-                    "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp")
+                    "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp", "ei", "diameter",
+                    "air_density", "cd_normal", "cd_tangential", "tip_drag_area", "wind_si")
 
 
 def _given_text(args, key: str) -> str:

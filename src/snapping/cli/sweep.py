@@ -30,7 +30,8 @@ def _add_sweep(sub) -> None:
             "  snapping sweep --chi 0.25,0.5 --N 50 -o sweep_si --length 1.022 --mass 0.0208   # SI too\n"
             "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --ensemble 4 -o sweep_ensemble\n"
             "  snapping sweep --chi 0.25,0.5 --N 200 --method euler-richardson --chords arclength -o sweep_paper\n"
-            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_cluster"
+            "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_cluster\n"
+            "  snapping sweep --chi 0.2,0.3 --N 100 --bending 1e-3 --drag-normal 0.5 -o sweep_body   # a line's body"
         ),
     )
     p.add_argument("--chi", type=_floats, required=True, help="comma-separated end separations in (0, 1)")
@@ -50,6 +51,9 @@ def _add_sweep(sub) -> None:
                    help="replace DIR/sweep.nc even if it holds another grid's runs, and files named like its runs "
                         "that snapping did not write (default: refuse)")
     p.add_argument("--json", action="store_true", help="print the per-run results as one JSON object")
+    from ._body import add_body_options
+
+    add_body_options(p)  # a line's body, the same at every (chi, N)
     _add_si_options(p)
     p.set_defaults(func=_cmd_sweep)
 
@@ -62,6 +66,11 @@ def _cmd_sweep(args) -> int:
     scales = _si_scales(args)
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method), ("chords", args.chords))
                if v is not None}
+    from ._body import body_from_args
+
+    body = body_from_args(args)
+    if body is not None and body.active:
+        options["body"] = body
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
     failed = None
@@ -94,6 +103,10 @@ def _cmd_sweep(args) -> int:
     bad = _nonfinite({"runs": rows})
     if args.json:
         obj = {"sweep": None if out is None else str(out), "runs": rows}
+        if "body" in grid.options:
+            from ..simulate.body import summarize
+
+            obj["body"] = summarize(grid.options["body"])
         if failed is not None:
             obj["failed"] = [f.to_dict() for f in failed.failures]
         if bad:
@@ -109,6 +122,10 @@ def _cmd_sweep(args) -> int:
             ca = combined.attrs
             print(f"  method {ca.get('method', '?')}, chords {ca.get('chords', '?')}, tol {ca.get('tol', '?')}; "
                   f"units: nondimensional (length L, mass M, time sqrt(L/g), force M g)")
+            if "body" in grid.options:
+                from ..simulate.body import summarize
+
+                print(f"  body (every run): {summarize(grid.options['body'])}")
             print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
             for r in rows:
                 t_snap = "no snap" if r["t_snap_v"] is None else f"{r['t_snap_v']:.6g}"
@@ -151,6 +168,7 @@ def _add_converge(sub) -> None:
             "  snapping converge --chi 0.05 --ratio 0.7071067811865476 --first 3   # 3 digits, ~4 min\n"
             "  snapping converge --chi 0.25 --lumping paper      # the paper's lumping: first order\n"
             "  snapping converge --chi 0.25 --length 1.022 --mass 0.0208   # the limits in SI too\n"
+            "  snapping converge --chi 0.25 --bending 1e-2 --n0 25         # the rod's limit: uniform chains\n"
             "\n"
             "With -o DIR every level's run file is kept there and a rerun reuses the finished levels."
         ),
@@ -173,6 +191,11 @@ def _add_converge(sub) -> None:
                    help="replace an existing --plot file, and files in -o named like a level that snapping did not "
                         "write (default: refuse them)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--n0", type=int, default=50, metavar="N",
+                   help="with a body: links of level 0 (uniform chains of N/ratio^k links; default 50)")
+    from ._body import add_body_options
+
+    add_body_options(p)
     _add_si_options(p)
     p.set_defaults(func=_cmd_converge)
 
@@ -180,9 +203,10 @@ def _add_converge(sub) -> None:
 def _cmd_converge(args) -> int:
     from .. import continuum, units
 
+    from .._validate import SnappingInputError
+
     scales = _si_scales(args)
     if args.plot is not None:
-        from .._validate import SnappingInputError
         from .._files import figure_format
         from ..simulate.dataset import check_writable
 
@@ -191,9 +215,16 @@ def _cmd_converge(args) -> int:
             check_writable(args.plot, name="plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
+    from ._body import body_from_args
+
+    body = body_from_args(args)
+    if "n0" in getattr(args, "_explicit", ()) and body is None:
+        raise SnappingInputError(f"--n0 {args.n0} needs a body (--bending, --drag-normal, ...): without one the "
+                                 f"levels are fold-following chains (--first, --ratio)")
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
                              free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
-                             progress=None if not args.json else False, overwrite=args.overwrite)
+                             progress=None if not args.json else False, overwrite=args.overwrite,
+                             **({} if body is None or not body.active else {"body": body, "n0": args.n0}))
     if args.plot is not None:
         res.plot(args.plot)
     if args.json:

@@ -48,7 +48,7 @@ import numpy as np
 
 from .. import _validate as V
 
-__all__ = ["Body", "PROFILE_MAX"]
+__all__ = ["Body", "PROFILE_MAX", "summarize"]
 
 #: largest coefficient accepted (stiffness, damping, drag, curvature, wind), nondimensional
 PROFILE_MAX = 1e8
@@ -184,6 +184,46 @@ class Body:
     def has_bending(self) -> bool:
         return self.clamp is not None or not (self._zero("bending") and self._zero("damping"))
 
+    @classmethod
+    def from_si(cls, length, mass, g: float = 9.81, *, ei=0.0, bending_damping=0.0, curvature=0.0, diameter=None,
+                air_density=None, cd_normal=None, cd_tangential=None, tip_drag_area=0.0, wind=None,
+                drag_linear_normal=0.0, drag_linear_tangential=0.0, clamp=None) -> "Body":
+        """The body of a line described in SI, for a chain of ``length`` [m] and ``mass`` [kg]
+        under ``g`` [m s-2]: EI in N m^2, the diameter in m (drag with the coefficients
+        ``cd_normal``, ``cd_tangential``), the air density in kg/m^3, the tip body's drag area
+        C_d A in m^2, the wind in m/s (the conversions: :func:`snapping.units.body_numbers`).
+        The linear drags and the clamp stay nondimensional.
+
+        >>> b = Body.from_si(2.0, 0.02, ei=1e-3, diameter=1e-3)   # 2 m of 10 g/m line
+        >>> round(b.bending, 8), round(b.drag_normal, 6)
+        (0.00127421, 0.144)
+        """
+        from ..units import body_numbers
+
+        si = {"ei": ei, "bending_damping": bending_damping, "curvature": curvature, "diameter": diameter,
+              "tip_drag_area": tip_drag_area, "wind": wind}
+        kw = body_numbers(length, mass, g, air_density=air_density, cd_normal=cd_normal, cd_tangential=cd_tangential,
+                          **si)
+        made = {"ei": ("bending",), "bending_damping": ("damping",), "curvature": ("curvature",),
+                "diameter": ("drag_normal", "drag_tangential"), "tip_drag_area": ("tip_drag",), "wind": ("wind",)}
+        for name, keys in made.items():  # a number out of the body's range is named by its SI input
+            if all(k in kw for k in keys):
+                try:
+                    cls(**{k: kw[k] for k in keys})
+                except V.SnappingInputError as exc:
+                    v = si[name]
+                    text = f"{v!r}" if np.ndim(v) == 0 and not callable(v) else "(its values)"
+                    raise V.SnappingInputError(f"{name}={text} gives {exc}") from None
+        return cls(kw.pop("bending"), drag_linear_normal=drag_linear_normal,
+                   drag_linear_tangential=drag_linear_tangential, clamp=clamp, **kw)
+
+    def numbers(self, h=None) -> dict:
+        """The body's nondimensional numbers, compactly, for a summary: every entry that is
+        not zero (a profile that varies: its range ``[min, max]`` over the nodes; a function
+        of s: over the nodes of a chain with links ``h``, else its name), ``beta`` for the
+        bending number."""
+        return summarize(self.describe(h))
+
     @staticmethod
     def taper_profile(B0: float, ratio: float, power: float = 1.0):
         """``B(s) = B0 (1 - c s/L)^power`` with ``B(L)/B(0) = ratio`` (s from the held end,
@@ -234,9 +274,9 @@ class Body:
         nodes ``x, y`` (index N the held end) leaves the held end."""
         if not (isinstance(self.clamp, str) and self.clamp == "start"):
             return self
-        d = self.describe()
-        d["clamp"] = math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1]))
-        return Body.from_describe(d)
+        kw = {k: getattr(self, k) for k in _PROFILES if k != "bending"}  # (functions of s kept as they are)
+        return Body(self.bending, wind=self.wind, tip_drag=self.tip_drag,
+                    clamp=math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1])), **kw)
 
     def model(self, mdl, h, theta0: float):
         """The compiled model (:func:`snapping.simulate.forced.make_body_model`) from the general
@@ -314,3 +354,47 @@ class Body:
             c = (c["t"], c["angle"])
         return cls(kw.pop("bending"), wind=tuple(d.get("wind", (0.0, 0.0))), tip_drag=d.get("tip_drag", 0.0),
                    clamp=c, **kw)
+
+
+#: the names :func:`summarize` gives the body's numbers
+SUMMARY_NAMES = {"bending": "beta", "curvature": "curvature", "damping": "bending_damping",
+                 "drag_normal": "drag_normal", "drag_tangential": "drag_tangential",
+                 "drag_linear_normal": "drag_linear_normal", "drag_linear_tangential": "drag_linear_tangential"}
+
+
+def summarize(d: dict) -> dict:
+    """The nonzero numbers of a body description (:meth:`Body.describe`, or its JSON as a run
+    records it in its attribute ``body``), compact: ``beta`` (the bending number
+    B/(lambda g L^3)), the drag numbers, the wind, the tip drag and the clamp; a profile that
+    varies along the line as ``[min, max]`` of its node values (a function's are recorded
+    beside it as ``nodes``).
+
+    >>> summarize(Body(1e-3, drag_normal=[0.0, 1.0, 2.0]).describe())
+    {'beta': 0.001, 'drag_normal': [0.0, 2.0]}
+    """
+    import json as _json
+
+    if isinstance(d, str):
+        d = _json.loads(d)
+    out = {}
+    for k, name in SUMMARY_NAMES.items():
+        v = d.get(k, 0.0)
+        if isinstance(v, dict):  # a function: its node values, recorded beside it
+            vals = (d.get("nodes") or {}).get(k)
+            v = vals if vals is not None else v.get("function", "function")
+        if isinstance(v, list):
+            if any(x != 0.0 for x in v):
+                out[name] = [float(min(v)), float(max(v))] if min(v) != max(v) else float(v[0])
+        elif isinstance(v, str):
+            out[name] = v
+        elif v:
+            out[name] = float(v)
+    w = d.get("wind") or [0.0, 0.0]
+    if any(w):
+        out["wind"] = [float(w[0]), float(w[1])]
+    if d.get("tip_drag"):
+        out["tip_drag"] = float(d["tip_drag"])
+    c = d.get("clamp")
+    if c is not None:
+        out["clamp"] = c if not isinstance(c, dict) else "prescribed motion (t, angle)"
+    return out

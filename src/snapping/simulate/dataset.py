@@ -86,6 +86,10 @@ def summary(ds: xr.Dataset) -> dict:
             out[k] = v.item() if isinstance(v, np.generic) else v
     if "method" in out:
         out["units"] = str(ds.attrs.get("units", UNITS))
+    if ds.attrs.get("body"):  # a line's body: its nondimensional numbers (beta, drag, ...; snapping.simulate.body)
+        from .body import summarize
+
+        out["body"] = summarize(str(ds.attrs["body"]))
     if isinstance(out.get("chi"), float) and np.isnan(out["chi"]):
         out["chi"] = None  # a general problem's start is not a catenary of some chi ('start' says what it is)
     if "snap_reached" in out:
