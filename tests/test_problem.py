@@ -312,7 +312,7 @@ def test_euler_richardson_refuses_what_it_cannot_take():
         run(0.3, problem=q)
 
 
-@pytest.mark.parametrize("name", ["problem", "pin", "general", "shapes", "errors", "driver"])
+@pytest.mark.parametrize("name", ["problem", "links", "pin", "general", "shapes", "errors", "driver"])
 def test_docstring_examples_run(name):
     import doctest
     import importlib

@@ -203,7 +203,7 @@ def test_a_run_time_refusal_and_a_crash_are_reported_with_their_kind(tmp_path, m
             raise MemoryError("out of memory")
         return real(params, path)
 
-    monkeypatch.setattr(S, "_run_one", fake)
+    monkeypatch.setattr("snapping.sweep_run._run_one", fake)  # (patched where _run_task uses it)
     with pytest.raises(S.SweepFailed) as info:
         S.run_sweep(grid, tmp_path, workers=1, progress=False)
     kinds = [(f.chi, f.kind, f.message, f.file) for f in info.value.failures]
@@ -216,7 +216,7 @@ def test_cli_sweep_with_a_failed_run_prints_the_table_and_exits_1(tmp_path, caps
     from snapping.cli import main
 
     real = S._run_one
-    monkeypatch.setattr(S, "_run_one", lambda params, path: real({**params, "dt_min": 3e-4}, path))
+    monkeypatch.setattr("snapping.sweep_run._run_one", lambda params, path: real({**params, "dt_min": 3e-4}, path))
     argv = ["sweep", "--chi", "0.1,0.5", "--N", "40", "--method", "fast", "--tol", "1e-8", "--workers", "1", "-o",
             str(tmp_path)]
     assert main(argv) == 1

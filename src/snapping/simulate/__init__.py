@@ -9,7 +9,8 @@ start shape, a moving held end, any gravity). Kernels are compiled with numba
 
 Layout (what is solved, how it is stepped, what is recorded, kept apart):
 
-* ``problem``: :class:`Problem`, :class:`Links`, :class:`PinMotion` (physics only);
+* ``problem``: :class:`Problem`, with ``links`` (:class:`Links`), ``pin``
+  (:class:`PinMotion`) and ``shape_files`` (a start shape read from a file) (physics only);
   ``chain``: the paper's initial catenary and state; ``shapes``: start curves;
 * ``kernels`` (position form: ``layout``, the array layouts; ``accelerations``, the
   tension solve; ``measures``; ``stepping``, the Euler-Richardson loop), ``angles``
