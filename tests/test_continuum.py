@@ -53,7 +53,7 @@ def test_fold_grading_follows_its_definition():
     assert h.sum() == pytest.approx(1.0, abs=1e-15) and h.min() >= h_min * (1 - 1e-6)
     on_fold = (x > 0.05) & (x < 0.5)
     target = np.minimum(frac * a * (2 * x[on_fold]) ** 0.25, h_min + gamma * x[on_fold])
-    assert np.abs(h[on_fold] / target - 1).max() < 1e-3
+    assert np.abs(h[on_fold] / target - 1).max() < 5e-4  # (the grading follows it to 3.1e-4 here)
     assert h.max() <= h_max * (1 + 1e-9) and h[-1] == pytest.approx(h_max, rel=1e-3)
     assert np.abs(np.diff(h)).max() <= gamma * h.max() * 1.01  # no kinks: the spacing changes by <= gamma h
     assert h[0] == pytest.approx(h_min, rel=0.1)

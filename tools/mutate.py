@@ -109,7 +109,10 @@ def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str
     """Apply ``m`` in the slot's copy, run its tests, restore the file: (verdict, seconds, last output)."""
     rel = m["file"]
     target = slot / rel
-    original_text = (ROOT / rel).read_text()
+    original_text = target.read_text()  # the copy's (the tree as it was when the run began)
+    if original_text.count(m["original"]) != 1:
+        return "error", 0.0, f"the original occurs {original_text.count(m['original'])} times in {rel}"
+    st = target.stat()
     mutated = original_text.replace(m["original"], m["replacement"], 1)
     env = dict(os.environ)
     env["PYTHONPATH"] = str(slot / "src")
@@ -141,7 +144,8 @@ def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str
             p.communicate()
             verdict, tail = "timeout", [f"(ran past {timeout:g} s)"]
     finally:
-        shutil.copy2(ROOT / rel, target)  # restore (with its mtime: the numba cache stays valid)
+        target.write_text(original_text)  # restore, with its mtime: the shared numba cache stays valid
+        os.utime(target, ns=(st.st_atime_ns, st.st_mtime_ns))
         if fresh:
             shutil.rmtree(fresh, ignore_errors=True)
     return verdict, time.monotonic() - t0, " | ".join(tail)
