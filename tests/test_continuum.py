@@ -104,7 +104,8 @@ def test_converge_small_study_keeps_its_invariants(tmp_path):
     # each level's CPU time where it ran (NaN where it was resumed: not measured again)
     assert np.all(ds.cpu_time.values > 0) and np.all(np.isnan(again.dataset.cpu_time.values))
     assert "CPU s" in c.table()
-    assert "converged" in ds.attrs["verdict"]
+    for q in ("v_peak", "a_peak", "sigma_peak"):  # every quantity, not any one
+        assert f"{q}: converged to {ds.attrs[q + '_digits']} significant digits" in ds.attrs["verdict"]
     # the figure of a study alone (no uniform chains beside it), as `snapping converge --plot` draws it
     png = tmp_path / "conv.png"
     c.plot(png)

@@ -84,7 +84,8 @@ def test_interpolant_reproduces_cubics_and_leave_one_out_finds_a_spike():
     g[4, 5] += math.log(1.1)  # a 10% spike at one node
     loo = T._loo_axis(ax[0], g, 0)
     assert 0.06 < loo[4, 5] < 0.12  # found at its own size (the interpolant through the others misses it)
-    assert loo[4, 0] < 1e-12 and loo[0, 5] < 0.2
+    assert loo[4, 0] < 1e-12
+    assert loo[0, 5] == loo[1, 5] > 1e-3  # the end takes its neighbour's (which sees the spike), not zero
 
 
 def test_outside_the_table_names_the_input_and_the_range():
@@ -120,9 +121,9 @@ def test_design_estimate_leads_with_the_computed_peaks_in_si():
         rod = estimates.whirling_rod(P, delta)
         for q, tq in (("v", "v_peak"), ("a", "a_peak"), ("sigma", "sigma_peak")):
             assert est.factors[scale][q] == pytest.approx(rod[q] / p.values[tq], rel=1e-12)
-    for scale, per in est.factor_ranges.items():
+    for scale, per in est.factor_ranges.items():  # (the values themselves: test_exact_checks.py, from the peaks)
         for q, (mean, lo, hi) in per.items():
-            assert 0 < lo <= mean <= hi
+            assert 0 < lo < mean < hi
     node = estimates.design_estimate(chain, chi=0.27, links=229)  # a grid point: its factors are among the chi row's
     for scale in ("delta_kappa0", "delta_c", "delta_N"):
         for q in ("v", "a", "sigma"):
@@ -174,11 +175,14 @@ def test_no_admissible_separation_says_the_minimum():
     # needs wide ends, and there the speed limit below fails
     res_v = design.design(chain, 100, max_speed=20.0, tip_mass=0.0)
     res_s = design.design(chain, 100, max_tension=1.2, tip_mass=0.0)
-    assert res_v.rows[0].admissible and res_s.rows[0].admissible
-    if res_v.rows[0].admissible[-1][1] < res_s.rows[0].admissible[0][0] or \
-            res_s.rows[0].admissible[-1][1] < res_v.rows[0].admissible[0][0]:
-        with pytest.raises(design.NoAdmissibleSeparation, match="no separation meets them all"):
-            design.design(chain, 100, max_speed=20.0, max_tension=1.2, tip_mass=0.0)
+    (v_lo, v_hi), = res_v.rows[0].admissible
+    (s_lo, s_hi), = res_s.rows[0].admissible
+    # both limits: the intersection of the two (the shipped table's peaks all fall with chi, so it is
+    # never empty here; limits met only apart are tested on a synthetic table in test_exact_checks.py)
+    both = design.design(chain, 100, max_speed=20.0, max_tension=1.2, tip_mass=0.0)
+    (lo, hi), = both.rows[0].admissible
+    assert lo == pytest.approx(max(v_lo, s_lo), rel=1e-9) and hi == pytest.approx(min(v_hi, s_hi), rel=1e-9)
+    assert v_lo != pytest.approx(s_lo, rel=1e-3)  # (two different boundaries: one of them decides)
     with pytest.raises(SnappingInputError, match="give at least one limit"):
         design.design(chain, 100)
     with pytest.raises(SnappingInputError, match="max_tension=-1"):
