@@ -138,7 +138,7 @@ def test_design_minimum_is_the_smallest_upper_end_and_its_message(fake):
     upper = peak * (1.0 + tab.err(chi))
     i = int(np.argmin(upper))
     assert i != chi.size - 1  # (not the smallest peak's: a real test of the bound's part)
-    lim = 0.5 * (peak.min() + upper.min())  # under the smallest upper end, over the smallest peak
+    lim = 0.5 * (peak[i] + upper[i])  # under the smallest upper end, over the peak there
     with pytest.raises(design.NoAdmissibleSeparation) as exc:
         design.design(CHAIN, 100, max_tension=lim, tip_mass=0.0)
     msg = str(exc.value)
