@@ -127,6 +127,15 @@ def test_design_boundaries_are_the_closed_form_crossings(fake):
     assert m["chi"] == 0.9 and m["peak"] == pytest.approx(tab.sigma(0.9) * MG, rel=1e-14)
     assert m["error"] == ERR and m["upper"] == pytest.approx(m["peak"] * (1 + ERR), rel=1e-14)
     assert d["minimum"]["max_tension"]["separation_m"] == 1.8 and "upper" not in d["minimum"]["max_tension"]
+    # and printed in metres, with the bound in percent
+    import io
+
+    out = io.StringIO()
+    design.print_design(res, file=out)
+    text = out.getvalue()
+    assert f"admissible: {2 * lo:.3g}-1.8 m (chi {lo:.3g}-0.9)" in text
+    assert f"nominal:    {2 * nlo:.3g}-1.8 m (chi {nlo:.3g}-0.9)" in text
+    assert f"smallest tension: {m['peak']:.4g} N (+-2%) at 1.8 m" in text
 
 
 def test_design_minimum_is_the_smallest_upper_end_and_its_message(fake):
@@ -386,6 +395,7 @@ def test_error_bar_of_two_triples_is_their_spread_and_order_is_the_last_triples(
     assert e["limit"] == pytest.approx(ests[1], rel=1e-14)
     assert e["error"] == pytest.approx(max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[-1])), rel=1e-9)
     # equal differences are no convergence (no order, no limit): the spread of the last three
+    assert extrapolate([0.1, 0.05, 0.025], [2.0, 2.0, 2.0])["digits"] == 16  # no difference: exact to the doubles
     for q in ([1.0, 2.0, 3.0], [1.0, 1.5, 2.0, 2.5]):
         e = extrapolate(0.1 * 0.5 ** np.arange(len(q)), q)
         assert not e["converging"] and math.isnan(e["order"])
@@ -516,6 +526,8 @@ def test_held_end_kinematics_closed_forms_and_the_cli_spec():
     assert x == pytest.approx(2.0 * (t - math.sin(w * t) / w) / w, rel=1e-13)
     assert vx == pytest.approx(2.0 * (1 - math.cos(w * t)) / w, rel=1e-13) and vx > 0
     assert ax == pytest.approx(2.0 * math.sin(w * t), rel=1e-13)
+    x, _, vx, _, ax, _ = f.kinematics(0.1 + 0.5 + 0.2)  # after its period: displaced by accel T^2/(2 pi), at rest
+    assert x == pytest.approx(2.0 * 0.5**2 / (2 * math.pi), rel=1e-13) and abs(vx) < 1e-15 and ax == 0.0
     q = parse_pin_motion("pull:1,2,0.3,0.1")
     assert (q.kind, q.accel, q.duration, q.t0) == ("pull", (1.0, 2.0), 0.3, 0.1)
     q = parse_pin_motion("pull:1,2,0.3")
