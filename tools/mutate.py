@@ -190,6 +190,7 @@ def main(argv=None) -> int:
         print("mutate: no mutation selected", file=sys.stderr)
         return 2
     jobs = max(1, args.jobs)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # (a terminated run removes its copies too)
     with tempfile.TemporaryDirectory(prefix="snapping-mutate-") as tmp:
         tmp = Path(tmp)
         shared_cache = tmp / "numba-shared"
