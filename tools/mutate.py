@@ -25,6 +25,7 @@ Usage (from the repository root; stdlib only)::
     python tools/mutate.py --min-score 90               # run them all
     python tools/mutate.py --only design-interval-le table-tip-scale
     python tools/mutate.py --class design --jobs 2 --timeout 300
+    python tools/mutate.py --control --jobs 2        # first: the covering tests pass unmutated
 
 A mutation (one ``[[mutation]]`` table)::
 
@@ -105,21 +106,23 @@ def _copy_tree(dest: Path) -> None:
             shutil.copy2(src, dest / name)
 
 
-def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str) -> tuple[str, float, str]:
-    """Apply ``m`` in the slot's copy, run its tests, restore the file: (verdict, seconds, last output)."""
+def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str,
+            control: bool = False) -> tuple[str, float, str]:
+    """Apply ``m`` in the slot's copy, run its tests, restore the file: (verdict, seconds, last output).
+    ``control``: run the tests on the unmutated copy instead (they must pass: 'survived')."""
     rel = m["file"]
     target = slot / rel
     original_text = target.read_text()  # the copy's (the tree as it was when the run began)
     if original_text.count(m["original"]) != 1:
         return "error", 0.0, f"the original occurs {original_text.count(m['original'])} times in {rel}"
     st = target.stat()
-    mutated = original_text.replace(m["original"], m["replacement"], 1)
+    mutated = original_text if control else original_text.replace(m["original"], m["replacement"], 1)
     env = dict(os.environ)
     env["PYTHONPATH"] = str(slot / "src")
     env["PYTHONDONTWRITEBYTECODE"] = "1"
     env.pop("PYTEST_ADDOPTS", None)
     fresh = None
-    if _compiled(original_text):
+    if _compiled(original_text) and not control:
         fresh = tempfile.mkdtemp(prefix="numba-", dir=slot.parent)
         env["NUMBA_CACHE_DIR"] = fresh
     else:
@@ -163,6 +166,9 @@ def main(argv=None) -> int:
     ap.add_argument("--min-score", type=float, default=0.0, help="exit 1 below this percentage caught")
     ap.add_argument("--mutations", type=Path, default=LIST, help="the mutation list (default tools/mutations.toml)")
     ap.add_argument("--python", default=sys.executable, help="the interpreter that runs pytest")
+    ap.add_argument("--control", action="store_true",
+                    help="first run each distinct set of covering tests on the unmutated copy: all must pass "
+                         "(else a 'caught' could be a test that fails anyway); exit 2 if one does not")
     args = ap.parse_args(argv)
     try:
         muts = load(args.mutations)
@@ -215,6 +221,29 @@ def main(argv=None) -> int:
             print(f"{v:9s} {sec:7.1f} s  {m['id']:40s} {m['class']}" + (f"\n          {tail}" if v != "caught" else ""),
                   flush=True)
 
+        if args.control:
+            sets = {}
+            for m in muts:
+                sets.setdefault((tuple(m["tests"]), m.get("k")), m)
+            failed = []
+
+            def control(m):
+                slot = free.pop()
+                try:
+                    v, sec, tail = run_one(m, slot, shared_cache, args.timeout, args.python, control=True)
+                finally:
+                    free.append(slot)
+                print(f"control {'ok' if v == 'survived' else 'FAILED':6s} {sec:7.1f} s  {' '.join(m['tests'])}"
+                      + (f" -k {m['k']!r}" if m.get("k") else "") + ("" if v == "survived" else f"\n          {tail}"),
+                      flush=True)
+                if v != "survived":
+                    failed.append(m["id"])
+
+            with ThreadPoolExecutor(max_workers=jobs) as pool:
+                list(pool.map(control, sets.values()))
+            if failed:
+                print(f"mutate: the covering tests of {failed} fail without a mutation", file=sys.stderr)
+                return 2
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(task, muts))
         counted = {"caught": 0, "timeout": 0, "survived": 0, "error": 0}
