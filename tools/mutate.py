@@ -3,7 +3,7 @@
 
 Each mutation in ``tools/mutations.toml`` replaces one exact piece of text (which must occur
 exactly once in its file: the runner refuses otherwise) by another. The runner applies one
-mutation at a time to a private copy of the tree (``src/``, ``tests/`` and ``pyproject.toml``
+mutation at a time to a private copy of the tree (``src/``, ``tests/``, ``tools/``, ``pyproject.toml``
 copied to a temporary directory; the working tree is never edited), runs the mutation's
 covering tests there with ``python -m pytest -x -q -p no:cacheprovider`` (PYTHONPATH at the
 copy's ``src``; a fresh NUMBA_CACHE_DIR when the mutated file holds numba-compiled code, else a
@@ -142,6 +142,8 @@ def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str
             out, _ = p.communicate(timeout=timeout)
             verdict = {0: "survived", 1: "caught"}.get(p.returncode, "error")
             tail = out.strip().splitlines()[-3:]
+            if verdict == "caught":  # the test that caught it
+                tail = [ln.split(" - ")[0] for ln in out.splitlines() if ln.startswith("FAILED ")][:1] or tail
         except subprocess.TimeoutExpired:
             os.killpg(p.pid, signal.SIGKILL)  # pytest and whatever it started (its own session)
             p.communicate()
@@ -166,6 +168,7 @@ def main(argv=None) -> int:
     ap.add_argument("--min-score", type=float, default=0.0, help="exit 1 below this percentage caught")
     ap.add_argument("--mutations", type=Path, default=LIST, help="the mutation list (default tools/mutations.toml)")
     ap.add_argument("--python", default=sys.executable, help="the interpreter that runs pytest")
+    ap.add_argument("--verbose", action="store_true", help="name the test that caught each mutation")
     ap.add_argument("--control", action="store_true",
                     help="first run each distinct set of covering tests on the unmutated copy: all must pass "
                          "(else a 'caught' could be a test that fails anyway); exit 2 if one does not")
@@ -218,7 +221,8 @@ def main(argv=None) -> int:
                 free.append(slot)
             results[m["id"]] = res
             v, sec, tail = res
-            print(f"{v:9s} {sec:7.1f} s  {m['id']:40s} {m['class']}" + (f"\n          {tail}" if v != "caught" else ""),
+            print(f"{v:9s} {sec:7.1f} s  {m['id']:40s} {m['class']}" + (f"\n          {tail}"
+                                                                         if v != "caught" or args.verbose else ""),
                   flush=True)
 
         if args.control:
