@@ -121,6 +121,7 @@ def run_one(m: dict, slot: Path, shared_cache: Path, timeout: float, python: str
     env["PYTHONPATH"] = str(slot / "src")
     env["PYTHONDONTWRITEBYTECODE"] = "1"
     env.pop("PYTEST_ADDOPTS", None)
+    env["SNAPPING_MUTATION"] = m["id"]  # (the list's own validity test skips: a mutated copy fails it)
     fresh = None
     if _compiled(original_text) and not control:
         fresh = tempfile.mkdtemp(prefix="numba-", dir=slot.parent)
