@@ -53,10 +53,11 @@ def test_fold_grading_follows_its_definition():
     assert h.sum() == pytest.approx(1.0, abs=1e-15) and h.min() >= h_min * (1 - 1e-6)
     on_fold = (x > 0.05) & (x < 0.5)
     target = np.minimum(frac * a * (2 * x[on_fold]) ** 0.25, h_min + gamma * x[on_fold])
-    assert np.abs(h[on_fold] / target - 1).max() < 1e-3
+    assert np.abs(h[on_fold] / target - 1).max() < 5e-4  # (the grading follows it to 3.1e-4 here)
     assert h.max() <= h_max * (1 + 1e-9) and h[-1] == pytest.approx(h_max, rel=1e-3)
     assert np.abs(np.diff(h)).max() <= gamma * h.max() * 1.01  # no kinks: the spacing changes by <= gamma h
-    assert h[0] == pytest.approx(h_min, rel=0.1)
+    # the first link spans one unit of n(x) = ln(1 + gamma x / h_min) / gamma (times N/n(1) <= 1)
+    assert h_min < h[0] <= h_min * math.expm1(gamma) / gamma * (1 + 1e-6)
 
 
 def test_graded_chain_with_equal_links_is_the_uniform_chain_bit_for_bit():
@@ -104,7 +105,8 @@ def test_converge_small_study_keeps_its_invariants(tmp_path):
     # each level's CPU time where it ran (NaN where it was resumed: not measured again)
     assert np.all(ds.cpu_time.values > 0) and np.all(np.isnan(again.dataset.cpu_time.values))
     assert "CPU s" in c.table()
-    assert "converged" in ds.attrs["verdict"]
+    for q in ("v_peak", "a_peak", "sigma_peak"):  # every quantity, not any one
+        assert f"{q}: converged to {ds.attrs[q + '_digits']} significant digits" in ds.attrs["verdict"]
     # the figure of a study alone (no uniform chains beside it), as `snapping converge --plot` draws it
     png = tmp_path / "conv.png"
     c.plot(png)

@@ -355,7 +355,9 @@ def test_resume_options_that_contradict_the_checkpoint_are_refused(checkpoint, a
     before = _digest(checkpoint)
     status, _, err = _cli(["simulate", "--resume", checkpoint, *argv], capsys)
     line = _one_line_error(err)
-    assert status == 2 and option in line and "--resume" in line or "checkpoint" in line
+    assert status == 2 and option in line and ("--resume" in line or "checkpoint" in line), line
+    keyword = "--" + option[2:].replace("-", "_")
+    assert keyword == option or keyword not in line  # the option as typed, not as a keyword (--t_end)
     assert _digest(checkpoint) == before
 
 

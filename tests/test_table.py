@@ -25,6 +25,15 @@ TAB = T.load_table()
 QS = ("v_peak", "a_peak", "sigma_peak", "t_snap_v")
 
 
+def reference(chi: float, N: int) -> dict:
+    """The peaks of an independent run (not the table's run_point, which design and the estimates
+    call themselves): the fast method at tol 1e-9, recorded at its own default thinning; it
+    agrees with the table's runs (tol 1e-6) to about 1e-6."""
+    from snapping import simulate
+
+    return dict(simulate.run(chi, N, tol=1e-9, progress=False).dataset.attrs)
+
+
 def test_shipped_table_is_small_and_says_how_it_was_built():
     assert T.TABLE_FILE.stat().st_size < 700_000
     a = TAB.ds.attrs
@@ -84,7 +93,8 @@ def test_interpolant_reproduces_cubics_and_leave_one_out_finds_a_spike():
     g[4, 5] += math.log(1.1)  # a 10% spike at one node
     loo = T._loo_axis(ax[0], g, 0)
     assert 0.06 < loo[4, 5] < 0.12  # found at its own size (the interpolant through the others misses it)
-    assert loo[4, 0] < 1e-12 and loo[0, 5] < 0.2
+    assert loo[4, 0] < 1e-12
+    assert loo[0, 5] == loo[1, 5] > 1e-3  # the end takes its neighbour's (which sees the spike), not zero
 
 
 def test_outside_the_table_names_the_input_and_the_range():
@@ -120,9 +130,9 @@ def test_design_estimate_leads_with_the_computed_peaks_in_si():
         rod = estimates.whirling_rod(P, delta)
         for q, tq in (("v", "v_peak"), ("a", "a_peak"), ("sigma", "sigma_peak")):
             assert est.factors[scale][q] == pytest.approx(rod[q] / p.values[tq], rel=1e-12)
-    for scale, per in est.factor_ranges.items():
+    for scale, per in est.factor_ranges.items():  # (the values themselves: test_exact_checks.py, from the peaks)
         for q, (mean, lo, hi) in per.items():
-            assert 0 < lo <= mean <= hi
+            assert 0 < lo < mean < hi
     node = estimates.design_estimate(chain, chi=0.27, links=229)  # a grid point: its factors are among the chi row's
     for scale in ("delta_kappa0", "delta_c", "delta_N"):
         for q in ("v", "a", "sigma"):
@@ -138,12 +148,17 @@ def test_design_separations_are_consistent_with_the_lookup():
     res = design.design(chain, 100, max_tension=20.0, tip_mass=0.0)
     (lo, hi), = res.rows[0].admissible
     assert hi == 0.9 and 0.05 < lo < 0.9
-    sig, err = TAB.values("sigma_peak", lo, 100, 0.0, with_error=True)
-    assert chain.force(sig) * (1 + err) == pytest.approx(20.0, rel=5e-3)  # the boundary meets the limit
-    for c in (lo * 1.02, (lo * hi) ** 0.5):
+    # the boundary meets the limit (located between 2000 samples to ~1e-6: interpolated in log chi)
+    for limit in (5.0, 20.0, 40.0):
+        r = design.design(chain, 100, max_tension=limit, tip_mass=0.0).rows[0]
+        sig, err = TAB.values("sigma_peak", r.admissible[0][0], 100, 0.0, with_error=True)
+        assert chain.force(sig) * (1 + err) == pytest.approx(limit, rel=1e-5)
+        sig = TAB.values("sigma_peak", r.nominal[0][0], 100, 0.0)
+        assert chain.force(sig) == pytest.approx(limit, rel=1e-5)
+    for c in (lo * 1.001, (lo * hi) ** 0.5):
         sig, err = TAB.values("sigma_peak", c, 100, 0.0, with_error=True)
         assert chain.force(sig) * (1 + err) <= 20.0
-    sig, err = TAB.values("sigma_peak", lo / 1.02, 100, 0.0, with_error=True)
+    sig, err = TAB.values("sigma_peak", lo / 1.001, 100, 0.0, with_error=True)
     assert chain.force(sig) * (1 + err) > 20.0
     (nlo, _), = res.rows[0].nominal
     assert nlo <= lo
@@ -160,7 +175,7 @@ def test_design_boundary_against_a_fresh_run():
     chain = estimates.Chain(length=2.0, mass=0.05)
     res = design.design(chain, 100, max_tension=20.0, tip_mass=0.0)
     lo = res.rows[0].nominal[0][0]
-    fresh = build.run_point(lo, 100, 0.0)
+    fresh = reference(lo, 100)
     _, err = TAB.values("sigma_peak", lo, 100, 0.0, with_error=True)
     assert abs(chain.force(fresh["sigma_peak"]) / 20.0 - 1.0) <= max(err, 1e-3)
 
@@ -174,11 +189,14 @@ def test_no_admissible_separation_says_the_minimum():
     # needs wide ends, and there the speed limit below fails
     res_v = design.design(chain, 100, max_speed=20.0, tip_mass=0.0)
     res_s = design.design(chain, 100, max_tension=1.2, tip_mass=0.0)
-    assert res_v.rows[0].admissible and res_s.rows[0].admissible
-    if res_v.rows[0].admissible[-1][1] < res_s.rows[0].admissible[0][0] or \
-            res_s.rows[0].admissible[-1][1] < res_v.rows[0].admissible[0][0]:
-        with pytest.raises(design.NoAdmissibleSeparation, match="no separation meets them all"):
-            design.design(chain, 100, max_speed=20.0, max_tension=1.2, tip_mass=0.0)
+    (v_lo, v_hi), = res_v.rows[0].admissible
+    (s_lo, s_hi), = res_s.rows[0].admissible
+    # both limits: the intersection of the two (the shipped table's peaks all fall with chi, so it is
+    # never empty here; limits met only apart are tested on a synthetic table in test_exact_checks.py)
+    both = design.design(chain, 100, max_speed=20.0, max_tension=1.2, tip_mass=0.0)
+    (lo, hi), = both.rows[0].admissible
+    assert lo == pytest.approx(max(v_lo, s_lo), rel=1e-9) and hi == pytest.approx(min(v_hi, s_hi), rel=1e-9)
+    assert v_lo != pytest.approx(s_lo, rel=1e-3)  # (two different boundaries: one of them decides)
     with pytest.raises(SnappingInputError, match="give at least one limit"):
         design.design(chain, 100)
     with pytest.raises(SnappingInputError, match="max_tension=-1"):
@@ -202,8 +220,8 @@ def test_cli_estimate_and_design(capsys, tmp_path):
     assert "--chi=0.03 is outside the table" in err and "--simulate" in err
     assert main(["estimate", "--chi", "0.03", "--links", "20", "--simulate", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    fresh = build.run_point(0.03, 20, 0.0)
-    assert d["computed_source"] == "simulation" and d["computed"]["v"] == pytest.approx(fresh["v_peak"], rel=1e-12)
+    fresh = reference(0.03, 20)
+    assert d["computed_source"] == "simulation" and d["computed"]["v"] == pytest.approx(fresh["v_peak"], rel=1e-5)
     assert main(["estimate", "--chi", "0.25", "--tip-mass", "0.1"]) == 2
     assert "--tip-mass 0.1 needs --links" in capsys.readouterr().err
     png = tmp_path / "design.png"
@@ -240,7 +258,7 @@ def test_computed_estimate_runs_where_the_table_is_not_accurate_enough():
     assert "snaps erratically" in estimates.design_estimate(chain, chi=0.3, links=20).computed_note  # table alone
     few = design.computed_estimate(chain, chi=0.3, links=20)  # few links: always one run (milliseconds)
     assert few.computed_source == "simulation" and "snaps erratically" in few.computed_note
-    assert few.computed["v"] == pytest.approx(build.run_point(0.3, 20, 0.0)["v_peak"], rel=1e-12)
+    assert few.computed["v"] == pytest.approx(reference(0.3, 20)["v_peak"], rel=1e-5)
     ok = design.computed_estimate(chain, chi=0.15, links=900)
     assert ok.computed_source == "table" and all(ok.computed_errors[q] <= design.TARGETS[q] for q in design.TARGETS)
     heavy = estimates.design_estimate(chain, chi=0.5, links=119, tip_mass=0.65)
@@ -260,7 +278,7 @@ def test_design_of_a_few_link_chain_runs_it():
     chi, si, e = res.curves[0.0]["max_tension"]
     assert np.all(e[np.isfinite(si)] == 0.0)
     for i in (0, len(chi) // 2, len(chi) - 1):  # the curve is the runs' peaks, in N
-        assert si[i] == pytest.approx(chain.force(build.run_point(float(chi[i]), 10, 0.0)["sigma_peak"]), rel=1e-12)
+        assert si[i] == pytest.approx(chain.force(reference(float(chi[i]), 10)["sigma_peak"]), rel=1e-5)
     for lo, hi in res.rows[0].admissible:
         inside = (chi >= lo * (1 - 1e-12)) & (chi <= hi * (1 + 1e-12))
         assert inside.any() and np.all(si[inside] <= 20.0)

@@ -135,7 +135,8 @@ def _interp(vals: np.ndarray, axes, pts: np.ndarray) -> np.ndarray:
         w = np.ones(pts.shape[0])
         for d, c in enumerate(corner):
             w = w * st[d][1][:, c]
-        out += w[:, None] * vals[tuple(st[d][0][:, c] for d, c in enumerate(corner))]
+        term = w[:, None] * vals[tuple(st[d][0][:, c] for d, c in enumerate(corner))]
+        out += np.where(w[:, None] == 0.0, 0.0, term)  # (a node of weight 0 may be a hole: NaN)
     return out
 
 
