@@ -386,7 +386,8 @@ class _Stepper:
 
 
 def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float = 1e-4, stop_fraction: float = 0.5,
-          t_end_max: float = 10.0, max_steps: int = 200000, refine: bool = True, records: bool = True) -> dict:
+          t_end_max: float = 10.0, max_steps: int = 200000, refine: bool = True, records: bool = True,
+          dt_fixed: float | None = None) -> dict:
     """Integrate ``problem`` with RODAS4 and banded O(N) stage solves (see the module).
 
     Runs to ``t_end``, or without it to the snap by the driver's rule (``v_max`` below
@@ -398,7 +399,8 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
     (peak location), ``n_jac`` (Jacobians: 20 complex residual evaluations each), ``n_lu``
     (banded factorisations), ``n_solves`` (banded solves), ``wall``, ``t``, ``y`` (final
     state) and, with ``records``, ``rec``: an array (steps + 1, 7) of ``t, v_max, a_max,
-    sigma_max, energy, W, D`` at the accepted steps.
+    sigma_max, energy, W, D`` at the accepted steps. ``dt_fixed``: every step of that size,
+    no error control (order studies).
     """
     mdl, y = body_model(problem)
     res = Residual(mdl)
@@ -415,7 +417,7 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
     D = res.jacobian(t, y, f)
     st.njac += 1
     hist[0] = (t, y.copy(), D)
-    h = float(h0)
+    h = float(h0 if dt_fixed is None else dt_fixed)
     nrej_row = 0
     vpeak = m[0]
     tstop = t_end if t_end is not None else t_end_max
@@ -428,6 +430,8 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
             h = tstop - t
         ft = st.time_derivative(t, y, f)
         ynew, err = st.step(t, y, f, D, h, ft)
+        if dt_fixed is not None:
+            err = 0.0 if np.all(np.isfinite(ynew)) else math.inf
         if not (err <= 1.0) or not np.all(np.isfinite(ynew)):
             st.nrej += 1
             nrej_row += 1
@@ -467,7 +471,7 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
         for i in range(len(hist) - 1):
             if i not in keep and hist[i] is not None:
                 hist[i] = None
-        h *= fac
+        h = h * fac if dt_fixed is None else float(dt_fixed)
     nrhs_steps = res.nrhs
     out = {"n_steps": st.nstep, "n_rejected": st.nrej, "n_jac": st.njac, "n_lu": st.nlu, "n_solves": st.nsolve,
            "t": t, "y": y, "stop": stopped, "tol": tol, "N": N}
