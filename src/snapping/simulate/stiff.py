@@ -422,14 +422,25 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
     vpeak = m[0]
     tstop = t_end if t_end is not None else t_end_max
     stopped = "t_end"
+    bps = sorted(b for b in G.breakpoints(mdl) if 0.0 <= b < tstop)
+    tl = t  # (the time the next step starts from: t, or its right limit at a breakpoint)
     while t < tstop:
         if st.nstep >= max_steps:
             stopped = "max_steps"
             break
         if t + h >= tstop:
             h = tstop - t
-        ft = st.time_derivative(t, y, f)
-        ynew, err = st.step(t, y, f, D, h, ft)
+        nb = [b for b in bps if b > t]
+        if nb and t + h > nb[0]:
+            h = nb[0] - t  # (land on the held end's breakpoints)
+        if t in bps and tl != np.nextafter(t, np.inf):  # a step from a breakpoint: its right limit
+            tl = np.nextafter(t, np.inf)
+            res.rhs(tl, y, f)
+            D = res.jacobian(tl, y, f)
+            st.njac += 1
+            hist[-1] = (tl, y.copy(), D)
+        ft = st.time_derivative(tl, y, f)
+        ynew, err = st.step(tl, y, f, D, h, ft)
         if dt_fixed is not None:
             err = 0.0 if np.all(np.isfinite(ynew)) else math.inf
         if not (err <= 1.0) or not np.all(np.isfinite(ynew)):
@@ -445,6 +456,9 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
             fac = min(fac, 1.0)
         nrej_row = 0
         t = t + h if t + h < tstop else tstop
+        if nb and abs(t - nb[0]) <= 4e-16 * max(1.0, abs(t)):
+            t = nb[0]
+        tl = t
         y = ynew
         st.nstep += 1
         res.rhs(t, y, f)
