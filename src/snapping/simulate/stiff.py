@@ -36,7 +36,8 @@ and the T of links j - 1 .. j + 1): one banded LU per step (LAPACK ``dgbtrf``, O
 one banded solve per stage (``dgbtrs``, O(N)). The derivatives ``M``, ``R_theta``,
 ``R_omega`` are exact: complex-step derivatives of a numpy transcription of the rows
 (:func:`Residual.R`), five colours per variable (columns five links apart touch no common
-row), 20 complex residual evaluations per Jacobian, no subtraction error.
+row), 20 complex residual evaluations per Jacobian (4 vectorised calls), no subtraction
+error.
 
 What the Jacobian leaves out. Air drag: the node velocities are sums over the chain
 (``v_j = v_{j+1} - h_j omega_j n_j``), so drag couples every omega to every node and is not
@@ -182,61 +183,65 @@ class Residual:
     # -- the rows, complex-safe
     def R(self, t, th, om, a, T):
         """The interleaved residual ``(angle row j, tension row j)_j`` (zero at the
-        accelerations and tensions of :func:`snapping.simulate.forced.forced_rhs`; no drag)."""
+        accelerations and tensions of :func:`snapping.simulate.forced.forced_rhs`; no drag).
+        Arguments may carry leading axes (several states at once: the colours of a Jacobian)."""
         N = self.N
         h, invm, invh = self.h, self.invm, self.invh
+        dt = np.result_type(th, om, a, T, 1.0)
+        th, om, a, T = (np.asarray(x, dtype=dt) for x in np.broadcast_arrays(th, om, a, T))
         c = np.cos(th)
         s = np.sin(th)
-        dt = complex if np.iscomplexobj(th) or np.iscomplexobj(om) else float
-        FX = np.zeros(N + 1, dtype=dt)
-        FY = np.zeros(N + 1, dtype=dt)
+        lead = th.shape[:-1]
+        FX = np.zeros(lead + (N + 1,), dtype=dt)
+        FY = np.zeros(lead + (N + 1,), dtype=dt)
         if self.hasbend:
-            M = np.zeros(N + 1, dtype=dt)
-            M[1:N] = self.Bl[1:N] * ((th[1:] - th[:-1]) - self.K0L[1:N]) + self.El[1:N] * (om[1:] - om[:-1])
+            M = np.zeros(lead + (N + 1,), dtype=dt)
+            M[..., 1:N] = (self.Bl[1:N] * ((th[..., 1:] - th[..., :-1]) - self.K0L[1:N])
+                           + self.El[1:N] * (om[..., 1:] - om[..., :-1]))
             if self.clamped:
                 phi, phid = FR.clamp_angle(t, self.par, self.tab)
-                M[N] = self.Bl[N] * ((phi - th[N - 1]) - self.K0L[N]) + self.El[N] * (phid - om[N - 1])
-            fq = (M[1:] - M[:-1]) * invh
+                M[..., N] = self.Bl[N] * ((phi - th[..., N - 1]) - self.K0L[N]) + self.El[N] * (phid - om[..., N - 1])
+            fq = (M[..., 1:] - M[..., :-1]) * invh
             fx = -s * fq
             fy = c * fq
-            FX[1:] += fx
-            FY[1:] += fy
-            FX[:-1] -= fx
-            FY[:-1] -= fy
+            FX[..., 1:] += fx
+            FY[..., 1:] += fy
+            FX[..., :-1] -= fx
+            FY[..., :-1] -= fy
         _, _, _, _, pax, pay = G.pin_kinematics(t, self.par, self.tab)
-        afx = FX[1:] * self.invm_next - FX[:N] * invm
-        afy = FY[1:] * self.invm_next - FY[:N] * invm
-        afx[N - 1] += pax
-        afy[N - 1] += pay - self.par[G.P_G]
-        dth = th[1:] - th[:-1]
+        afx = FX[..., 1:] * self.invm_next - FX[..., :N] * invm
+        afy = FY[..., 1:] * self.invm_next - FY[..., :N] * invm
+        afx[..., N - 1] += pax
+        afy[..., N - 1] += pay - self.par[G.P_G]
+        dth = th[..., 1:] - th[..., :-1]
         e = np.cos(dth) * invm[1:]
         Sd = np.sin(dth) * invm[1:]
         rowT = -(invm + self.invm_next) * T + h * om * om + (afx * c + afy * s)
-        rowT[:-1] += e * T[1:]
-        rowT[1:] += e * T[:-1]
+        rowT[..., :-1] += e * T[..., 1:]
+        rowT[..., 1:] += e * T[..., :-1]
         rowA = h * a - (c * afy - s * afx)
-        rowA[:-1] -= Sd * T[1:]
-        rowA[1:] += Sd * T[:-1]
-        out = np.empty(2 * N, dtype=rowT.dtype if np.iscomplexobj(rowT) else rowA.dtype)
-        out[0::2] = rowA
-        out[1::2] = rowT
+        rowA[..., :-1] -= Sd * T[..., 1:]
+        rowA[..., 1:] += Sd * T[..., :-1]
+        out = np.empty(lead + (2 * N,), dtype=np.result_type(rowA, rowT))
+        out[..., 0::2] = rowA
+        out[..., 1::2] = rowT
         return out
 
     def jacobian(self, t, y, f):
         """The exact derivatives of :meth:`R` at the state y with its accelerations ``f[N:2N]``
-        and tensions (``self.sig``, from the evaluation that gave f): arrays (4, NCOL, 2N), the
-        columns of colour k of ``dR/dtheta, dR/domega, dR/da, dR/dT`` (complex steps)."""
+        and tensions (``self.sig``, from the evaluation that gave f): an array (4, NCOL, 2N),
+        the columns of colour k of ``dR/dtheta, dR/domega, dR/da, dR/dT`` (complex steps, the
+        five colours of a variable in one vectorised evaluation of the rows)."""
         N = self.N
-        base = [y[:N].astype(complex), y[N:2 * N].astype(complex), f[N:2 * N].astype(complex),
-                self.sig.astype(complex)]
+        base = [y[:N], y[N:2 * N], f[N:2 * N], self.sig.copy()]
+        E = np.zeros((NCOL, N))
+        for k in range(NCOL):
+            E[k, k::NCOL] = 1.0
         D = np.empty((4, NCOL, 2 * N))
         for v in range(4):
-            for k in range(NCOL):
-                args = list(base)
-                p = args[v].copy()
-                p[k::NCOL] += 1j * _EPS_CS
-                args[v] = p
-                D[v, k] = self.R(t, *args).imag / _EPS_CS
+            args = list(base)
+            args[v] = base[v] + (1j * _EPS_CS) * E
+            D[v] = self.R(t, *args).imag / _EPS_CS
         return D
 
     def matvec(self, D, v, x):
