@@ -2,9 +2,11 @@
 dop853, peaks side by side and their evaluation counts (for sizes where the tolerance
 ladder of ``bench_stiff.py`` is too long for a shared machine).
 
-Usage (N, beta, zeta as in bench_stiff.py, tol of dop853, tol of stiff)::
+Usage (N, beta, zeta as in bench_stiff.py, tol of dop853, tol of stiff, optional t_end;
+without it both stop by the driver's snap rule)::
 
     python benchmarks/bench_stiff_single.py 1000 1e-2 1 1e-6 1e-6
+    python benchmarks/bench_stiff_single.py 1000 1e-2 1 1e-6 1e-6 1.3
 """
 
 import os
@@ -19,17 +21,18 @@ from bench_simulate import print_machine  # noqa: E402
 
 N, beta, zeta, tol_d, tol_s = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), float(
     sys.argv[5])
+t_end = float(sys.argv[6]) if len(sys.argv) > 6 else None
 print_machine()
 eta = zeta * beta ** 0.5 / (2 * N * N)
 p = Problem.catenary(0.25, N, body=Body(bending=beta, damping=eta))
-print(f"chi = 0.25, N = {N}, beta = {beta:g}, eta = {eta:.3g}", flush=True)
+print(f"chi = 0.25, N = {N}, beta = {beta:g}, eta = {eta:.3g}, t_end = {t_end}", flush=True)
 t0 = time.perf_counter()
-ds = run(problem=p, method="fast", tol=tol_d).dataset
+ds = run(problem=p, method="fast", tol=tol_d, t_end=t_end).dataset
 a = ds.attrs
 print(f"dop853 tol {tol_d:g}: v {a['v_peak']:.10g} a {a['a_peak']:.10g} sigma {a['sigma_peak']:.10g} t_snap_v "
       f"{a['t_snap_v']:.8g}; rhs {a['n_rhs']}, steps {a['n_steps']}, stop t {float(ds['t'].values[-1]):.4f}, "
       f"wall {time.perf_counter() - t0:.1f} s", flush=True)
-o = ST.solve(p, None, tol_s, records=False)
+o = ST.solve(p, t_end, tol_s, records=False)
 print(f"stiff  tol {tol_s:g}: v {o['v_peak']:.10g} a {o['a_peak']:.10g} sigma {o['sigma_peak']:.10g} t_snap_v "
       f"{o['t_snap_v']:.8g}; rhs {o['n_rhs']} (+{o['n_rhs_refine']} peaks), steps {o['n_steps']} "
       f"(rejected {o['n_rejected']}), jac {o['n_jac']}, lu {o['n_lu']}, solves {o['n_solves']}, stop t {o['t']:.4f}, "
