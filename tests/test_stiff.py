@@ -147,3 +147,12 @@ def test_energy_balance():
         assert rec[-1, 6] > 1e-4  # (something was dissipated)
         errs.append(np.abs(bal - bal[0]).max())
     assert errs[1] < 1e-6 and errs[1] < errs[0]
+
+
+def test_chain_without_a_body():
+    """A problem without a body (the paper's chain) runs through the same rows (empty body block)."""
+    p = Problem.catenary(0.25, 12)
+    o = ST.solve(p, None, 1e-7, records=False)
+    ds = run(problem=p, method="fast", tol=1e-10).dataset
+    for q in ("v", "a", "sigma"):
+        assert abs(o[f"{q}_peak"] - ds.attrs[f"{q}_peak"]) < 1e-6 * ds.attrs[f"{q}_peak"]
