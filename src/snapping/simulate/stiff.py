@@ -58,6 +58,20 @@ Peaks (v, a, sigma): the global maxima over accepted steps, then located between
 neighbouring steps by Brent's bounded search on the state at time t, obtained by one
 RODAS4 step from the accepted step before (an interpolant as accurate as the steps).
 
+Measured (``benchmarks/bench_stiff.py``, ``bench_stiff_single.py``; chi = 0.25, peaks to
+1e-6): the step is not set by the bending stiffness, but by the bending waves the release
+excites. The catenary is not a bending equilibrium (the free end and the hinge carry no
+moment), so releasing it launches grid-scale bending waves; without bending damping
+they never decay, and an error-controlled method must follow them: undamped, this
+method takes as many or more evaluations than dop853 (N = 100: 0.34-0.55x dop853's
+efficiency at beta = 1e-6 .. 1e-2; N = 300, beta = 1e-2: 159k against 108k). With a
+little bending damping (``eta = sqrt(beta)/(2 N^2)``: damping ratio ~1 for the shortest
+wave, negligible for the fall) the waves decay and the L-stable steps pass over them:
+dop853/stiff evaluations 1.3 (N = 100), 2.9 (N = 300), 11 (N = 1000, beta = 1e-4) and
+13-25 (N = 1000, beta = 1e-2). Each step also costs a Jacobian (4 vectorised complex
+evaluations of the numpy rows) and a banded LU, so wall times are 2-60x dop853's per
+evaluation count (numpy, not compiled).
+
 Integration status: :func:`solve` runs a problem to ``t_end`` (or to the snap by the
 driver's rule ``v_max < stop_fraction * peak``) and returns the peaks, step and
 evaluation counts, the final state and per-step records (time, v_max, a_max,
