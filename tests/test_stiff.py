@@ -62,6 +62,9 @@ def test_banded_derivatives_against_finite_differences(clamp):
             m[v][k] -= eps
             full[:, k] = (res.R(t, *a) - res.R(t, *m)) / (2 * eps)
         assert np.abs(full - _band_full(res, D, v)).max() < 1e-6 * max(1.0, np.abs(full).max())
+    # the compiled colours are the numpy ones
+    Dn = res.jacobian(t, y, f, compiled=False)
+    assert np.allclose(D, Dn, rtol=1e-13, atol=1e-13 * np.abs(Dn).max())
 
 
 def test_ode_jacobian_against_finite_differences_of_the_rhs():

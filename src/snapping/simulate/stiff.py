@@ -87,6 +87,7 @@ import time
 
 import numpy as np
 from scipy.linalg import lapack
+from numba import njit
 from scipy.optimize import minimize_scalar
 
 from . import forced as FR
@@ -131,6 +132,73 @@ def body_model(problem):
     a = problem.initial_angles()
     y0[:a.size] = a
     return mdl, y0
+
+
+@njit(cache=True, fastmath=False, error_model="numpy")
+def _rows(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbend, phi, phid, pax, payg, M, FX, FY,
+          out):
+    """:meth:`Residual.R` for one complex state, compiled (scratch ``M, FX, FY`` of length N + 1)."""
+    for i in range(N + 1):
+        M[i] = 0.0
+        FX[i] = 0.0
+        FY[i] = 0.0
+    if hasbend:
+        for i in range(1, N):
+            M[i] = Bl[i] * ((th[i] - th[i - 1]) - K0L[i]) + El[i] * (om[i] - om[i - 1])
+        if clamped:
+            M[N] = Bl[N] * ((phi - th[N - 1]) - K0L[N]) + El[N] * (phid - om[N - 1])
+        for j in range(N):
+            fq = (M[j + 1] - M[j]) * invh[j]
+            cj = np.cos(th[j])
+            sj = np.sin(th[j])
+            FX[j + 1] += -sj * fq
+            FY[j + 1] += cj * fq
+            FX[j] -= -sj * fq
+            FY[j] -= cj * fq
+    for j in range(N):
+        cj = np.cos(th[j])
+        sj = np.sin(th[j])
+        afx = FX[j + 1] * invm_next[j] - FX[j] * invm[j]
+        afy = FY[j + 1] * invm_next[j] - FY[j] * invm[j]
+        if j == N - 1:
+            afx += pax
+            afy += payg
+        rt = -(invm[j] + invm_next[j]) * T[j] + h[j] * om[j] * om[j] + (afx * cj + afy * sj)
+        ra = h[j] * a[j] - (cj * afy - sj * afx)
+        if j < N - 1:
+            d = th[j + 1] - th[j]
+            rt += np.cos(d) * invm[j + 1] * T[j + 1]
+            ra -= np.sin(d) * invm[j + 1] * T[j + 1]
+        if j > 0:
+            d = th[j] - th[j - 1]
+            rt += np.cos(d) * invm[j] * T[j - 1]
+            ra += np.sin(d) * invm[j] * T[j - 1]
+        out[2 * j] = ra
+        out[2 * j + 1] = rt
+
+
+@njit(cache=True, fastmath=False, error_model="numpy")
+def _jacobian(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbend, phi, phid, pax, payg, D):
+    """The coloured complex-step columns of :meth:`Residual.jacobian`, compiled."""
+    M = np.zeros(N + 1, dtype=np.complex128)
+    FX = np.zeros(N + 1, dtype=np.complex128)
+    FY = np.zeros(N + 1, dtype=np.complex128)
+    out = np.zeros(2 * N, dtype=np.complex128)
+    x = np.zeros((4, N), dtype=np.complex128)
+    x[0, :] = th
+    x[1, :] = om
+    x[2, :] = a
+    x[3, :] = T
+    for v in range(4):
+        for k in range(NCOL):
+            for j in range(k, N, NCOL):
+                x[v, j] += 1j * _EPS_CS
+            _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbend, phi, phid, pax,
+                  payg, M, FX, FY, out)
+            for i in range(2 * N):
+                D[v, k, i] = out[i].imag / _EPS_CS
+            for j in range(k, N, NCOL):
+                x[v, j] -= 1j * _EPS_CS  # (exact: the real part is untouched)
 
 
 class Residual:
@@ -241,17 +309,25 @@ class Residual:
         out[..., 1::2] = rowT
         return out
 
-    def jacobian(self, t, y, f):
+    def jacobian(self, t, y, f, compiled=True):
         """The exact derivatives of :meth:`R` at the state y with its accelerations ``f[N:2N]``
         and tensions (``self.sig``, from the evaluation that gave f): an array (4, NCOL, 2N),
-        the columns of colour k of ``dR/dtheta, dR/domega, dR/da, dR/dT`` (complex steps, the
-        five colours of a variable in one vectorised evaluation of the rows)."""
+        the columns of colour k of ``dR/dtheta, dR/domega, dR/da, dR/dT`` (complex steps;
+        compiled, or with ``compiled=False`` the five colours of a variable in one vectorised
+        numpy evaluation of :meth:`R`)."""
         N = self.N
+        D = np.empty((4, NCOL, 2 * N))
+        if compiled:
+            phi, phid = FR.clamp_angle(t, self.par, self.tab) if self.clamped else (0.0, 0.0)
+            _, _, _, _, pax, pay = G.pin_kinematics(t, self.par, self.tab)
+            _jacobian(N, y[:N].astype(complex), y[N:2 * N].astype(complex), f[N:2 * N].astype(complex),
+                      self.sig.astype(complex), self.h, self.invm, self.invm_next, self.invh, self.Bl, self.K0L,
+                      self.El, self.clamped, self.hasbend, phi, phid, pax, pay - self.par[G.P_G], D)
+            return D
         base = [y[:N], y[N:2 * N], f[N:2 * N], self.sig.copy()]
         E = np.zeros((NCOL, N))
         for k in range(NCOL):
             E[k, k::NCOL] = 1.0
-        D = np.empty((4, NCOL, 2 * N))
         for v in range(4):
             args = list(base)
             args[v] = base[v] + (1j * _EPS_CS) * E
