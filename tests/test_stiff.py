@@ -65,6 +65,9 @@ def test_banded_derivatives_against_finite_differences(clamp):
     # the compiled colours are the numpy ones
     Dn = res.jacobian(t, y, f, compiled=False)
     assert np.allclose(D, Dn, rtol=1e-13, atol=1e-13 * np.abs(Dn).max())
+    x = np.random.default_rng(5).standard_normal(N)
+    for v in (0, 1):
+        assert np.allclose(res.matvec(D, v, x), res.matvec_numpy(D, v, x), rtol=1e-14, atol=1e-14)
 
 
 def test_ode_jacobian_against_finite_differences_of_the_rhs():

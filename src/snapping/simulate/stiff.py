@@ -136,8 +136,11 @@ def body_model(problem):
 
 @njit(cache=True, fastmath=False, error_model="numpy")
 def _rows(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbend, phi, phid, pax, payg, M, FX, FY,
-          out):
-    """:meth:`Residual.R` for one complex state, compiled (scratch ``M, FX, FY`` of length N + 1)."""
+          out, C0, S0, Cd0, Sd0):
+    """:meth:`Residual.R` for one complex state whose angles are ``theta + i delta`` with a
+    tiny delta (a complex step), compiled: ``cos(theta + i delta) = cos theta - i delta sin
+    theta`` from the real ``C0, S0`` (cos, sin of theta) and ``Cd0, Sd0`` (of theta_{j+1} -
+    theta_j), exact to rounding for |delta| <= 1e-20. Scratch ``M, FX, FY`` (N + 1)."""
     for i in range(N + 1):
         M[i] = 0.0
         FX[i] = 0.0
@@ -149,15 +152,17 @@ def _rows(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbe
             M[N] = Bl[N] * ((phi - th[N - 1]) - K0L[N]) + El[N] * (phid - om[N - 1])
         for j in range(N):
             fq = (M[j + 1] - M[j]) * invh[j]
-            cj = np.cos(th[j])
-            sj = np.sin(th[j])
+            dl = th[j].imag
+            cj = complex(C0[j], -S0[j] * dl)
+            sj = complex(S0[j], C0[j] * dl)
             FX[j + 1] += -sj * fq
             FY[j + 1] += cj * fq
             FX[j] -= -sj * fq
             FY[j] -= cj * fq
     for j in range(N):
-        cj = np.cos(th[j])
-        sj = np.sin(th[j])
+        dl = th[j].imag
+        cj = complex(C0[j], -S0[j] * dl)
+        sj = complex(S0[j], C0[j] * dl)
         afx = FX[j + 1] * invm_next[j] - FX[j] * invm[j]
         afy = FY[j + 1] * invm_next[j] - FY[j] * invm[j]
         if j == N - 1:
@@ -166,13 +171,17 @@ def _rows(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbe
         rt = -(invm[j] + invm_next[j]) * T[j] + h[j] * om[j] * om[j] + (afx * cj + afy * sj)
         ra = h[j] * a[j] - (cj * afy - sj * afx)
         if j < N - 1:
-            d = th[j + 1] - th[j]
-            rt += np.cos(d) * invm[j + 1] * T[j + 1]
-            ra -= np.sin(d) * invm[j + 1] * T[j + 1]
+            dl = th[j + 1].imag - th[j].imag
+            cd = complex(Cd0[j], -Sd0[j] * dl)
+            sd = complex(Sd0[j], Cd0[j] * dl)
+            rt += cd * invm[j + 1] * T[j + 1]
+            ra -= sd * invm[j + 1] * T[j + 1]
         if j > 0:
-            d = th[j] - th[j - 1]
-            rt += np.cos(d) * invm[j] * T[j - 1]
-            ra += np.sin(d) * invm[j] * T[j - 1]
+            dl = th[j].imag - th[j - 1].imag
+            cd = complex(Cd0[j - 1], -Sd0[j - 1] * dl)
+            sd = complex(Sd0[j - 1], Cd0[j - 1] * dl)
+            rt += cd * invm[j] * T[j - 1]
+            ra += sd * invm[j] * T[j - 1]
         out[2 * j] = ra
         out[2 * j + 1] = rt
 
@@ -189,16 +198,36 @@ def _jacobian(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, h
     x[1, :] = om
     x[2, :] = a
     x[3, :] = T
+    C0 = np.cos(th.real)
+    S0 = np.sin(th.real)
+    Cd0 = np.cos(th.real[1:] - th.real[:-1])
+    Sd0 = np.sin(th.real[1:] - th.real[:-1])
     for v in range(4):
         for k in range(NCOL):
             for j in range(k, N, NCOL):
                 x[v, j] += 1j * _EPS_CS
             _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, Bl, K0L, El, clamped, hasbend, phi, phid, pax,
-                  payg, M, FX, FY, out)
+                  payg, M, FX, FY, out, C0, S0, Cd0, Sd0)
             for i in range(2 * N):
                 D[v, k, i] = out[i].imag / _EPS_CS
             for j in range(k, N, NCOL):
                 x[v, j] -= 1j * _EPS_CS  # (exact: the real part is untouched)
+
+
+@njit(cache=True, fastmath=False, error_model="numpy")
+def _matvec(N, Dv, x, out):
+    """``out += sum_k Dv[k, i] x[link of colour k near row i]`` (the coloured columns times x)."""
+    for i in range(2 * N):
+        j = i // 2
+        acc = 0.0
+        for k in range(NCOL):
+            d = (k - j) % NCOL
+            if d > 2:
+                d -= NCOL
+            lk = j + d
+            if 0 <= lk < N:
+                acc += Dv[k, i] * x[lk]
+        out[i] += acc
 
 
 class Residual:
@@ -336,6 +365,12 @@ class Residual:
 
     def matvec(self, D, v, x):
         """``(dR/d var) x`` for var index v (0 theta, 1 omega) from the coloured columns."""
+        out = np.zeros(2 * self.N)
+        _matvec(self.N, D[v], x, out)
+        return out
+
+    def matvec_numpy(self, D, v, x):
+        """:meth:`matvec` in numpy (tests)."""
         out = np.zeros(2 * self.N)
         for k in range(NCOL):
             r, lk = self.cidx[k][0], self.cidx[k][1]
