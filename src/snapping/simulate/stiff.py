@@ -230,6 +230,22 @@ def _matvec(N, Dv, x, out):
         out[i] += acc
 
 
+@njit(cache=True, fastmath=False, error_model="numpy")
+def _assemble(N, D, gh, ab):
+    """The stage matrix in LAPACK band storage (``A[i, j]`` at ``ab[KL + KU + i - j, j]``):
+    column a_l (2l) ``dR/da + (gh)^2 dR/dtheta + gh dR/domega``, column T_l (2l + 1) ``dR/dT``."""
+    for i in range(2 * N):
+        j = i // 2
+        for k in range(NCOL):
+            d = (k - j) % NCOL
+            if d > 2:
+                d -= NCOL
+            lk = j + d
+            if 0 <= lk < N:
+                ab[KL + KU + i - 2 * lk, 2 * lk] = D[2, k, i] + gh * gh * D[0, k, i] + gh * D[1, k, i]
+                ab[KL + KU + i - 2 * lk - 1, 2 * lk + 1] = D[3, k, i]
+
+
 class Residual:
     """The rows ``R(theta, omega, a, T; t)`` of the accelerations and tensions (numpy,
     complex-safe: the derivatives are complex steps), their exact banded derivatives, and
@@ -387,10 +403,7 @@ class StageMatrix:
         N = res.N
         self.res, self.D, self.gh = res, D, gh
         ab = np.zeros((2 * KL + KU + 1, 2 * N))
-        for k in range(NCOL):
-            r, lk, ia, ca, it, ct = res.cidx[k]
-            ab[ia, ca] = D[2, k, r] + gh * gh * D[0, k, r] + gh * D[1, k, r]
-            ab[it, ct] = D[3, k, r]
+        _assemble(N, D, gh, ab)
         self.ab = ab
         self.lu, self.piv, info = lapack.dgbtrf(ab, KL, KU)
         if info != 0:
