@@ -34,10 +34,10 @@ with ``w = M^{-1}[R_theta (b_theta + U_omega)/alpha + R_omega U_omega]`` (``alph
 of lower and upper bandwidth 5 (per link: its a and T against the a of links j - 2 .. j + 2
 and the T of links j - 1 .. j + 1): one banded LU per step (LAPACK ``dgbtrf``, O(N)) and
 one banded solve per stage (``dgbtrs``, O(N)). The derivatives ``M``, ``R_theta``,
-``R_omega`` are exact: complex-step derivatives of a numpy transcription of the rows
-(:func:`Residual.R`), five colours per variable (columns five links apart touch no common
-row), 20 complex residual evaluations per Jacobian (4 vectorised calls), no subtraction
-error.
+``R_omega`` are exact: complex-step derivatives of a transcription of the rows
+(:meth:`Residual.R` in numpy, ``_rows`` compiled), five colours per variable (columns five
+links apart touch no common row): 20 complex evaluations of the rows per Jacobian, no
+subtraction error. The Jacobian is taken at every accepted step (RODAS4 needs it exact).
 
 What the Jacobian leaves out. Air drag: the node velocities are sums over the chain
 (``v_j = v_{j+1} - h_j omega_j n_j``), so drag couples every omega to every node and is not
