@@ -115,10 +115,12 @@ def test_stage_matrix_banded_against_dense():
     assert np.allclose(np.concatenate([Uth, Uom]), U, rtol=1e-10, atol=1e-12 * np.abs(U).max())
 
 
-def test_fourth_order_at_fixed_steps():
+@pytest.mark.parametrize("pin", [PinMotion.pull((0.3, -0.2)), None])
+def test_fourth_order_at_fixed_steps(pin):
     """RODAS4 with the exact Jacobian: order 4 on the whole state (angles, rates, the held
-    end's work W and the dissipated D; a moving held end, so f_t and the W/D rows count)."""
-    p = Problem.catenary(0.25, 6, body=Body(bending=1e-2, damping=2e-3), pin=PinMotion.pull((0.3, -0.2)))
+    end's work W and the dissipated D; a moving held end: f_t and the W/D rows by
+    differences; a fixed one: the analytic D row)."""
+    p = Problem.catenary(0.25, 6, body=Body(bending=1e-2, damping=2e-3), pin=pin)
     T = 0.24
     ref = ST.solve(p, T, dt_fixed=T / 96, refine=False, records=False)["y"]
     errs = []
@@ -142,10 +144,11 @@ def test_peaks_agree_with_dop853():
     assert abs(o["t_snap_v"] - ds.attrs["t_snap_v"]) < 1e-5
 
 
-def test_energy_balance():
+@pytest.mark.parametrize("pin", [PinMotion.pull((0.2, -0.1)), None])
+def test_energy_balance(pin):
     """kinetic + gravity + bending - W + D is constant to the method's accuracy (damping,
-    a moving held end)."""
-    p = Problem.catenary(0.25, 10, body=Body(bending=1e-3, damping=1e-3), pin=PinMotion.pull((0.2, -0.1)))
+    a moving held end: W and D rows by differences; a fixed one: the analytic D row)."""
+    p = Problem.catenary(0.25, 10, body=Body(bending=1e-3, damping=1e-3), pin=pin)
     errs = []
     for tol in (1e-6, 1e-8):
         rec = ST.solve(p, 0.8, tol, refine=False)["rec"]

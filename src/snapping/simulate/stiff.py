@@ -44,9 +44,10 @@ What the Jacobian leaves out. Air drag: the node velocities are sums over the ch
 banded; it is left out of ``J``. RODAS4 with an approximate Jacobian loses order (it is a
 Rosenbrock method, not a W-method), so with strong drag the step sizes grow; the results
 stay error-controlled. The work and dissipation components ``W, D`` (quadratures of the
-state) get their exact Jacobian rows in the stage direction by one forward difference
-(one extra evaluation per stage, only when the model has a moving pin or clamp, damping or
-drag); the time derivative ``f_t`` by one forward difference per step for a moving pin or
+state) get their exact Jacobian rows in the stage direction: analytic when only bending
+damping acts on them (``D' = sum eta_i/l_i (omega_i - omega_{i-1})^2``, ``W' = 0``), else
+by one forward difference (one extra evaluation per stage: a moving pin or clamp, drag);
+the time derivative ``f_t`` by one forward difference per step for a moving pin or
 clamp.
 
 The method. RODAS4 (Hairer and Wanner, *Solving ODEs II*, sec. VI.4; the coefficients of
@@ -269,6 +270,9 @@ class Residual:
         self.autonomous = par[G.P_PIN] == G.PIN_FIXED and int(par[FR.P_CNK]) == 0
         # W, D have dynamics: work of a moving held end or clamp, dissipation by damping or drag
         self.quad = (not self.autonomous) or self.clamped or bool(np.any(self.El != 0.0)) or par[FR.P_HASDRAG] != 0.0
+        # their Jacobian rows: analytic when only damping acts on them (a fixed held end and
+        # clamp, no drag: W' = 0, D' = sum El_i (omega_i - omega_{i-1})^2), else a difference
+        self.quad_fd = self.quad and ((not self.autonomous) or par[FR.P_HASDRAG] != 0.0)
         w = G.Work(N)
         self.c, self.s, self.S, self.cp, self.dp, self.sig = w.c, w.s, w.S, w.cp, w.dp, w.sig
         self.Z = np.zeros((7, N + 1))
@@ -497,7 +501,14 @@ class _Stepper:
             Ui[N:2 * N] = Uom
             # W, D: (1/(gamma h)) U_q - dq'/dx U_x = b_q, the directional derivative by a difference
             bq = b[2 * N:]
-            if res.quad:
+            if res.quad and not res.quad_fd:  # dD'/domega U_omega, exact
+                El, om = res.El, y[N:2 * N]
+                bq = bq.copy()
+                bq[1] += 2.0 * float(np.dot(El[1:N] * (om[1:] - om[:-1]), Uom[1:] - Uom[:-1]))
+                if res.clamped:
+                    _, phid = FR.clamp_angle(t, res.par, res.tab)
+                    bq[1] -= 2.0 * El[N] * (phid - om[N - 1]) * Uom[N - 1]
+            elif res.quad:
                 ux = Ui[:2 * N]
                 nu = np.sqrt(np.mean(ux * ux))
                 if nu > 0.0:
@@ -539,7 +550,7 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
     t_snap_a, t_snap_sigma`` (located between steps when ``refine``), ``n_steps,
     n_rejected``, ``n_rhs`` (right-hand-side evaluations of the steps: 6 per attempted
     step), ``n_rhs_extra`` (W/D directional derivatives and ``f_t``), ``n_rhs_refine``
-    (peak location), ``n_jac`` (Jacobians: 20 complex residual evaluations each), ``n_lu``
+    (peak location; all evaluations: ``n_rhs + n_rhs_extra + n_rhs_refine``), ``n_jac`` (Jacobians: 20 complex residual evaluations each), ``n_lu``
     (banded factorisations), ``n_solves`` (banded solves), ``wall``, ``t``, ``y`` (final
     state) and, with ``records``, ``rec``: an array (steps + 1, 7) of ``t, v_max, a_max,
     sigma_max, energy, W, D`` at the accepted steps. ``dt_fixed``: every step of that size,
@@ -630,6 +641,7 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
                 hist[i] = None
         h = h * fac if dt_fixed is None else float(dt_fixed)
     nrhs_steps = res.nrhs
+    nq_steps = st.nrhs_q
     out = {"n_steps": st.nstep, "n_rejected": st.nrej, "n_jac": st.njac, "n_lu": st.nlu, "n_solves": st.nsolve,
            "t": t, "y": y, "stop": stopped, "tol": tol, "N": N}
     names = ("v", "a", "sigma")
@@ -641,8 +653,8 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
         out[f"{names[q]}_peak"] = float(val)
         out[f"t_snap_{names[q]}"] = float(tq)
     out["n_rhs_refine"] = res.nrhs - nrhs_steps
-    out["n_rhs_extra"] = st.nrhs_q
-    out["n_rhs"] = nrhs_steps - st.nrhs_q
+    out["n_rhs_extra"] = nq_steps
+    out["n_rhs"] = nrhs_steps - nq_steps
     out["wall"] = time.perf_counter() - w0
     if records:
         out["rec"] = np.array(rec)
