@@ -60,18 +60,19 @@ neighbouring steps by Brent's bounded search on the state at time t, obtained by
 RODAS4 step from the accepted step before (an interpolant as accurate as the steps).
 
 Measured (``benchmarks/bench_stiff.py``, ``bench_stiff_single.py``; chi = 0.25, peaks to
-1e-6): the step is not set by the bending stiffness, but by the bending waves the release
-excites. The catenary is not a bending equilibrium (the free end and the hinge carry no
-moment), so releasing it launches grid-scale bending waves; without bending damping
-they never decay, and an error-controlled method must follow them: undamped, this
-method takes as many or more evaluations than dop853 (N = 100: 0.34-0.55x dop853's
-efficiency at beta = 1e-6 .. 1e-2; N = 300, beta = 1e-2: 159k against 108k). With a
-little bending damping (``eta = sqrt(beta)/(2 N^2)``: damping ratio ~1 for the shortest
-wave, negligible for the fall) the waves decay and the L-stable steps pass over them:
-dop853/stiff evaluations 1.3 (N = 100), 2.9 (N = 300), 11 (N = 1000, beta = 1e-4) and
-13-25 (N = 1000, beta = 1e-2). Each step also costs a Jacobian (4 vectorised complex
-evaluations of the numpy rows) and a banded LU, so wall times are 2-60x dop853's per
-evaluation count (numpy, not compiled).
+1e-6; counts are right-hand-side evaluations, all included): the step is not set by the
+bending stiffness, but by the bending waves the release excites. The catenary is not a
+bending equilibrium (the free end and the hinge carry no moment), so releasing it
+launches grid-scale bending waves; without bending damping they never decay, and an
+error-controlled method must follow them. Undamped, this method needs more evaluations
+than dop853 (N = 100, beta = 1e-6, 1e-4, 1e-2: 0.34, 0.55, 0.48 times dop853's
+efficiency). With a little bending damping (``eta = sqrt(beta)/(2 N^2)``: damping ratio
+about 1 for the shortest wave, negligible for the fall) the waves decay and the L-stable
+steps pass over them: dop853/stiff evaluations 0.6-1.3 (N = 100), 2.8-2.9 (N = 300),
+11.3 (N = 1000, beta = 1e-4, to the snap) and 25 (N = 1000, beta = 1e-2, to t = 1.3).
+Each step also costs a Jacobian (20 complex evaluations of the compiled rows) and a
+banded LU, and the step loop is Python: per evaluation the method is 5-50x slower in
+wall time than dop853's compiled loop (N = 1000, beta = 1e-2: 66 s against 86 s).
 
 Integration status: :func:`solve` runs a problem to ``t_end`` (or to the snap by the
 driver's rule ``v_max < stop_fraction * peak``) and returns the peaks, step and
