@@ -549,13 +549,21 @@ def solve(problem, t_end: float | None = None, tol: float = 1e-8, *, h0: float =
     ``stop_fraction`` of its running peak after the peak; at ``t_end_max`` at the latest).
     Returns a dict: the peaks ``v_peak, a_peak, sigma_peak`` and their times ``t_snap_v,
     t_snap_a, t_snap_sigma`` (located between steps when ``refine``), ``n_steps,
-    n_rejected``, ``n_rhs`` (right-hand-side evaluations of the steps: 6 per attempted
-    step), ``n_rhs_extra`` (W/D directional derivatives and ``f_t``), ``n_rhs_refine``
-    (peak location; all evaluations: ``n_rhs + n_rhs_extra + n_rhs_refine``), ``n_jac`` (Jacobians: 20 complex residual evaluations each), ``n_lu``
+    n_rejected``, ``n_rhs`` (right-hand-side evaluations of the steps: 5 per attempted
+    step, 1 per accepted step (its end, which starts the next), 2 at the start),
+    ``n_rhs_extra`` (W/D directional derivatives and ``f_t``), ``n_rhs_refine`` (peak
+    location; all evaluations: ``n_rhs + n_rhs_extra + n_rhs_refine``), ``n_jac``
+    (Jacobians: 20 complex evaluations of the rows each), ``n_lu``
     (banded factorisations), ``n_solves`` (banded solves), ``wall``, ``t``, ``y`` (final
     state) and, with ``records``, ``rec``: an array (steps + 1, 7) of ``t, v_max, a_max,
     sigma_max, energy, W, D`` at the accepted steps. ``dt_fixed``: every step of that size,
     no error control (order studies).
+
+    >>> from snapping.simulate import Body, Problem
+    >>> from snapping.simulate import stiff
+    >>> o = stiff.solve(Problem.catenary(0.25, 8, body=Body(bending=1e-3)), 0.1, 1e-6)
+    >>> o["stop"], o["n_rhs"] == 5 * (o["n_steps"] + o["n_rejected"]) + o["n_steps"] + 2, round(o["t"], 12)
+    ('t_end', True, 0.1)
     """
     mdl, y = body_model(problem)
     res = Residual(mdl)
