@@ -8,11 +8,10 @@ tolerance of a ladder whose peaks v, a, sigma are all within ``acc`` (relative, 
 dop853 at the same accuracy (the cost the issue's target compares with). Counts are the
 primary measure (wall times on a shared machine are noisy).
 
-Stiff's counts: ``rhs`` = right-hand-side evaluations of the steps (6 per attempted
-step, the compiled kernel of every method, plus the W/D rows' differences where there are
-any), ``+ref`` those of the peak location, ``jac``
-Jacobians (each 20 complex-step evaluations of the numpy rows, not counted in ``rhs``),
-``lu`` banded factorisations, ``sol`` banded solves. dop853's ``rhs`` is its ``n_rhs``.
+Stiff's counts: ``rhs`` = right-hand-side evaluations of the steps (5 per attempted step,
+1 per accepted step, the compiled kernel of every method, plus the W/D rows' differences
+where there are any), ``+ref`` those of the peak location, ``jac`` Jacobians (each 20
+complex-step evaluations of the compiled rows, not counted in ``rhs``), ``lu`` banded factorisations, ``sol`` banded solves. dop853's ``rhs`` is its ``n_rhs``.
 
 Optional bending damping (Kelvin-Voigt) ``eta = zeta sqrt(beta)/(2 N^2)``: damping ratio
 about ``zeta`` for the chain's shortest bending wave (frequency ``sqrt(beta) (2N)^2``,
