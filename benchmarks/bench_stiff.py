@@ -11,7 +11,8 @@ primary measure (wall times on a shared machine are noisy).
 Stiff's counts: ``rhs`` = right-hand-side evaluations of the steps (5 per attempted step,
 1 per accepted step, the compiled kernel of every method, plus the W/D rows' differences
 where there are any), ``+ref`` those of the peak location, ``jac`` Jacobians (each 20
-complex-step evaluations of the compiled rows, not counted in ``rhs``), ``lu`` banded factorisations, ``sol`` banded solves. dop853's ``rhs`` is its ``n_rhs``.
+complex-step evaluations of the compiled rows, not counted in ``rhs``), ``lu`` banded
+factorisations, ``sol`` banded solves. dop853's ``rhs`` is its ``n_rhs``.
 
 Optional bending damping (Kelvin-Voigt) ``eta = zeta sqrt(beta)/(2 N^2)``: damping ratio
 about ``zeta`` for the chain's shortest bending wave (frequency ``sqrt(beta) (2N)^2``,
@@ -53,7 +54,8 @@ def dop(p, tol):
 
 def stf(p, tol):
     o = ST.solve(p, None, tol, records=False)
-    return {"peaks": [o[f"{q}_peak"] for q in Q], "rhs": o["n_rhs"] + o["n_rhs_extra"], "ref": o["n_rhs_refine"], "steps": o["n_steps"],
+    return {"peaks": [o[f"{q}_peak"] for q in Q], "rhs": o["n_rhs"] + o["n_rhs_extra"], "ref": o["n_rhs_refine"],
+            "steps": o["n_steps"],
             "rej": o["n_rejected"], "jac": o["n_jac"], "lu": o["n_lu"], "sol": o["n_solves"], "wall": o["wall"]}
 
 
@@ -95,17 +97,20 @@ def main():
             R = dop(p, 1e-11)
             ref = R["peaks"]
             chk = stf(p, 1e-9)
-            print(f"  N={N} beta={beta:g} eta={eta:.3g}: reference dop853 1e-11 rhs {R['rhs']} ({R['wall']:.0f} s); stiff 1e-9 "
+            print(f"  N={N} beta={beta:g} eta={eta:.3g}: reference dop853 1e-11 rhs {R['rhs']} ({R['wall']:.0f} s); "
+                  f"stiff 1e-9 "
                   f"differs by {err(chk['peaks'], ref):.1e}", flush=True)
             d = ladder(dop, p, ref, acc, [1e-5, 1e-6, 1e-7, 1e-8])
             s = ladder(stf, p, ref, acc, [1e-5, 3e-6, 1e-6, 3e-7, 1e-7])
             rows.append((N, beta, eta, base, d, s, err(chk["peaks"], ref)))
-    print("\n|   N | beta | eta | dop853 beta=0: tol, rhs | dop853: tol, rhs, steps, wall | stiff: tol, rhs (+ref), steps, "
+    print("\n|   N | beta | eta | dop853 beta=0: tol, rhs | dop853: tol, rhs, steps, wall | "
+          "stiff: tol, rhs (+ref), steps, "
           "jac/lu/sol, wall | dop853/stiff rhs | stiff / (beta=0 dop853) rhs | ref check |")
     print("|---|---|---|---|---|---|---|---|---|")
     for N, beta, eta, b, d, s, c in rows:
         tot = s["rhs"] + s["ref"]
-        print(f"| {N} | {beta:g} | {eta:.2g} | {b['tol']}, {b['rhs']} | {d['tol']}, {d['rhs']}, {d['steps']}, {d['wall']:.1f} s | "
+        print(f"| {N} | {beta:g} | {eta:.2g} | {b['tol']}, {b['rhs']} | {d['tol']}, {d['rhs']}, {d['steps']}, "
+              f"{d['wall']:.1f} s | "
               f"{s['tol']}, {s['rhs']} (+{s['ref']}), {s['steps']}, {s['jac']}/{s['lu']}/{s['sol']}, "
               f"{s['wall']:.1f} s | {d['rhs'] / tot:.2f} | {tot / b['rhs']:.2f} | {c:.1e} |")
 
