@@ -236,12 +236,20 @@ def test_run_instead_thresholds():
 
 
 # ============================================================ the table: interpolation and bounds
+def _table_dataset():
+    """The shipped table file as an xarray Dataset (loaded, closed)."""
+    import xarray as xr
+
+    with xr.open_dataset(T.TABLE_FILE, engine="netcdf4") as f:
+        return f.load()
+
+
 def test_interpolation_is_the_centred_cubic_in_each_axis():
     """Off the grid along one axis at a time, the table's value is the cubic through the two
     nodes on each side (one-sided at the ends) of the log quantity, in log chi, log N and
     asinh(tip / 1e-3): computed here from the stored numbers by Neville's scheme."""
     tab = T.load_table()
-    ds = tab.ds
+    ds = _table_dataset()  # (the stored numbers, read by xarray: the table reads them with netCDF4 alone)
     chis, Ns, tips = list(ds.chi.values), list(ds.N.values), list(ds.tip_mass.values)
 
     def stencil(axis, x):
@@ -324,7 +332,7 @@ def test_estimator_factors_against_the_whirling_rod_over_the_stored_peaks():
 
     tab = T.load_table()
     N = 229  # a node: the stored peaks themselves
-    row = tab.ds.sel(N=N, tip_mass=0.0)
+    row = _table_dataset().sel(N=N, tip_mass=0.0)
     chis = tab.chi
     peaks = {q: row[var].values.astype(float) for q, var in (("v", "v_peak"), ("a", "a_peak"),
                                                                ("sigma", "sigma_peak"))}
@@ -414,13 +422,13 @@ def test_a_resumed_level_must_have_the_same_tolerance_and_masses(tmp_path):
 
     params = {"frac": 0.5, "h_min": 0.02, "h_max": 0.05}
     path = str(tmp_path / "level.nc")
-    first, _ = _run_level((0.5, params, "shared", None, 1e-6, path))
+    first, _ = _run_level((0.5, params, "shared", None, 1e-6, path, None))
     assert first["cpu_time"] > 0 and first["n_links"] < 60
-    again, _ = _run_level((0.5, params, "shared", None, 1e-6, path))
+    again, _ = _run_level((0.5, params, "shared", None, 1e-6, path, None))
     assert math.isnan(again["cpu_time"]) and again["v_peak"] == first["v_peak"]  # resumed
-    other_tol, _ = _run_level((0.5, params, "shared", None, 1e-7, path))
+    other_tol, _ = _run_level((0.5, params, "shared", None, 1e-7, path, None))
     assert not math.isnan(other_tol["cpu_time"])  # run again at its own tolerance
-    other_mass, _ = _run_level((0.5, params, "paper", None, 1e-7, path))
+    other_mass, _ = _run_level((0.5, params, "paper", None, 1e-7, path, None))
     assert not math.isnan(other_mass["cpu_time"])  # and with its own masses
 
 
@@ -616,7 +624,7 @@ def test_combined_sweep_file_that_is_not_a_sweeps_is_not_replaced(tmp_path):
 def test_weighted_fit_standard_errors_against_the_linear_estimator():
     """The intercept and slope are linear in the data, a = sum c_i y_i: with residual variance
     s2 per normalised weight their variances are s2 sum c_i^2 (covariance included)."""
-    from snapping.scaling.fit import _wls
+    from snapping.scaling._loglog import _wls
 
     rng = np.random.default_rng(11)
     for xm_shift in (-3.0, 2.0):  # the window centre on both sides of x = 0 (the covariance's sign)
