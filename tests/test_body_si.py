@@ -270,3 +270,37 @@ def test_api_bad_body_of_sweep_and_converge_is_refused_by_name():
         sweep.Grid(chi=[0.3], N=[10], options={"body": 3})
     c = continuum.converge(0.5, levels=3, first=-2, body=Body())  # a body that changes nothing: the string's study
     assert c.dataset.attrs["grading"] == "fold" and "body" not in c.dataset.attrs
+
+
+def test_wind_without_drag_is_refused_not_ignored(capsys):
+    """The wind acts on a line only through its drag: asked for on the command line without any,
+    it is refused by name (it used to run as if it had not been given, and leave no trace in
+    the file)."""
+    assert not Body(wind=(0.5, 0.0)).active  # (the API: an inactive body, documented)
+    base = ["simulate", "--chi", "0.25", "--N", "16", "--t-end", "0.1", "--no-progress"]
+    for extra in (["--wind", "0.5,0"], ["--length", "2", "--mass", "0.02", "--wind-si", "3,0"]):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "needs drag" in err[0] and "--drag-normal" in err[0], err
+
+
+@pytest.mark.parametrize("opt, value, needle", [
+    ("--bending", "-1e-4", "--bending=-0.0001 is out of range"),
+    ("--bending", "-inf", "--bending=-inf"),
+    ("--ei", "-1e-3", "--ei=-0.001 is out of range"),
+])
+def test_negative_numbers_in_any_form_reach_the_check_of_their_option(opt, value, needle, capsys):
+    """argparse alone takes only -1 and -.5 for numbers; -1e-4 or -inf read as unknown options
+    ("expected one argument"): the option's own check names the value instead."""
+    si = ["--length", "2", "--mass", "0.02"] if opt == "--ei" else []
+    assert main(["simulate", "--chi", "0.25", "--N", "16", "--t-end", "0.1", *si, opt, value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and needle in err[0], err
+
+
+def test_a_negative_wind_component_is_a_value(capsys):
+    """--wind -0.5,0 (a wind towards -x) is a valid value, not an option."""
+    assert main(["simulate", "--chi", "0.25", "--N", "16", "--t-end", "0.1", "--no-progress", "--json",
+                 "--wind", "-0.5,0", "--drag-normal", "1"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["body"]["wind"] == [-0.5, 0.0]

@@ -518,11 +518,14 @@ CLI_VALID = {
     ("design", "--max-speed", "1e308"), ("design", "--max-acceleration", "1e308"),
     ("fit", "--window=v_max={},1e-2", "5e-324"), ("fit", "--window=v_max=1e-4,{}", "1e308"),
     # a line's body (issue 21): zero is no body, the smallest subnormal a valid (negligible) one, a wind any sign
+    # (a wind without drag is refused on the command line: the base of simulate(body) has none, so only 0 there)
     *{("simulate(body)", o, v) for o in ("--bending", "--bending-damping", "--drag-normal", "--drag-tangential",
-                                         "--tip-drag", "--wind={},0", "--drag-linear") for v in ("0", "5e-324")},
+                                         "--tip-drag", "--drag-linear") for v in ("0", "5e-324")},
+    ("simulate(body)", "--wind={},0", "0"),
     *{("simulate(body SI)", o, v) for o in ("--ei", "--diameter", "--air-density", "--cd-normal", "--cd-tangential",
                                             "--tip-drag-area", "--wind-si={},0") for v in ("0", "5e-324")},
-}  # (a wind "-1,0" typed as a separate word is argparse's refusal, naming the option: --wind=-1,0 is the way)
+    ("simulate(body SI)", "--wind-si={},0", "-1"),  # (a negative number is a value: --wind-si -1,0 too)
+}
 #: a bound that cannot be met: the run fails by design (exit 1, one line on stderr)
 CLI_FAILS = {("simulate", "--max-energy-drift", "5e-324")}
 #: valid values that would start a long computation (converge's --first: level_parameters checks it)

@@ -35,7 +35,19 @@ _SUBCOMMANDS = (_add_ideal, _add_estimate, _add_design, _add_simulate, _add_swee
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors and exit status 2."""
+    """argparse with one-line errors and exit status 2, and negative numbers in any form taken as
+    values (``--bending -1e-4``, ``--wind -0.5,0``: argparse alone reads only ``-1`` and ``-.5``
+    as numbers, the rest as unknown options, "expected one argument")."""
+
+    #: a negative number (decimal or scientific, inf, nan) or a comma list starting with one
+    _NEGATIVE = r"-(?:\d+\.?\d*|\.\d+|inf|nan)(?:[eE][-+]?\d+)?"
+
+    def __init__(self, *args, **kwargs):
+        import re
+
+        super().__init__(*args, **kwargs)
+        num = self._NEGATIVE
+        self._negative_number_matcher = re.compile(rf"^{num}(?:,\s*[-+]?{num[1:]})*$", re.IGNORECASE)
 
     def error(self, message: str):  # noqa: D401 - argparse API
         import re

@@ -96,7 +96,15 @@ def body_from_args(args):
     kw["clamp"] = clamp
     if si is not None:
         kw.update(_si_numbers(args, si))
-    return Body(**kw)
+    body = Body(**kw)
+    if body.wind != (0.0, 0.0) and body.tip_drag == 0.0 and all(
+            body._zero(k) for k in ("drag_normal", "drag_tangential", "drag_linear_normal", "drag_linear_tangential")):
+        # (the API's Body takes it, as an inactive body; on the command line it would be an option silently dropped)
+        opt = "--wind-si" if args.wind is None else "--wind"
+        raise SnappingInputError(f"{opt} needs drag: the wind acts on the line only through its drag (give "
+                                 f"--drag-normal, --drag-tangential, --drag-linear or --tip-drag, or --diameter "
+                                 f"or --tip-drag-area with --length and --mass)")
+    return body
 
 
 def body_si_inputs(args) -> dict | None:
