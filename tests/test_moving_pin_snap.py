@@ -196,3 +196,26 @@ def test_a_tables_last_sample_is_a_jump_with_the_same_convention():
     assert m.kinematics(t_last)[4] == 0.0
     assert m.kinematics(t_last - 1e-9)[4] == pytest.approx(1.0, rel=1e-6)
     assert m.kinematics(t_last)[0] == pytest.approx(0.08, rel=1e-12)
+
+
+def test_the_records_rule_needs_a_rise_after_settling():
+    """The rule on a record (synthetic, so the answer is known): a relative speed that only
+    falls after the held end settled is no snap (the held end's drive dying away); one that
+    rises and then falls below half of its peak is; the record before the settle time does
+    not count (its 2.0 is not the peak the fall is judged against)."""
+    from snapping.simulate import general as G
+    from snapping.simulate import kernels as K
+
+    col = K.NREC + G.RECORD_NAMES_G.index("v_rel_max")
+
+    def record(t, v):
+        rec = np.zeros((len(t), G.NREC_G))
+        rec[:, K.R_T] = t
+        rec[:, col] = v
+        return rec
+
+    t = [0.0, 0.2, 0.3, 0.4, 0.5, 0.6]
+    assert not D.relative_fall(record(t, [0.0, 2.0, 1.0, 0.8, 0.4, 0.3]), 0.3, 0.5)   # falls only
+    assert D.relative_fall(record(t, [0.0, 2.0, 1.0, 1.2, 0.9, 0.5]), 0.3, 0.5)       # rises to 1.2, then < 0.6
+    assert not D.relative_fall(record(t, [0.0, 2.0, 1.0, 1.2, 0.9, 0.7]), 0.3, 0.5)   # not below half yet
+    assert not D.relative_fall(record(t, [5.0, 0.1, 1.0, 1.2, 0.9, 0.7]), 0.0, 0.5)   # armed at 5.0, never exceeded: no rise
