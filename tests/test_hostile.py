@@ -465,13 +465,7 @@ def test_catalogue_size():
 
 # ------------------------------------------------------------------ #25 section 3: behaviours
 # (the refusals of #25 are in the catalogues above: _py_cases_25 and the end of _cli_cases)
-def _cli(argv, capsys):
-    try:
-        status = main([str(a) for a in argv])
-    except SystemExit as exc:
-        status = exc.code
-    out, err = capsys.readouterr()
-    return status, out, err
+from test_files import _cli  # noqa: E402 (the command run in-process: status, stdout, stderr)
 
 
 def _interrupted_checkpoint(path, **kw):
