@@ -147,10 +147,11 @@ def _cmd_simulate(args) -> int:
 
         taper = None if args.taper is None else _numbers("--taper", args.taper.replace(":", ","), 1, 2)
         supports = None if args.supports is None else _numbers("--supports", args.supports, 2, 2)
+        from ._body import attach_body, body_from_args, line_links
+
         problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
                                tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
-                               pin_motion=args.pin_motion, gravity=args.gravity)
-        from ._body import attach_body, body_from_args
+                               pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
         body = body_from_args(args)
         if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
@@ -254,7 +255,7 @@ _RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "s
 #: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
 _PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity", "bending", "damping",
                     "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp", "ei", "diameter",
-                    "air_density", "cd_normal", "cd_tangential", "tip_drag_area", "wind_si")
+                    "air_density", "cd_normal", "cd_tangential", "tip_drag_area", "wind_si", "line")
 
 
 def _given_text(args, key: str) -> str:
