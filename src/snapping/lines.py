@@ -321,7 +321,7 @@ CATALOGUE: dict[str, Line] = {ln.name: ln for ln in (
              "tip_mass": "1 g: an estimate for a nylon cracker (popper)",
              "tip_drag_area": "1e-4 m^2: an estimate for the cracker's frayed end (C_d A)",
              "cd_tangential": _CT,
-             "ea": "None: not known here"}),
+             "ea": "None: no published value found (the plaited thong is inextensible here)"}),
     Line("climbing-rope", "dynamic single climbing rope, 9.8 mm (EN 892)",
          mass_per_length=0.062, diameter=9.8e-3, ei=6e-4, cd_normal=1.2, cd_tangential=0.01,
          ea=75 * 9.81 / 0.08, length=30.0,
