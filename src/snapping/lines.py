@@ -9,7 +9,7 @@ was derived. Use a line by name::
 
     >>> from snapping import lines
     >>> fly = lines.get("fly-line")
-    >>> round(fly.mass(9.144 + 0.15) * 1e3 - fly.mass(0.15) * 1e3, 3)   # 30 ft after the tip: 140 grains
+    >>> round((fly.mass(0.1524 + 9.144) - fly.mass(0.1524)) * 1e3, 3)   # g in 30 ft after the tip: 140 grains
     9.072
     >>> body = fly.body(9.144)             # the Body of 30 ft of line (a snapping.simulate.Body)
     >>> problem = fly.problem(0.25, 40, length=9.144)   # its catenary start, tapered masses included
