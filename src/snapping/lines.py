@@ -207,12 +207,13 @@ class Line:
         and the tip body's mass; the paper's uniform chain for a uniform line without one."""
         from .simulate import Links
 
+        N = V.integer("N", N, 1)
         L = self.length if length is None else V.positive("length", length)
         M = self.mass(L)
         if self.taper is None and self.tip_mass == 0.0:
             return Links.uniform(N)
         lam = M / L
-        return Links.from_density(np.full(V.integer("N", N, 1), 1.0 / N),
+        return Links.from_density(np.full(N, 1.0 / N),
                                   lambda u: self.mass_per_length * self.ratio(L * (1.0 - u), L) ** 2 / lam,
                                   tip_mass=self.tip_mass / M, kind="line", params={"line": self.name})
 
