@@ -140,6 +140,7 @@ def test_cli_line_runs_the_catalogue_problem_and_options_override(capsys):
     wh = lines.get("bullwhip")
     ref = run(wh.problem(0.3, 30), progress=False).summary()
     assert s["v_peak"] == ref["v_peak"] and s["n_rhs"] == ref["n_rhs"]  # bit for bit: masses, taper, tip body
+    assert s["line"] == "bullwhip" and s["body_si"]["ei"]["value"] == "profile: bullwhip ei"
     s2 = _cli_json(["simulate", "--chi", "0.3", "--N", "30", "--line", "nylon-monofilament", "--length", "2",
                     "--ei", "0"], capsys)
     ny = lines.get("nylon-monofilament")

@@ -199,6 +199,8 @@ def _cmd_simulate(args) -> int:
     body_si = si_summary(body_si_inputs(args)) if args.resume is None else None
     if body_si:
         summary["body_si"] = body_si  # the SI inputs the body's numbers ("body") were made from
+    if getattr(args, "line_obj", None) is not None and args.resume is None:
+        summary["line"] = args.line_obj.name  # (snapping.lines: the catalogue's line, as overridden)
     bad = _nonfinite(summary)
     if bad and failed is None:  # a completed run whose results are not numbers: not a result
         where = f" (the run file is {args.output})" if args.output else ""
