@@ -224,3 +224,25 @@ def test_energy_balance_of_a_real_line_closes_and_the_dissipation_is_the_drag_wo
     D = float(ds["dissipated"][-1])
     assert D > 0.1 * float(ds["energy"][0])  # the air takes a good part of the energy by t = 1
     assert work == pytest.approx(D, rel=1e-10)  # (measured 9e-13; 200 intervals instead of 800: 3e-8)
+
+
+def test_the_showcase_compares_like_with_like():
+    """examples/real_lines.py: the ideal chain has the real line's links, start and held-end
+    motion, and no body; the whip's handle turns by the stroke's angle and is at rest after it."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "examples" / "real_lines.py"
+    spec = importlib.util.spec_from_file_location("real_lines", path)
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    for name in ("bullwhip", "fly-line"):
+        real, ideal = ex.problems(name, 20)
+        assert ideal.body is None and real.body.active
+        np.testing.assert_array_equal(real.links.m, ideal.links.m)
+        np.testing.assert_array_equal(real.x, ideal.x)
+        assert real.pin.describe() == ideal.pin.describe()
+    real, _ = ex.problems("bullwhip", 20)
+    t, a = real.body.clamp
+    assert a[-1] - a[0] == pytest.approx(2.0, rel=1e-12) and t[-1] == 0.3
+    assert real.pin.kind == "flick" and real.pin.accel == (-10.0, 0.0)
