@@ -104,7 +104,9 @@ def _si_scales(args):
     --length nor --mass is given; SnappingInputError naming the option when one is bad."""
     from .._validate import SnappingInputError
     from ..units import Scales
+    from ._body import apply_line
 
+    apply_line(args)  # --line NAME: its --length, --mass and SI body where not given
     if args.length is None and args.mass is None:
         if "g" in getattr(args, "_explicit", ()):
             raise SnappingInputError(f"--g {args.g!r} needs --length METERS and --mass KG (it only scales SI output)")

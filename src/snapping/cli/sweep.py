@@ -66,8 +66,9 @@ def _cmd_sweep(args) -> int:
     scales = _si_scales(args)
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method), ("chords", args.chords))
                if v is not None}
-    from ._body import body_from_args
+    from ._body import body_from_args, refuse_line_masses
 
+    refuse_line_masses(args, "sweep")
     body = body_from_args(args)
     if body is not None and body.active:
         options["body"] = body
@@ -215,8 +216,9 @@ def _cmd_converge(args) -> int:
             check_writable(args.plot, name="plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
-    from ._body import body_from_args
+    from ._body import body_from_args, refuse_line_masses
 
+    refuse_line_masses(args, "converge")
     body = body_from_args(args)
     if "n0" in getattr(args, "_explicit", ()) and body is None:
         raise SnappingInputError(f"--n0 {args.n0} needs a body (--bending, --drag-normal, ...): without one the "
