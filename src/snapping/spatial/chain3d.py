@@ -64,6 +64,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ..simulate.general import BLOCK, _pow2_near
+
 __all__ = ["Work", "make_model", "rhs3d", "measure3d", "project", "pin3d", "nodes_to_state", "state_to_nodes",
            "NMEAS", "MEAS_NAMES"]
 
@@ -165,29 +167,43 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
     Y = N
     Z = 2 * N
     U = n3
-    # ---- pass 1: row j: sub T_{j-1} + b_j T_j + sup_j T_{j+1} = r_j
-    sub = 0.0  # C_{j-1}/m_j
-    cprev = 0.0
-    dprev = 0.0
-    for j in range(N):
-        ux = y[U + X + j]
-        uy = y[U + Y + j]
-        uz = y[U + Z + j]
-        r = -h[j] * (ux * ux + uy * uy + uz * uz)
-        if j < N - 1:
-            b = -(invm[j] + invm[j + 1])
-            C = y[X + j] * y[X + j + 1] + y[Y + j] * y[Y + j + 1] + y[Z + j] * y[Z + j + 1]
-            sup = C * invm[j + 1]
-        else:
-            b = -invm[j]
-            r -= Ex * y[X + j] + Ey * y[Y + j] + Ez * y[Z + j]
-            sup = 0.0
-        den = 1.0 / (b - sub * cprev)
-        cprev = sup * den
-        dprev = (r - sub * dprev) * den
-        cp[j] = cprev
-        dp[j] = dprev
-        sub = sup
+    # ---- pass 1: row j: e_{j-1} T_{j-1} + b_j T_j + e_j T_{j+1} = r_j; Thomas's pivots as ratios of
+    # leading minors p_j = b_j p_{j-1} - e_{j-1}^2 p_{j-2}, q_j = r_j p_{j-1} - e_{j-1} q_{j-1} (no
+    # division in the recurrence; cp_j = e_j p_{j-1}/p_j, dp_j = q_j/p_j), rescaled by a power of two
+    # every BLOCK rows (as snapping.simulate.general.general_rhs; the recurrences are homogeneous)
+    eprev = 0.0
+    pm = 1.0
+    pmm = 0.0
+    q = 0.0
+    j0 = 0
+    while j0 < N:
+        j1 = min(j0 + BLOCK, N)
+        for j in range(j0, j1):
+            ux = y[U + X + j]
+            uy = y[U + Y + j]
+            uz = y[U + Z + j]
+            r = -h[j] * (ux * ux + uy * uy + uz * uz)
+            if j < N - 1:
+                b = -(invm[j] + invm[j + 1])
+                C = y[X + j] * y[X + j + 1] + y[Y + j] * y[Y + j + 1] + y[Z + j] * y[Z + j + 1]
+                e = C * invm[j + 1]
+            else:
+                b = -invm[j]
+                r -= Ex * y[X + j] + Ey * y[Y + j] + Ez * y[Z + j]
+                e = 0.0
+            p = b * pm - (eprev * eprev) * pmm
+            q = r * pm - eprev * q
+            inv = 1.0 / p
+            cp[j] = e * pm * inv
+            dp[j] = q * inv
+            pmm = pm
+            pm = p
+            eprev = e
+        sc = 1.0 / _pow2_near(pm)
+        pm *= sc
+        pmm *= sc
+        q *= sc
+        j0 = j1
     # ---- pass 2: back substitution
     Tn = dp[N - 1]
     T[N - 1] = Tn
