@@ -184,6 +184,8 @@ def test_whirling_chain_stays_steady():
     r = np.column_stack([P[:, 0], P[:, 1], np.zeros(N + 1)])
     v = np.column_stack([np.zeros(N + 1), np.zeros(N + 1), -Omega * P[:, 0]])  # Omega yhat x r
     prob = Problem3D(links, r, v)
+    made = Problem3D.whirling(Omega, links=links)  # (the constructor's own shooting: the same shape)
+    assert np.abs(made.r - r).max() < 1e-13 and np.abs(made.v - v).max() < 1e-13
     turns = 3
     res = run3d(prob, tol=1e-11, t_end=turns * 2 * math.pi / Omega)
     rn, vn = C.state_to_nodes(res["state"], links.h)
@@ -207,6 +209,8 @@ def test_whirling_chain_stays_steady():
                        g_dir=(0.0, 0.0, 0.0)), "g_dir"),
     (lambda: Problem3D(Links.uniform(2), [[0, 0.9, 0], [0, 0.5, 0], [0, 0, 0]], np.zeros((3, 3))), "link 0"),
     (lambda: Problem3D.nodes([[0, 1.0], [0, 0]]), "3 columns"),
+    (lambda: Problem3D.whirling(1.0, 30), "omega"),
+    (lambda: Problem3D.whirling(float("inf"), 30), "omega"),
 ])
 def test_bad_input_is_named(make, word):
     with pytest.raises(SnappingInputError, match=word):

@@ -199,6 +199,50 @@ class Problem3D:
         return replace(self, v=v, start=start)
 
     @classmethod
+    def whirling(cls, omega: float, N: int | None = None, *, links: Links | None = None, gravity: float = 1.0,
+                 **kw) -> "Problem3D":
+        """The chain rotating steadily at rate ``omega`` about the vertical (gravity's direction,
+        +y) through its held end, free end out (the first mode), in the plane z = 0 at t = 0
+        with velocities ``omega yhat x r``. Its discrete shape: node by node from the free end
+        (radius ``x0``), ``T_j e_j = T_{j-1} e_{j-1} - m_j (g yhat + omega^2 x_j xhat)``, with
+        ``x0`` found (bisection, then Brent) so that the held end lies on the axis. Below the
+        first critical rate (about ``1.2 sqrt(g/L)`` for a uniform chain) the only steady state
+        is hanging straight: SnappingInputError."""
+        from scipy.optimize import brentq
+
+        links = Links.uniform(V.integer("N", N, 1)) if links is None else links
+        w = V.real("omega", omega)
+        g = V.real("gravity", gravity)
+        h, m = links.h, links.m
+
+        def shoot(x0):
+            x, y, Fx, Fy = x0, 0.0, 0.0, 0.0
+            pts = [(x, y)]
+            for j in range(links.N):
+                Fx, Fy = Fx - m[j] * w * w * x, Fy - m[j] * g
+                T = math.hypot(Fx, Fy)
+                x, y = x + h[j] * Fx / T, y + h[j] * Fy / T
+                pts.append((x, y))
+            return np.array(pts)
+
+        L = links.length
+        xs = np.linspace(1e-6 * L, L, 2001)
+        xN = np.array([shoot(x)[-1, 0] for x in xs])
+        P = None
+        for k in np.flatnonzero(np.sign(xN[1:]) != np.sign(xN[:-1])) if w > 0.0 and g > 0.0 else []:
+            x0 = brentq(lambda x: shoot(x)[-1, 0], xs[k], xs[k + 1], xtol=1e-15 * L, rtol=1e-15)
+            Q = shoot(x0)
+            if np.all(Q[:, 0] - Q[-1, 0] >= -1e-12 * L):  # (the first mode: the chain does not cross the axis)
+                P = Q - Q[-1]
+                break
+        if P is None:
+            raise V.SnappingInputError(f"omega={omega!r} has no steady whirling shape (gravity {g:g}): the rate must "
+                                       f"exceed the chain's first critical rate (about 1.2 sqrt(g/L) uniform)")
+        r = np.column_stack([P[:, 0], P[:, 1], np.zeros(links.N + 1)])
+        v = np.column_stack([np.zeros(links.N + 1), np.zeros(links.N + 1), -w * P[:, 0]])
+        return cls(links, r, v, gravity=g, start={"kind": "whirling", "omega": w, "x0": float(P[0, 0])}, **kw)
+
+    @classmethod
     def nodes(cls, r, v=None, *, links: Links | None = None, **kw) -> "Problem3D":
         """Start from node coordinates ((N + 1, 3), row N the held end at the origin); ``links``
         default: uniform links of the chords' length (the chords must be equal)."""
