@@ -17,6 +17,7 @@ Usage::
 
     python benchmarks/bench_chain3d.py                     # all three
     python benchmarks/bench_chain3d.py --parts growth --N 100,200,400 --chi 0.25,0.1
+    python benchmarks/bench_chain3d.py --parts growth --N 200 --chi 0.25 --mode random --seed 1
     python benchmarks/bench_chain3d.py --parts cost,big --tol 1e-8
 """
 
@@ -34,17 +35,18 @@ def _load() -> str:
     return "load %.2f %.2f %.2f" % os.getloadavg()
 
 
-def growth(chis, Ns, epss, tol):
+def growth(chis, Ns, epss, tol, mode="sin", seed=1):
     from snapping.spatial import Problem3D, run3d
 
-    print(f"# out-of-plane growth: velocity perturbation eps sin(pi s/L), tol {tol:g}")
+    what = "eps sin(pi s/L)" if mode == "sin" else f"eps times random node values (seed {seed}, max 1)"
+    print(f"# out-of-plane growth: velocity perturbation {what}, tol {tol:g}")
     print(f"{'chi':>5} {'N':>5} {'eps':>7} {'v_peak':>12} {'dv/v':>10} {'z_snap/eps':>11} {'vz_snap/eps':>12} "
           f"{'zmax/eps':>9} {'vzmax/eps':>10} {'n_rhs':>7}")
     for chi in chis:
         for N in Ns:
             base = run3d(Problem3D.catenary(chi, N), tol=tol)
             for eps in epss:
-                r = run3d(Problem3D.catenary(chi, N).perturbed(eps), tol=tol)
+                r = run3d(Problem3D.catenary(chi, N).perturbed(eps, mode, seed=seed), tol=tol)
                 dv = r["v_peak"] / base["v_peak"] - 1.0
                 print(f"{chi:5.2f} {N:5d} {eps:7.0e} {r['v_peak']:12.9f} {dv:10.2e} {r['z_amp_snap'] / eps:11.6f} "
                       f"{r['vz_amp_snap'] / eps:12.5f} {r['z_amp_max'] / eps:9.5f} {r['vz_amp_max'] / eps:10.4f} "
@@ -120,14 +122,15 @@ def big(N, chi, tol, eps=1e-4):
     run3d(Problem3D.catenary(0.5, 10), tol=tol)  # (compiled)
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     p3 = Problem3D.catenary(chi, N).perturbed(eps)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     r = run3d(p3, tol=tol)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     state_mb = (2 * 16 + 2 * 7 + 6) * (6 * N + 1) * 8 / 2**20
     print(f"# N={N}, chi={chi}, tol={tol:g}, eps={eps:g} ({_load()})")
     print(f"v_peak {r['v_peak']:.9f} at t {r['t_snap_v']:.9f}, z_snap/eps {r['z_amp_snap'] / eps:.6f}, "
-          f"{r['n_rhs']} evaluations, {r['n_steps']} steps, run {r['wall_time']:.1f} s (with the start: {wall:.1f} s), "
+          f"{r['n_rhs']} evaluations, {r['n_steps']} steps, wall {wall:.1f} s, CPU {cpu:.1f} s "
+          f"({cpu / r['n_rhs'] * 1e6:.0f} us CPU an evaluation incl. stepping), "
           f"peak RSS {rss1 / 1024:.0f} MiB (grew {(rss1 - rss0) / 1024:.0f} MiB; stepper arrays {state_mb:.0f} MiB)")
 
 
@@ -138,6 +141,8 @@ def main(argv=None):
     ap.add_argument("--N", default="100,200,400")
     ap.add_argument("--eps", default="1e-6,1e-4,1e-2")
     ap.add_argument("--tol", type=float, default=1e-10, help="tol of the growth study")
+    ap.add_argument("--mode", default="sin", help="perturbation mode (sin, random)")
+    ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--cost-tol", type=float, default=1e-8)
     ap.add_argument("--cost-N", type=int, default=1000)
     ap.add_argument("--big-N", type=int, default=10000)
@@ -145,7 +150,7 @@ def main(argv=None):
     parts = a.parts.split(",")
     if "growth" in parts:
         growth([float(c) for c in a.chi.split(",")], [int(n) for n in a.N.split(",")],
-               [float(e) for e in a.eps.split(",")], a.tol)
+               [float(e) for e in a.eps.split(",")], a.tol, a.mode, a.seed)
     if "cost" in parts:
         cost(a.cost_N, 0.25, a.cost_tol)
     if "big" in parts:

@@ -63,6 +63,53 @@ NREC = 3 + C.NMEAS
 RECORD_NAMES = ("t", "dt", "err") + C.MEAS_NAMES
 RECORD_CHUNK = 4096
 PEAK_XTOL = 1e-10
+#: error norm: per link (:func:`step_error3d`, True) or per component (:func:`snapping.simulate.rk.step_error`)
+NORM_LINK = True
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
+    """The scaled error of a step (accept if <= 1): Hairer's DOP853 estimate of every
+    component (as :func:`snapping.simulate.rk.scaled_error`), scaled per link by
+    ``tol (1 + |e_j|)`` for the three components of ``e_j`` and ``tol (1 + |u_j|)`` for those
+    of ``u_j`` (the larger at the step's two ends), maximum over the components. The norm of
+    the link's vector, not each component's own size: a component that passes through zero
+    while the link turns fast (``|u_j|`` large) would otherwise ask for a relative accuracy
+    the planar method (whose angular velocity is the link's ``|u_j|``) never asks for."""
+    n3 = 3 * N
+    for j in range(N):
+        a0 = 0.0
+        a1 = 0.0
+        b0 = 0.0
+        b1 = 0.0
+        for c in range(3):
+            i = c * N + j
+            a0 += y0[i] * y0[i]
+            a1 += y1[i] * y1[i]
+            b0 += y0[n3 + i] * y0[n3 + i]
+            b1 += y1[n3 + i] * y1[n3 + i]
+        se = tol * (1.0 + math.sqrt(max(a0, a1)))
+        su = tol * (1.0 + math.sqrt(max(b0, b1)))
+        for c in range(3):
+            ytmp[c * N + j] = se
+            ytmp[n3 + c * N + j] = su
+    ytmp[2 * n3] = tol * (1.0 + max(abs(y0[2 * n3]), abs(y1[2 * n3])))
+    err = 0.0
+    for i in range(2 * n3 + 1):
+        e5 = 0.0
+        for jj in range(R._E5NZ.size):
+            e5 += R.E5_RK[R._E5NZ[jj]] * Kst[R._E5NZ[jj], i]
+        e3 = 0.0
+        for jj in range(R._E3NZ.size):
+            e3 += R.E3_RK[R._E3NZ[jj]] * Kst[R._E3NZ[jj], i]
+        sc = ytmp[i]
+        e5 /= sc
+        e3 /= sc
+        d = e5 * e5 + 0.01 * e3 * e3
+        v = abs(h) * e5 * e5 / math.sqrt(d) if d > 0.0 else (0.0 if d == 0.0 else np.inf)
+        if not v <= err:  # (NaN propagates)
+            err = v
+    return err
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -74,6 +121,8 @@ def step3d(N, t, h, y0, y1, Kst, ytmp, T, cp, dp, tol, par, hh, invm):
         C.rhs3d(N, t + R.C_RK[st] * h, ytmp, Kst[st], T, cp, dp, par, hh, invm)
     R.end_state(n, h, y0, Kst, y1)
     C.rhs3d(N, t + h, y1, Kst[R.NS], T, cp, dp, par, hh, invm)
+    if NORM_LINK:
+        return step_error3d(N, h, tol, y0, y1, Kst, ytmp)
     return R.step_error(n, h, tol, y0, y1, Kst, ytmp)
 
 
