@@ -88,28 +88,20 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
             a1 += y1[i] * y1[i]
             b0 += y0[n3 + i] * y0[n3 + i]
             b1 += y1[n3 + i] * y1[n3 + i]
-        se = tol * (1.0 + math.sqrt(max(a0, a1)))
-        su = tol * (1.0 + math.sqrt(max(b0, b1)))
+        se = math.sqrt(max(a0, a1))
+        su = math.sqrt(max(b0, b1))
         for c in range(3):
             ytmp[c * N + j] = se
             ytmp[n3 + c * N + j] = su
-    ytmp[2 * n3] = tol * (1.0 + max(abs(y0[2 * n3]), abs(y1[2 * n3])))
+    ytmp[2 * n3] = max(abs(y0[2 * n3]), abs(y1[2 * n3]))
+    n = 2 * n3 + 1
+    for i in range(n):  # (rk's branch-free component error with |y| := the link's norm: vectorises)
+        ytmp[i] = R.scaled_error(Kst, i, ytmp[i], ytmp[i], h, tol)
     err = 0.0
-    for i in range(2 * n3 + 1):
-        e5 = 0.0
-        for jj in range(R._E5NZ.size):
-            e5 += R.E5_RK[R._E5NZ[jj]] * Kst[R._E5NZ[jj], i]
-        e3 = 0.0
-        for jj in range(R._E3NZ.size):
-            e3 += R.E3_RK[R._E3NZ[jj]] * Kst[R._E3NZ[jj], i]
-        sc = ytmp[i]
-        e5 /= sc
-        e3 /= sc
-        d = e5 * e5 + 0.01 * e3 * e3
-        v = abs(h) * e5 * e5 / math.sqrt(d) if d > 0.0 else (0.0 if d == 0.0 else np.inf)
-        if not v <= err:  # (NaN propagates)
-            err = v
-    return err
+    for i in range(n):
+        if ytmp[i] > err:
+            err = ytmp[i]
+    return err if err - err == 0.0 else np.inf
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
