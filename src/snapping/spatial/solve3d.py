@@ -8,7 +8,8 @@ has its own loop, :func:`advance3d`, around :func:`snapping.spatial.chain3d.rhs3
 
 Per attempted step: 12 evaluations (first same as last); 3 more for the dense output of a
 step a peak search needs, 1 per point of the search. Error control as the planar method
-(max norm over the 6N components, rtol = atol = ``tol``). After each accepted step the state
+(max norm, rtol = atol = ``tol``), each component scaled by its link's vector norm
+(:func:`step_error3d`). After each accepted step the state
 is projected back onto ``|e_j| = 1, e_j . u_j = 0`` (:func:`snapping.spatial.chain3d.project`);
 the next step's first stage is the last stage of this one (at the unprojected end state,
 which differs by the local error: ``reeval=True`` evaluates it again at the projected state,
@@ -422,7 +423,8 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     out-of-plane amplitude, ``vz_amp_snap``), the largest out-of-plane amplitude over the
     run, the final state's, the counts ``n_rhs, n_steps, n_rejected``, the wall time, the
     drifts of the energy balance ``E - W`` and (fixed end) of the angular momentum along
-    gravity, the largest link error, ``record`` (one row an accepted step, columns
+    gravity, the largest link error ``| |e_j| - 1 |`` at the end of an accepted step before
+    its projection (what the projection removes; after it, links are unit to round-off), ``record`` (one row an accepted step, columns
     :data:`RECORD_NAMES`) and ``state`` (the final state ``[e, u, W]``).
     """
     from .._validate import SnappingInputError
