@@ -1,0 +1,89 @@
+"""The 3D run Dataset (snapping.spatial.dataset3d), the CLI's 3D runs and the 3D figures.
+
+Checks against independent references: the planar run (snapping.simulate, method fast) of
+the same planar problem gives the snapshots x, y, vx, vy and the tensions (its own solve, in
+link angles), and its energy zero; the z of a planar problem is exactly 0.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from snapping import schema
+from snapping.cli import main
+from snapping.simulate import run
+from snapping.simulate.dataset import load_run
+from snapping.simulate.problem import Problem
+from snapping.spatial import Problem3D
+from snapping.spatial.dataset3d import run3d_dataset
+
+TIMES = [0.5, 1.0]
+
+
+@pytest.fixture(scope="module")
+def pair():
+    planar = run(Problem.catenary(0.25, 30), method="fast", tol=1e-11, snapshot_times=TIMES, progress=False).dataset
+    spatial = run3d_dataset(Problem3D.catenary(0.25, 30), tol=1e-11, snapshot_times=TIMES)
+    return planar, spatial
+
+
+def _requested(ds):
+    return ds.isel(snapshot=np.flatnonzero(ds["snapshot_kind"].values == "requested"))
+
+
+def test_planar_problem_in_3d_has_the_planar_snapshots(pair):
+    planar, spatial = pair
+    p, s = _requested(planar), _requested(spatial)
+    np.testing.assert_array_equal(s["t_snapshot"].values, TIMES)
+    np.testing.assert_array_equal(p["t_snapshot"].values, TIMES)
+    for name, tol in (("x", 1e-12), ("y", 1e-12), ("vx", 1e-11), ("vy", 1e-11), ("tension", 1e-11)):
+        np.testing.assert_allclose(s[name].values, p[name].values, rtol=0, atol=tol, err_msg=name)
+    assert np.all(spatial["z"].values == 0.0) and np.all(spatial["vz"].values == 0.0)
+    assert np.all(spatial["z_amp"].values == 0.0)
+    # the energy has the planar zero (hanging straight at rest), and the same start
+    assert spatial.attrs["energy_initial"] == pytest.approx(planar.attrs["energy_initial"], abs=1e-14)
+    assert spatial.attrs["v_peak"] == pytest.approx(planar.attrs["v_peak"], rel=1e-10)
+    assert spatial.attrs["t_snap_v"] == pytest.approx(planar.attrs["t_snap_v"], abs=1e-8)
+
+
+def test_names_are_in_the_schema_and_a_planar_run_has_no_3d_name(pair):
+    planar, spatial = pair
+    known = {**schema.ALL_VARS, **schema.SPATIAL_VARS}
+    for name, var in spatial.data_vars.items():
+        assert name in known, name
+        assert var.attrs["units"] and var.attrs["long_name"], name
+    for name in spatial.coords:
+        assert name in schema.COORDS, name
+    attrs_known = (set(schema.INPUT_ATTRS) | set(schema.RESULT_ATTRS) | set(schema.PROBLEM_ATTRS)
+                   | set(schema.SPATIAL_ATTRS) | {"title", "Conventions", "units"})
+    assert set(spatial.attrs) <= attrs_known, set(spatial.attrs) - attrs_known
+    new = set(schema.SPATIAL_VARS) | set(schema.SPATIAL_ATTRS)
+    assert not new & (set(schema.ALL_VARS) | set(schema.RESULT_ATTRS) | set(schema.INPUT_ATTRS))
+    assert not new & (set(planar.data_vars) | set(planar.attrs))
+    assert {"z", "vz", "z_amp", "vz_amp", "start_z", "start_vz"} <= set(spatial.data_vars)
+
+
+def test_perturbed_run_dataset_records_the_out_of_plane_motion(tmp_path):
+    eps = 1e-4
+    p = Problem3D.catenary(0.25, 20).perturbed(eps)
+    path = tmp_path / "run3d.nc"
+    ds = run3d_dataset(p, tol=1e-9, snapshot_times=[0.3], output=path)
+    back = load_run(path)
+    assert int(back.attrs["dims"]) == 3 and json.loads(back.attrs["perturbation"])["eps"] == eps
+    np.testing.assert_array_equal(back["z"].values, ds["z"].values)
+    # the initial snapshot is the start; the record's z_amp is the snapshots' largest |z| (plane z = 0)
+    np.testing.assert_allclose(ds["vz"].isel(snapshot=0).values, p.v[:, 2], rtol=0, atol=1e-16)
+    for i, t in enumerate(ds["t_snapshot"].values):
+        k = int(np.argmin(abs(ds["t"].values - t)))
+        if ds["t"].values[k] == t:
+            assert ds["z_amp"].values[k] == pytest.approx(abs(ds["z"].isel(snapshot=i)).max(), rel=1e-12)
+    pk = ds.isel(snapshot=int(np.flatnonzero(ds["snapshot_kind"].values == "peak")[0]))
+    assert float(abs(pk["z"]).max()) == pytest.approx(ds.attrs["z_amp_snap"], rel=1e-9)
+    assert float(pk["speed"].max()) == pytest.approx(ds.attrs["v_peak"], rel=1e-9)
+    # links exactly their length in every snapshot
+    r = np.stack([ds[c].values for c in "xyz"], axis=-1)
+    np.testing.assert_allclose(np.linalg.norm(np.diff(r, axis=1), axis=-1), 1 / 20, rtol=1e-12)
