@@ -80,10 +80,55 @@ def test_perturbed_run_dataset_records_the_out_of_plane_motion(tmp_path):
     for i, t in enumerate(ds["t_snapshot"].values):
         k = int(np.argmin(abs(ds["t"].values - t)))
         if ds["t"].values[k] == t:
-            assert ds["z_amp"].values[k] == pytest.approx(abs(ds["z"].isel(snapshot=i)).max(), rel=1e-12)
+            assert ds["z_amp"].values[k] == pytest.approx(float(abs(ds["z"].isel(snapshot=i)).max()), rel=1e-12)
     pk = ds.isel(snapshot=int(np.flatnonzero(ds["snapshot_kind"].values == "peak")[0]))
     assert float(abs(pk["z"]).max()) == pytest.approx(ds.attrs["z_amp_snap"], rel=1e-9)
     assert float(pk["speed"].max()) == pytest.approx(ds.attrs["v_peak"], rel=1e-9)
     # links exactly their length in every snapshot
     r = np.stack([ds[c].values for c in "xyz"], axis=-1)
     np.testing.assert_allclose(np.linalg.norm(np.diff(r, axis=1), axis=-1), 1 / 20, rtol=1e-12)
+
+
+# ---------------------------------------------------------------- the CLI
+def test_cli_dims3_writes_the_3d_run_file(tmp_path, capsys):
+    path = tmp_path / "r.nc"
+    assert main(["simulate", "--chi", "0.25", "--N", "12", "--perturb", "1e-4", "--tol", "1e-9", "--json",
+                 "--snapshot-times", "0.5", "-o", str(path)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ds = load_run(path)
+    ref = run3d_dataset(Problem3D.catenary(0.25, 12).perturbed(1e-4), tol=1e-9, snapshot_times=[0.5])
+    assert out["dims"] == 3 and out["v_peak"] == ref.attrs["v_peak"] and out["z_amp_snap"] == ref.attrs["z_amp_snap"]
+    np.testing.assert_array_equal(ds["z"].values, ref["z"].values)
+    assert main(["simulate", "--dims", "3", "--chi", "0.25", "--N", "12", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["z_amp_max"] == 0.0
+
+
+def test_cli_whirl_runs_the_steady_shape(tmp_path, capsys):
+    path = tmp_path / "w.nc"
+    assert main(["simulate", "--whirl", "2.5", "--N", "12", "--t-end", "1", "--tol", "1e-10", "--json",
+                 "-o", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["stop_reason"] == "t_end"
+    p = Problem3D.whirling(2.5, 12)
+    ds = load_run(path)
+    # a steady whirl: the start shape turned rigidly about the vertical (velocity -omega x e_z at t = 0)
+    fin = ds.isel(snapshot=-1)
+    t = float(fin["t_snapshot"])
+    assert t == 1.0
+    c, s = math.cos(2.5 * t), math.sin(2.5 * t)
+    np.testing.assert_allclose(fin["x"].values, c * p.r[:, 0], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(fin["z"].values, -s * p.r[:, 0], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(fin["y"].values, p.r[:, 1], rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--chi", "0.25", "--N", "10", "--perturb", "nan"], "eps=nan"),
+    (["--chi", "0.25", "--N", "10", "--perturb", "inf", "--perturb-mode", "random", "--seed", "1"], "eps=inf"),
+    (["--whirl", "0.5", "--N", "10"], "omega=0.5 has no steady whirling shape"),
+    (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--bending", "1e-3"], "no 3D form"),
+    (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--dims", "2"], "--dims 2"),
+    (["--whirl", "2.5", "--N", "10", "--chi", "0.3"], "--whirl"),
+])
+def test_cli_3d_bad_input_is_one_line_exit_2(argv, word, capsys):
+    assert main(["simulate", *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert word in err and len(err.splitlines()) == 1
