@@ -132,3 +132,29 @@ def test_cli_3d_bad_input_is_one_line_exit_2(argv, word, capsys):
     assert main(["simulate", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert word in err and len(err.splitlines()) == 1
+
+
+# ---------------------------------------------------------------- figures
+def test_figures_draw_from_a_small_run(tmp_path):
+    from snapping.figures import save
+    from snapping.spatial.figures3d import amplitude_vs_eps, chain_views, growth
+
+    g = growth(0.5, 8, [1e-6, 1e-5, 1e-4], tol=1e-9)
+    # linear growth: z/eps the same at every eps (independent of the figure: the runs themselves)
+    ratio = g["z_amp_snap"] / g["eps"]
+    assert np.ptp(ratio) < 1e-3 * ratio.mean() and ratio.mean() > 0
+    fig = amplitude_vs_eps(g)
+    ax = fig.axes[0]
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+    # the dotted linear-growth line through the smallest eps has slope 1 on the log-log axes
+    dotted = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
+    x, y = dotted[0].get_data()
+    assert np.log(y[1] / y[0]) / np.log(x[1] / x[0]) == pytest.approx(1.0, abs=1e-12)
+    ds = run3d_dataset(Problem3D.catenary(0.5, 8).perturbed(1e-2), tol=1e-8, snapshot_times=[0.4, 0.8])
+    fig2 = chain_views(ds, n=3)
+    assert len(fig2.axes[1].get_lines()) == 3
+    z_drawn = fig2.axes[2].get_lines()[-1].get_ydata()
+    pk = int(np.flatnonzero(ds["snapshot_kind"].values == "peak")[0])
+    np.testing.assert_array_equal(z_drawn, ds["z"].isel(snapshot=pk).values)
+    paths = save(fig2, tmp_path / "views")
+    assert all(p.stat().st_size > 0 for p in paths)
