@@ -402,8 +402,7 @@ class Stepper3D:
             y = self.state_at(ts)
             C.project(self.N, y)
             self.snapshots.append((ts, "requested", y))
-        # with requested times still to come, hand back to Python after every accepted step
-        # (so the dense output of the step that passes one is still stored); no effect on the steps
+        # times to come: back to Python after every accepted step (its dense output); same steps
         self.ctl[Q_CALLMAX] = 1.0 if pend else self.callmax
 
     def loop(self, snapshot_times=()) -> int:
@@ -447,8 +446,7 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     its projection (what the projection removes; after it, links are unit to round-off), ``record`` (one row an accepted step, columns
     :data:`RECORD_NAMES`) and ``state`` (the final state ``[e, u, W]``), ``snapshots``: a list of
     ``(t, "requested", state)`` at the ``snapshot_times`` reached (dense output, projected;
-    they do not change the steps). :func:`snapping.spatial.dataset3d.run3d_dataset` makes the
-    run Dataset of it.
+    the steps are unchanged; :mod:`snapping.spatial.dataset3d` makes the run Dataset).
     """
     from .._validate import SnappingInputError
 
