@@ -6,7 +6,7 @@
 * :mod:`snapping.spatial.starts3d`: :class:`Problem3D`, planar starts in space and the
   out-of-plane perturbations only 3D has;
 * :mod:`snapping.spatial.dataset3d`: the run Dataset of a 3D run (the planar names, and
-  ``z``, ``vz``, ``z_amp``, ... of :data:`snapping.schema.SPATIAL_VARS`);
+  ``z``, ``vz``, ``z_amp``, ... of ``snapping.schema.SPATIAL_VARS``);
 * :mod:`snapping.spatial.figures3d`: the out-of-plane amplitude against eps, the chain in space.
 
 It imports from :mod:`snapping.simulate` (links, the catenary, the DOP853 tableau); the
