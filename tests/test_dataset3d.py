@@ -50,6 +50,19 @@ def test_planar_problem_in_3d_has_the_planar_snapshots(pair):
     assert spatial.attrs["t_snap_v"] == pytest.approx(planar.attrs["t_snap_v"], abs=1e-8)
 
 
+def test_snapshots_do_not_change_the_steps():
+    from snapping.spatial.solve3d import run3d
+
+    p = Problem3D.catenary(0.3, 15).perturbed(1e-3)
+    a = run3d(p, tol=1e-9)
+    b = run3d(p, tol=1e-9, snapshot_times=[0.0, 0.2, 0.7, 1.0, 50.0])
+    np.testing.assert_array_equal(a["record"], b["record"])
+    assert a["v_peak"] == b["v_peak"] and [s[0] for s in b["snapshots"]] == [0.0, 0.2, 0.7, 1.0]
+    # a snapshot is the state at its time: the dense output agrees with a run stopped there
+    c = run3d(p, tol=1e-12, t_end=0.7)
+    np.testing.assert_allclose(b["snapshots"][2][2], c["state"], rtol=0, atol=3e-9)
+
+
 def test_names_are_in_the_schema_and_a_planar_run_has_no_3d_name(pair):
     planar, spatial = pair
     known = {**schema.ALL_VARS, **schema.SPATIAL_VARS}
@@ -127,6 +140,8 @@ def test_cli_whirl_runs_the_steady_shape(tmp_path, capsys):
     (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--bending", "1e-3"], "no 3D form"),
     (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--dims", "2"], "--dims 2"),
     (["--whirl", "2.5", "--N", "10", "--chi", "0.3"], "--whirl"),
+    (["--dims", "3", "--chi", "0.25", "--N", "10", "--length", "2", "--mass", "0.1"], "--length/--mass"),
+    (["--dims", "3", "--chi", "0.25", "--N", "10", "--method", "euler-richardson"], "--method"),
 ])
 def test_cli_3d_bad_input_is_one_line_exit_2(argv, word, capsys):
     assert main(["simulate", *argv]) == 2

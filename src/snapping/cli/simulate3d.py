@@ -46,6 +46,9 @@ def cmd_simulate3d(args, times) -> int:
         if getattr(args, key) != off:
             raise SnappingInputError(f"--{key.replace('_', '-')} {getattr(args, key)} has no 3D form yet "
                                      f"(a 3D run: --dims 3, --perturb, --whirl)")
+    if getattr(args, "length", None) is not None or getattr(args, "mass", None) is not None:
+        raise SnappingInputError("--length/--mass (results in SI) have no 3D form yet: a 3D run reports "
+                                 "nondimensional numbers")
     if args.method not in ("fast", "dop853"):
         raise SnappingInputError(f"--method {args.method}: a 3D run is stepped by DOP853 (fast or dop853)")
     if args.N is None:
