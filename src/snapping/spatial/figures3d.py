@@ -79,7 +79,7 @@ def chain_views(ds, n: int = 4):
     tpk = ts[kinds == "peak"][0] if np.any(kinds == "peak") else ts[-1]
     idx = [i for i in range(ts.size) if ts[i] <= tpk and kinds[i] != "final"] or [0]
     idx = [idx[int(round(k))] for k in np.linspace(0, len(idx) - 1, min(n, len(idx)))]
-    fig = plt.figure(figsize=(12, 3.9), constrained_layout=True)
+    fig = plt.figure(figsize=(12, 4.3), constrained_layout=True)
     a3 = fig.add_subplot(1, 3, 1, projection="3d")
     axy = fig.add_subplot(1, 3, 2)
     axz = fig.add_subplot(1, 3, 3)
@@ -98,7 +98,7 @@ def chain_views(ds, n: int = 4):
     axy.set_xlabel("x")
     axy.set_ylabel("y (down)")
     axy.set_title("in the start's plane", fontsize=9)
-    axy.legend(fontsize=7)
+    fig.legend(*axy.get_legend_handles_labels(), loc="outside lower center", ncol=len(idx), fontsize=8)
     axz.set_xlabel("x")
     axz.set_ylabel("z (out of the plane)")
     axz.set_title("seen along gravity", fontsize=9)
