@@ -209,7 +209,7 @@ def _cmd_simulate(args) -> int:
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         rows = []
         for k, v in summary.items():
-            if k in ("snap_note", "peaks", "body", "body_si"):
+            if k in ("snap_note", "peaks", "body", "body_si", "compression_note"):
                 continue
             note = note_units.get(k)
             if v is None and k in precise:
@@ -224,6 +224,8 @@ def _cmd_simulate(args) -> int:
         )
         if not reached and summary.get("snap_note"):
             print(f"  note: {summary['snap_note']}")
+        if summary.get("compression_note"):
+            print(f"  note: {summary['compression_note']}")
         _print_body(summary)
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
     if failed is not None:
