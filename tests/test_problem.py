@@ -385,7 +385,7 @@ def test_checkpoint_of_an_older_layout_is_refused_clearly(tmp_path):
     with xr.open_dataset(out) as f:
         ds = f.load()
     ctl = ds["checkpoint_ctl"].values
-    assert ctl.size == R.NQ and ctl[R.Q_TBRK] == np.inf and ds.attrs["checkpoint_version"] == 2
+    assert ctl.size == R.NQ and ctl[R.Q_TBRK] == np.inf and ds.attrs["checkpoint_version"] == 3
     old = ds.drop_vars("checkpoint_ctl").assign(checkpoint_ctl=(("checkpoint_ctl",), ctl[:37]))
     old.attrs["checkpoint_version"] = 1
     del old.attrs[schema.DIGEST_ATTR]
