@@ -28,7 +28,7 @@ compressed when::
 
 the floor 1 being the chain's weight (the force unit M g), the scale of the terms of
 ``b`` when every tension is near zero (a chain in free fall). With the safety factor 8
-this is 4e-12 of the tension scale at N = 24 and 7e-7 at N = 10^4: far below any
+this is 4.3e-12 of the tension scale at N = 24 and 7e-7 at N = 10^4: far below any
 tension a line notices, far above what round-off makes of a chain that never pushes.
 For a general chain (unequal links or masses) the entries are rescaled by the link
 lengths and masses and the bound is the uniform chain's, approximately.
@@ -66,7 +66,7 @@ def compression_tolerance(N: int) -> float:
     N-link chain (see the module's docstring).
 
     >>> f"{compression_tolerance(24):.3g}"
-    '4.26e-12'
+    '4.27e-12'
     """
     return COMPRESSION_SAFETY * (2.0 * N + 1.0) ** 2 * float(np.finfo(float).eps)
 
