@@ -58,6 +58,7 @@ def test_numbers_scale_as_their_definitions():
     assert "link_scale" not in a and a["end_mass"] == 0.0
     assert D.line_numbers(1.0, 0.5, N=[10, 40])["link_scale"] == (0.1, 0.025)
     assert "end_mass" not in D.line_numbers(1.0, 0.5, end_mass=None)
+    assert D.line_numbers(2.0, 0.5, end_mass=0.125)["end_mass"] == 0.25  # M_end / (lambda L) = M_end / M
 
 
 @pytest.mark.parametrize("kw, name", [({"ea": 0.0}, "ea="), ({"ea": math.inf}, "ea="), ({"ea": -5.0}, "ea="),

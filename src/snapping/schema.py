@@ -192,7 +192,7 @@ RESULT_ATTRS: dict[str, str] = {
     "t_min_tension": "time of min_tension",
     "s_min_tension": "arclength of the midpoint of the link of min_tension",
     "t_compression": ("first recorded time at which the rigid links carried compression: sigma_min < "
-                      "-compression_tolerance max(1, sigma_max, |sigma_min|) (NaN: never; the history from then on "
+                      "-compression_tolerance max(1, sigma_max) (NaN: never; the history from then on "
                       "is not what a real, slack-capable line does; snapping.simulate.compression)"),
     "compression_tolerance": ("relative round-off bound of the link tensions, 8 (2N + 1)^2 eps (the condition "
                               "number bound of the tension solve times a safety factor)"),

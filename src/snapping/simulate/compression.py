@@ -24,10 +24,12 @@ backward error of a few units of round-off per row) are in error by at most abou
 ``(2N + 1)^2 eps ||sigma||`` with ``||sigma|| = max_k |sigma_k|``. A step counts as
 compressed when::
 
-    sigma_min < -COMPRESSION_SAFETY (2N + 1)^2 eps max(1, sigma_max, |sigma_min|)
+    sigma_min < -COMPRESSION_SAFETY (2N + 1)^2 eps max(1, sigma_max)
 
 the floor 1 being the chain's weight (the force unit M g), the scale of the terms of
-``b`` when every tension is near zero (a chain in free fall). With the safety factor 8
+``b`` when every tension is near zero (a chain in free fall). (Where ``|sigma_min|`` is the
+largest tension in magnitude, ``||sigma||`` is ``|sigma_min|`` and its sign is certain; the
+rule then holds whichever scale is used, so ``max(1, sigma_max)`` is the whole rule.) With the safety factor 8
 this is 4.3e-12 of the tension scale at N = 24 and 7e-7 at N = 10^4: far below any
 tension a line notices, far above what round-off makes of a chain that never pushes.
 For a general chain (unequal links or masses) the entries are rescaled by the link
@@ -73,13 +75,12 @@ def compression_tolerance(N: int) -> float:
 
 def compressed_steps(records: np.ndarray, N: int) -> np.ndarray:
     """Boolean mask of the recorded steps whose minimum tension is compression (below
-    ``-compression_tolerance(N) max(1, sigma_max, |sigma_min|)``); False where the
+    ``-compression_tolerance(N) max(1, sigma_max)``); False where the
     record has no ``sigma_min`` (NaN: a file written before it existed)."""
     rec = np.asarray(records, dtype=float)
     smin, smax = rec[:, K.R_SIGMIN], rec[:, K.R_SIGMAX]
     with np.errstate(invalid="ignore"):
-        scale = np.fmax(np.fmax(1.0, smax), np.abs(smin))
-        return smin < -compression_tolerance(N) * scale
+        return smin < -compression_tolerance(N) * np.fmax(1.0, smax)
 
 
 def compression_results(records: np.ndarray, N: int) -> dict:
