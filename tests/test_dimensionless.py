@@ -113,3 +113,7 @@ def test_estimate_design_and_sweep_print_it(capsys, tmp_path):
     assert main(["sweep", "--chi", "0.5", "--N", "8,16", "--output", str(tmp_path / "sw"), "--length", "1",
                  "--mass", "0.5", "--bending", "0.001"]) == 0
     assert _block(capsys.readouterr().out) == {"beta": "0.001", "end_mass": "0", "link_scale": "0.125"}
+    assert main(["converge", "--chi", "0.25", "--levels", "3", "--first", "-1", "--length", "1", "--mass", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert _block(out) == {"link_scale": "8e-06"}  # the graded levels' smallest links h_min/L
+    assert "8e-06, 4e-06, 2e-06" in out

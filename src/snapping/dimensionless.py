@@ -12,7 +12,7 @@ name               definition                              mechanism
 ``drag_normal``    0.5 rho C_n d L / lambda                cross-flow air drag (diameter d)
 ``drag_tangential`` 0.5 rho C_t pi d L / lambda            skin friction along the line
 ``end_mass``       M_end / (lambda L)                      a point mass at the free end
-``link_scale``     h / L = 1 / N                           the links (the discreteness)
+``link_scale``     h / L = 1 / N (graded: the smallest)    the links (the discreteness)
 =================  ======================================  ==========================================
 
 The bending and drag numbers are those of :func:`snapping.units.body_numbers` (the
@@ -44,7 +44,7 @@ NUMBERS: dict[str, tuple[str, str]] = {
     "drag_normal": ("0.5 rho C_n d L/lambda", "normal air drag"),
     "drag_tangential": ("0.5 rho C_t pi d L/lambda", "tangential air drag"),
     "end_mass": ("M_end/(lambda L)", "end mass"),
-    "link_scale": ("h/L = 1/N", "links"),
+    "link_scale": ("h/L (1/N; graded links: the smallest)", "links"),
 }
 
 

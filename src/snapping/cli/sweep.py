@@ -201,10 +201,13 @@ def _add_converge(sub) -> None:
     p.set_defaults(func=_cmd_converge)
 
 
-def _level_links(res):
-    """The numbers of links of a convergence study's levels (None: not recorded)."""
-    ds = res.dataset
-    return [int(n) for n in ds["N"].values] if "N" in ds.variables else None
+def _level_numbers(res, scales, args):
+    """The dimensionless numbers of a convergence study's line; its link scale: each level's
+    smallest link h_min/L (graded chains)."""
+    numbers = _dimensionless(scales, args)
+    if numbers is not None and "h_min" in res.dataset.variables:
+        numbers["link_scale"] = tuple(float(h) for h in res.dataset["h_min"].values)
+    return numbers
 
 
 def _cmd_converge(args) -> int:
@@ -243,5 +246,5 @@ def _cmd_converge(args) -> int:
     else:
         print(res.table())
         _print_si(scales, units.si_rows(res.summary(), scales) if scales else [])
-        _print_dimensionless(_dimensionless(scales, args, N=_level_links(res)))
+        _print_dimensionless(_level_numbers(res, scales, args))
     return 0
