@@ -4,16 +4,16 @@ Each mechanism has a scale of its own; measured in the chain's units (length L, 
 length lambda = M/L, gravity g) it is one number, and the ideal chain is the limit where
 every number goes to zero (issue 24):
 
-=================  ======================================  ==========================================
-name               definition                              mechanism
-=================  ======================================  ==========================================
-``beta``           EI / (lambda g L^3)                     bending stiffness EI [N m^2]
-``stretching``     c / sqrt(g L),  c = sqrt(EA / lambda)   axial stiffness EA [N]: longitudinal waves
-``drag_normal``    0.5 rho C_n d L / lambda                cross-flow air drag (diameter d)
-``drag_tangential`` 0.5 rho C_t pi d L / lambda            skin friction along the line
-``end_mass``       M_end / (lambda L)                      a point mass at the free end
-``link_scale``     h / L = 1 / N (graded: the smallest)    the links (the discreteness)
-=================  ======================================  ==========================================
+===================  =====================================  ==========================================
+name                 definition                             mechanism
+===================  =====================================  ==========================================
+``beta``             EI / (lambda g L^3)                    bending stiffness EI [N m^2]
+``stretching``       c / sqrt(g L),  c = sqrt(EA / lambda)  axial stiffness EA [N]: longitudinal waves
+``drag_normal``      0.5 rho C_n d L / lambda               cross-flow air drag (diameter d)
+``drag_tangential``  0.5 rho C_t pi d L / lambda            skin friction along the line
+``end_mass``         M_end / (lambda L)                     a point mass at the free end
+``link_scale``       h / L = 1 / N (graded: the smallest)   the links (the discreteness)
+===================  =====================================  ==========================================
 
 The bending and drag numbers are those of :func:`snapping.units.body_numbers` (the
 coefficients the simulator's :class:`snapping.simulate.Body` takes: the drag per length

@@ -9,9 +9,7 @@ link tension ``sigma_min`` and the arclength ``s_sigma_min`` of its link's midpo
 (:mod:`snapping.schema`); this module turns them into the run's attributes
 (:func:`compression_results`) and the line its summary prints (:func:`compression_note`).
 
-The threshold (why a tension below it is compression, not round-off)
---------------------------------------------------------------------
-The tensions of a state solve ``A sigma = b`` with ``A`` symmetric tridiagonal,
+*The threshold* (why a tension below it is compression, not round-off). The tensions of a state solve ``A sigma = b`` with ``A`` symmetric tridiagonal,
 diagonal ``-2`` (``-1`` in the row of the link at the held end), off-diagonal
 ``cos(theta_{k+1} - theta_k)``, and ``sigma_0 = 0`` at the free end. ``-A`` is positive
 definite; by Perron-Frobenius (``x.(-A)x >= |x|.(D - E_1)|x|``, ``E_1`` the off-diagonal
