@@ -84,23 +84,24 @@ def line_numbers(length, mass, g: float = units.G_STANDARD, *, N=None, ei=0.0, e
     >>> round(n["end_mass"], 12), n["link_scale"]
     (0.2, (0.02, 0.01))
     """
-    s = units.Scales(length, mass, g)
-    L, M = s.length, s.mass
+    L, M, gg = V.si_scales(length, mass, g)  # (not units.Scales: pint only where the body needs it)
     lam = M / L
-    body = units.body_numbers(L, M, s.g, ei=ei, diameter=diameter, air_density=air_density, cd_normal=cd_normal,
-                              cd_tangential=cd_tangential)
     out: dict = {}
-    if isinstance(body["bending"], float) and body["bending"] != 0.0:
-        out["beta"] = body["bending"]
-    elif not isinstance(body["bending"], float):
+    body: dict = {}
+    if not (isinstance(ei, (int, float)) and ei == 0.0) or diameter is not None or air_density is not None \
+            or cd_normal is not None or cd_tangential is not None:  # (pint only then: a table query stays light)
+        body = units.body_numbers(L, M, gg, ei=ei, diameter=diameter, air_density=air_density,
+                                  cd_normal=cd_normal, cd_tangential=cd_tangential)
+    if not isinstance(body.get("bending", 0.0), float):
         raise V.SnappingInputError(f"ei={ei!r} must be one number (N m^2) here")
+    if body.get("bending", 0.0) != 0.0:
+        out["beta"] = body["bending"]
     if ea is not None:
         e = V.real("ea", ea)
         if not (math.isfinite(e) and e > 0.0):
             raise V.SnappingInputError(f"ea={e!r} is out of range: the axial stiffness EA must be finite and > 0 (N)")
-        Q = units.registry().Quantity  # c/sqrt(gL) = sqrt(EA/(lambda g L)), checked dimensionless by pint
-        out["stretching"] = math.sqrt(float((Q(e, "N") / (Q(lam, "kg/m") * Q(s.g, "m/s**2") * Q(L, "m")))
-                                            .to("dimensionless").magnitude))
+        # c/sqrt(gL) = sqrt(EA/lambda)/sqrt(gL): [N / (kg m-1)] = m2 s-2, over [m s-2 m] = m2 s-2
+        out["stretching"] = math.sqrt(e / lam) / math.sqrt(gg * L)
     for k in ("drag_normal", "drag_tangential"):
         if k in body:
             if not isinstance(body[k], float):

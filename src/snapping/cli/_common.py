@@ -168,7 +168,7 @@ def _dimensionless(scales, args, *, N=None, tip_mass=None) -> dict | None:
     --length/--mass/--g, the body's SI options where the command has them (--ei, --diameter,
     --air-density, --cd-normal, --cd-tangential; --bending, --drag-normal, --drag-tangential as
     given), --ea where it has it, ``N`` links and the ``tip_mass`` ratio (None: not said); None
-    without SI scales."""
+    without SI scales (``scales``: anything with ``length``, ``mass`` and ``g``)."""
     if scales is None:
         return None
     from .. import dimensionless

@@ -147,10 +147,9 @@ def _cmd_estimate(args) -> int:
 
 
 def _numbers_of(chain, args, N, tip_mass) -> dict:
-    """The dimensionless numbers (snapping.dimensionless) of the chain of --length/--mass/--g."""
-    from ..units import Scales
-
-    return _dimensionless(Scales(chain.length, chain.mass, chain.g), args, N=N, tip_mass=tip_mass)
+    """The dimensionless numbers (snapping.dimensionless) of the chain of --length/--mass/--g
+    (the chain stands for the SI scales: its length, mass and g)."""
+    return _dimensionless(chain, args, N=N, tip_mass=tip_mass)
 
 
 # -------------------------------------------------------------------------- design
