@@ -179,7 +179,9 @@ def _dimensionless(scales, args, *, N=None, tip_mass=None) -> dict | None:
     if hasattr(args, "ei"):
         from ._body import SI_BODY, body_si_inputs
 
-        kw = {SI_BODY[k][0]: v for k, v in (body_si_inputs(args) or {}).items()
+        # a tapered line (--line) gives profiles of s: its numbers are those at the held end, s = 0,
+        # as snapping.lines.Line.numbers
+        kw = {SI_BODY[k][0]: (v(0.0) if callable(v) else v) for k, v in (body_si_inputs(args) or {}).items()
               if k in ("ei", "diameter", "air_density", "cd_normal", "cd_tangential")}
     out = dimensionless.line_numbers(scales.length, scales.mass, scales.g, N=N, ea=getattr(args, "ea", None),
                                      end_mass=None if tip_mass is None else tip_mass * scales.mass, **kw)
