@@ -316,11 +316,20 @@ class ElasticLine:
             return f, K
 
         scale = float(self.m.sum()) * max(self.g, 1e-300)
+        # the force's round-off: a position's last bit times the stiffest link's EA/h
+        floor = 16.0 * np.finfo(float).eps * float((self.ea / self.h).max()) * max(1.0, float(np.abs(z).max()))
         mu = 1e-3 * float(self.ea.max() / self.h.min())
         P = potential(z)
         for _ in range(max_iter):
             f, K = grad_hess(z)
-            if np.abs(f).max() <= tol * scale:
+            if np.abs(f).max() <= tol * scale + floor:
+                for _ in range(3):  # polish: plain Newton steps while the force still falls
+                    zt = z.copy()
+                    zt[idx] += sp.linalg.spsolve(K, f)
+                    ft, Kt = grad_hess(zt)
+                    if not np.abs(ft).max() < np.abs(f).max():
+                        break
+                    z, f, K = zt, ft, Kt
                 return z
             A = (K + sp.diags(mu * mrow / self.m.mean())).tocsc()
             step = sp.linalg.spsolve(A, f)
