@@ -167,7 +167,10 @@ def test_energy_balances_through_slack_and_taut(damping):
     r = solve(p, Elastic.from_wave_speed(20.0, damping=damping), t_end=0.8, tol=1e-9)
     s = r.summary()
     assert s["n_slack_steps"] > 10  # slack-taut transitions happened
-    assert s["energy_drift"] < 1e-8
+    # (with damping the tension jumps by c de/dt where a link goes taut: a discontinuity; measured
+    # 5e-9 at tol 1e-7 and 1e-9 alike. A dissipation rate left out where the damping cancels
+    # the tension (T = 0 < f) made it 2.3e-7)
+    assert s["energy_drift"] < (2e-8 if damping else 1e-8)
     ds = r.dataset
     if damping:
         assert s["dissipated_total"] > 1e-4  # the balance is not trivial
@@ -175,7 +178,8 @@ def test_energy_balances_through_slack_and_taut(damping):
     else:
         assert s["dissipated_total"] == 0.0
     # the energy itself (not only the balance): E(t) + D(t) = E(0) from the recorded columns
-    np.testing.assert_allclose(ds["energy"] + ds["dissipated"] - ds["pin_work"], s["energy_initial"], atol=1e-8)
+    np.testing.assert_allclose(ds["energy"] + ds["dissipated"] - ds["pin_work"], s["energy_initial"],
+                               atol=2e-8 if damping else 1e-8)
 
 
 def test_energy_balances_with_a_moving_held_end():

@@ -113,6 +113,8 @@ def rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, dz, T, E, ED, FV):
     diss = 0.0
     for j in range(N):
         tj = T[j]
+        # (also where the damping cancels the tension, T = 0 < f: there the rate is -h f edot)
+        diss += h[j] * (tj - FV[j]) * ED[j]
         if tj == 0.0:
             continue
         ln = h[j] * (1.0 + E[j])
@@ -125,7 +127,6 @@ def rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, dz, T, E, ED, FV):
         if j + 1 < N:
             dz[4 * j + 6] -= tj * ux * invm[j + 1]
             dz[4 * j + 7] -= tj * uy * invm[j + 1]
-        diss += h[j] * (tj - FV[j]) * ED[j]
     for i in range(N):
         dz[4 * i + 3] += g
     # the held end's power on the line, and the dissipation rate

@@ -1,4 +1,4 @@
-"""Stepping the extensible line (:mod:`snapping.simulate.elastic`): error-controlled, with
+"""Stepping the extensible line (:mod:`snapping.simulate.elastic_model`): error-controlled, with
 steps that its stiffness does not dictate, recorded into a run Dataset.
 
 The default method is scipy's ``Radau`` (implicit Runge-Kutta, order 5, L-stable) with the
@@ -34,7 +34,7 @@ from scipy.integrate import DOP853, Radau
 
 from .. import _validate as V
 from .. import schema
-from .elastic import STARTS, Elastic, ElasticLine
+from .elastic_model import STARTS, Elastic, ElasticLine
 
 __all__ = ["solve", "ElasticRun", "METHODS"]
 
