@@ -193,13 +193,16 @@ def test_energy_balances_with_a_moving_held_end():
 # ------------------------------------------------------------------ EA -> infinity
 @pytest.mark.slow
 def test_stiff_line_approaches_the_inextensible_chain():
-    """chi = 0.25, N = 12: the peaks of v_max move toward the inextensible run's as c grows
-    (measured rate about 1/c; benchmarks/bench_elastic.py for N = 50-200)."""
+    """chi = 0.25, N = 12: the peak of v_max moves toward the inextensible run's as the wave
+    speed grows (measured: -1.50e-2 at c = 30, -2.86e-3 at c = 100, a rate of about c^-1.4;
+    N = 30: -4.7e-2 at c = 30, -9.6e-4 at c = 300). The peaks of a and sigma do not follow at
+    these c: they come from slack-taut jerks after the snap (where the inextensible chain
+    carries compression), which grow with c."""
     p = Problem.catenary(0.25, links=Links.uniform(12, lumping="shared"))
     ref = run(problem=p, method="fast", tol=1e-11).summary()["v_peak"]
-    err = [abs(solve(p, Elastic.from_wave_speed(c), tol=1e-8).summary()["v_peak"] / ref - 1.0) for c in (30.0, 300.0)]
-    assert err[1] < err[0] / 5.0
-    assert err[1] < 5e-3
+    err = [abs(solve(p, Elastic.from_wave_speed(c), tol=1e-6).summary()["v_peak"] / ref - 1.0) for c in (30.0, 100.0)]
+    assert err[1] < err[0] / 4.0
+    assert err[1] < 4e-3
 
 
 # ------------------------------------------------------------------ bad input
