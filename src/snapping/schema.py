@@ -222,8 +222,23 @@ def result_units(name: str) -> str:
     return RESULT_UNITS.get(name, "1")
 
 
+#: Per accepted step, runs of the extensible line only (:mod:`snapping.simulate.elastic`); their
+#: ``energy`` is kinetic + gravity + elastic, and ``energy - pin_work + dissipated`` is conserved.
+ELASTIC_STEP_VARS: dict[str, dict[str, str]] = {
+    "s_sigma_max": _v("arclength (at rest) of the midpoint of the link of largest tension"),
+    "elastic_energy": _v("elastic energy of the links (sum over taut links of h_j times the integral of the "
+                         "tension over the strain)"),
+    "strain_max": _v("largest link strain l_j/h_j - 1 (negative: every link shorter than at rest)"),
+    "n_slack": _v("number of slack links (tension 0)"),
+}
+#: Per snapshot (and per link) of the extensible line.
+ELASTIC_LINK_VARS: dict[str, dict[str, str]] = {
+    "strain": _v("link strain l_j/h_j - 1 (at most 0: slack)"),
+    "axial_stiffness": _v("axial stiffness EA of the link (the table's initial slope for a tension-strain table)"),
+}
+
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,
-            **BODY_STEP_VARS}
+            **BODY_STEP_VARS, **ELASTIC_STEP_VARS, **ELASTIC_LINK_VARS}
 
 # ---------------------------------------------------------------- checkpoints
 #: Status values of a run file that :func:`snapping.simulate.resume` continues.

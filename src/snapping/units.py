@@ -94,6 +94,9 @@ VARIABLE_KINDS: dict[str, str] = {
     "pin_x": _L, "pin_y": _L, "pin_vx": _V, "pin_vy": _V, "pin_work": _E, "v_rel_max": _V,
     # a run with a body (bending, drag)
     "bending_energy": _E, "dissipated": _E,
+    # the extensible line (snapping.simulate.elastic)
+    "s_sigma_max": _L, "elastic_energy": _E, "strain_max": _1, "n_slack": _1, "strain": _1,
+    "axial_stiffness": _F,
     # the problem of a general run
     "link_length": _L, "node_mass": _M, "start_x": _L, "start_y": _L, "start_vx": _V, "start_vy": _V,
     "pin_table_t": _T, "pin_table_x": _L, "pin_table_y": _L,
