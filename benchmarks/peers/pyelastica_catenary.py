@@ -331,6 +331,7 @@ def main(argv=None) -> int:
     ap.add_argument("--continuum", default="", help="also the project's N-convergence at these N (e.g. 50,100,200,400)")
     ap.add_argument("--quick", action="store_true", help="N = 20, EA = 1e2, 3e2: a few seconds")
     a = ap.parse_args(argv)
+    sys.stdout.reconfigure(line_buffering=True)  # progress shows when the output goes to a file
     Ns = [int(x) for x in a.N.split(",") if x]
     eas, tols = _floats(a.ea), _floats(a.tols)
     if a.quick:
