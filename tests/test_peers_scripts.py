@@ -59,12 +59,13 @@ def _catenary(chi, N):
     return np.array(xs[::-1]), np.array(ys[::-1])
 
 
-def test_help_without_pyelastica():
-    """--help parses (and imports neither code's solver) whether or not pyelastica is there."""
-    out = subprocess.run([sys.executable, str(SCRIPT), "--help"], capture_output=True, text=True, env=_env(),
+@pytest.mark.parametrize("script,option", [(SCRIPT, "--ea"), (SCRIPT.parent / "moordyn_catenary.py", "--c")])
+def test_help_without_the_peer(script, option):
+    """--help parses (and imports neither code's solver) whether or not the peer is there."""
+    out = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, env=_env(),
                          timeout=120)
     assert out.returncode == 0, out.stderr
-    assert "--quick" in out.stdout and "--ea" in out.stdout
+    assert "--quick" in out.stdout and option in out.stdout
 
 
 @pytest.mark.parametrize("N", [7, 40])
