@@ -262,9 +262,9 @@ def matched(rows: list[Result], level: float):
     return out
 
 
-def compare(chi, N, beta, eas, tols, dt_halvings, budget):
+def compare(chi, N, beta, eas, tols, dt_halvings, budget, ref_tol=REF_TOL):
     """The table for one chain (chi, N, beta); returns its rows."""
-    ref = run_project(chi, N, beta, REF_TOL)
+    ref = run_project(chi, N, beta, ref_tol)
     rows = [run_project(chi, N, beta, tol) for tol in tols]
     t_spent = 0.0
     for ea in eas:
@@ -283,7 +283,7 @@ def compare(chi, N, beta, eas, tols, dt_halvings, budget):
     for r in rows:
         r.err = abs(r.v_peak / ref.v_peak - 1.0)
     print(f"chi = {chi:g}, N = {N}, beta = B/(lambda g L^3) = {beta:g}; reference: this project at tol = "
-          f"{REF_TOL:g}: v_tip peak {ref.v_peak:.10f} at t = {ref.t_peak:.6f}, a_tip at the snap "
+          f"{ref_tol:g}: v_tip peak {ref.v_peak:.10f} at t = {ref.t_peak:.6f}, a_tip at the snap "
           f"{ref.a_snap:.5g} ({ref.count} evaluations, {ref.wall:.2f} s)")
     table(rows)
     for level in LEVELS:
@@ -328,6 +328,8 @@ def main(argv=None) -> int:
     ap.add_argument("--dt-halvings", type=int, default=1,
                     help="extra PyElastica runs at the stiffest EA with dt halved this many times (default 1)")
     ap.add_argument("--budget", type=float, default=600.0, help="CPU seconds for PyElastica per N (default 600)")
+    ap.add_argument("--ref-tol", type=float, default=REF_TOL,
+                    help=f"tolerance of this project's reference solve (default {REF_TOL:g})")
     ap.add_argument("--continuum", default="", help="also the project's N-convergence at these N (e.g. 50,100,200,400)")
     ap.add_argument("--quick", action="store_true", help="N = 20, EA = 1e2, 3e2: a few seconds")
     a = ap.parse_args(argv)
@@ -347,7 +349,7 @@ def main(argv=None) -> int:
     run_project(a.chi, 10, a.beta, 1e-4)
     run_pyelastica(a.chi, 10, a.beta, 1e2, t_max=1e-3)
     for N in Ns:
-        compare(a.chi, N, a.beta, eas, tols, a.dt_halvings, a.budget)
+        compare(a.chi, N, a.beta, eas, tols, a.dt_halvings, a.budget, a.ref_tol)
     if a.continuum:
         continuum(a.chi, a.beta, [int(x) for x in a.continuum.split(",")], 1e-9)
     print(f"uptime: {os.popen('uptime').read().strip()}")
