@@ -323,7 +323,8 @@ def main(argv=None) -> int:
     ap.add_argument("--beta", type=float, default=1e-3, help="bending number B/(lambda g L^3) (default 1e-3)")
     ap.add_argument("--N", default="50,100", help="links, comma-separated (default 50,100)")
     ap.add_argument("--ea", default="1e2,1e3,1e4",
-                    help="PyElastica's stretch (= shear) stiffness EA/(lambda g), comma-separated (default 1e2,1e3,1e4)")
+                    help="PyElastica's stretch (= shear) stiffness EA/(lambda g), comma-separated "
+                         "(default 1e2,1e3,1e4)")
     ap.add_argument("--tols", default=",".join(f"{t:g}" for t in PROJECT_TOLS), help="this project's tolerances")
     ap.add_argument("--dt-halvings", type=int, default=1,
                     help="extra PyElastica runs at the stiffest EA with dt halved this many times (default 1)")
