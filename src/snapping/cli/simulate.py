@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import sys
 
-from ._common import (_add_si_options, _formatter, _nonfinite, _nonfinite_error, _numbers, _print_si, _si_scales,
-                      _with_si, print_json, print_table)
+from ._common import (_add_si_options, _dimensionless, _formatter, _nonfinite, _nonfinite_error, _numbers,
+                      _print_dimensionless, _print_si, _si_scales, _with_si, print_json, print_table)
 
 
 # ------------------------------------------------------------------------ simulate
@@ -219,14 +219,16 @@ def _cmd_simulate(args) -> int:
         where = f" (the run file is {args.output})" if args.output else ""
         return _nonfinite_error("simulate", bad, where)
     reached = summary.get("snap_reached", True)
+    numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass) if args.resume is None else None
     if args.json:
-        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales)}))
+        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales),
+                                                      **({"dimensionless_numbers": numbers} if numbers else {})}))
     else:
         note_units = {"wall_time": "s"}
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         rows = []
         for k, v in summary.items():
-            if k in ("snap_note", "peaks", "body", "body_si"):
+            if k in ("snap_note", "peaks", "body", "body_si", "compression_note"):
                 continue
             note = note_units.get(k)
             if v is None and k in precise:
@@ -241,8 +243,11 @@ def _cmd_simulate(args) -> int:
         )
         if not reached and summary.get("snap_note"):
             print(f"  note: {summary['snap_note']}")
+        if summary.get("compression_note"):
+            print(f"  note: {summary['compression_note']}")
         _print_body(summary)
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
+        _print_dimensionless(numbers)
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
