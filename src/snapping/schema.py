@@ -312,3 +312,39 @@ CHECKPOINT_ATTRS: dict[str, str] = {
 #: values; :func:`snapping.simulate.dataset.content_digest`). A checkpoint whose digest
 #: does not match (an edited ``chi``, a damaged state) is not resumed.
 DIGEST_ATTR = "integrity_sha256"
+
+# ---------------------------------------------------------------- 3D runs
+#: Names that only a 3D run (:mod:`snapping.spatial`, :mod:`snapping.spatial.dataset3d`) has.
+#: A 3D run Dataset uses the planar names above where they mean the same (``x``, ``y``,
+#: ``vx``, ``v_max``, ``t_snap_v``, ...; ``y`` along gravity's default direction, downward)
+#: and these for the third coordinate and what only space has. A planar run has none of them.
+#: ``energy`` of a 3D run has the planar zero: the chain hanging straight down at rest from a
+#: held end at the origin.
+SPATIAL_STEP_VARS: dict[str, dict[str, str]] = {
+    "z_amp": _v("out-of-plane amplitude: largest distance of a node from the reference plane through the held end"),
+    "vz_amp": _v("largest out-of-plane node speed (velocity component along the reference plane's normal)"),
+    "angular_momentum_g": _v("angular momentum about the held end along gravity's direction"),
+}
+SPATIAL_NODE_PROFILE_VARS: dict[str, dict[str, str]] = {
+    "z": _v("node position, e3 component (out of the e1-e2 plane)"),
+    "vz": _v("node velocity, e3 component"),
+    "az": _v("node acceleration, e3 component"),
+}
+SPATIAL_PROBLEM_VARS: dict[str, dict[str, str]] = {
+    "start_z": _v("node position at t = 0, e3 component"),
+    "start_vz": _v("node velocity at t = 0, e3 component"),
+}
+#: Global attributes of a 3D run, besides the planar ones that mean the same.
+SPATIAL_ATTRS: dict[str, str] = {
+    "dims": "number of space dimensions of the run (3: snapping.spatial; planar runs have no such attribute)",
+    "g_dir": "unit direction of gravity (x, y, z)",
+    "normal": "unit normal of the reference plane whose out-of-plane amplitude z_amp measures",
+    "perturbation": "JSON description of the out-of-plane perturbation of the start ('' if none)",
+    "whirl": "rotation rate of a whirling start about the vertical through the held end (NaN: not whirling)",
+    "z_amp_snap": "out-of-plane amplitude at the speed peak (t_snap_v)",
+    "vz_amp_snap": "largest out-of-plane node speed at the speed peak",
+    "z_amp_max": "largest out-of-plane amplitude over the run",
+    "angular_momentum_drift": "max |angular_momentum_g(t) - angular_momentum_g(0)| (conserved: fixed end, gravity only)",
+    "link_error_max": "largest | |e_j| - 1 | at the end of an accepted step before its projection",
+}
+SPATIAL_VARS = {**SPATIAL_STEP_VARS, **SPATIAL_NODE_PROFILE_VARS, **SPATIAL_PROBLEM_VARS}

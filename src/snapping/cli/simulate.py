@@ -59,6 +59,12 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
+            "in space (snapping.spatial; --dims 3, implied by --perturb and --whirl):\n"
+            "  snapping simulate --dims 3 --chi 0.25 --N 200 -o run3d.nc   # a planar start, run in 3D\n"
+            "  snapping simulate --chi 0.25 --N 200 --perturb 1e-4          # out-of-plane kick sin(pi s/L)\n"
+            "  snapping simulate --chi 0.25 --N 200 --perturb 1e-4 --perturb-mode random --seed 1\n"
+            "  snapping simulate --whirl 2.5 --N 30 --t-end 7.5             # a steadily whirling chain\n"
+            "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
@@ -119,6 +125,9 @@ def _add_simulate(sub) -> None:
                    help="fail after more than this many consecutive rejected steps (default 100)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (it is off anyway when not a tty)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    from .simulate3d import add_3d_options
+
+    add_3d_options(p)
     _add_si_options(p)
     p.set_defaults(func=_cmd_simulate)
 
@@ -138,6 +147,10 @@ def _cmd_simulate(args) -> int:
         _times(times)  # a bad time is named first
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} without -o RUN.nc: the snapshots are "
                                  f"profiles kept only in the run file; add -o RUN.nc (or leave out --snapshot-times)")
+    from .simulate3d import cmd_simulate3d, wants_3d
+
+    if wants_3d(args):  # the chain in space (snapping.spatial)
+        return cmd_simulate3d(args, times)
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
     if args.resume is None and (not start_given or args.N is None):
