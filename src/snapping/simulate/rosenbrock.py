@@ -1,0 +1,321 @@
+"""The compiled RODAS4 step loop of the stiff method (``method="rodas4"``, alias ``"stiff"``).
+
+The method and the banded stage solves are those of :mod:`snapping.simulate.stiff` (the
+Python reference, :func:`snapping.simulate.stiff.solve`) and
+:mod:`snapping.simulate.stiff_system` (the rows, their complex-step derivatives, the
+stage matrix in LAPACK band storage): here they are one numba loop (:func:`advance_rodas`)
+that shares the bookkeeping of every accepted step with DOP853
+(:func:`snapping.simulate.rk.after_attempt_with`: records, peaks, invariants, the stop
+rules), so the two methods differ only in how a step is taken.
+
+A step (Hairer and Wanner, *Solving ODEs II*, sec. VI.4, ``rodas.f``): the Jacobian at the
+step's start (:func:`jacobian_at`, once per accepted step: 20 complex evaluations of the
+compiled rows), the banded stage matrix of bandwidth 5 factored by Gaussian elimination
+with partial pivoting (:func:`band_lu`, O(N)), six stages (five new evaluations), the error
+estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``),
+the new state, and on acceptance one evaluation there (the next step's ``f``). The
+continuous extension of order 3 (``rodas.f``'s CONTRO: ``y(t0 + s h) = (1 - s) y0 + s (y1 +
+(1 - s)(c2 + s c3))`` with ``c2, c3`` fixed combinations of ``U_1 .. U_5``) gives the state
+between steps at no cost (:func:`dense_eval`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import forced as FR
+from . import general as G
+from . import models as MD
+from . import rk as R
+from .stiff import RODAS4
+from .stiff_system import KL, KU, NCOL, _assemble, _jacobian, _matvec
+
+__all__ = ["band_lu", "band_solve", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at", "NSTG",
+           "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3"]
+
+GAMMA = RODAS4["gamma"]
+C_NODE = np.array(RODAS4["c"])
+D_TIME = np.array(RODAS4["d"])
+A_ST = np.zeros((6, 6))
+C_ST = np.zeros((6, 6))
+for _i in range(6):
+    for _j, _v in enumerate(RODAS4["a"][_i]):
+        A_ST[_i, _j] = _v
+    for _j, _v in enumerate(RODAS4["C"][_i]):
+        C_ST[_i, _j] = _v
+#: the dense output's weights of U_1 .. U_5 (rodas.f, METH = 1: D21 .. D25, D31 .. D35)
+D2 = np.array([10.12623508344586, -7.487995877610167, -34.80091861555747, -7.992771707568823, 1.025137723295662])
+D3 = np.array([-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872])
+#: the step-size rule of an error estimate of order 3 (rodas.f: at most 6x larger)
+ERR_EXPONENT = -0.25
+MAX_FACTOR = 6.0
+#: rows of a step slot's stage array: f at the start, U_1 .. U_6, f at the end
+NSTG = 8
+S_F0, S_F1 = 0, 7
+#: the engine's counters (``cnt``): Jacobians, factorisations, evaluations of the W/D rows'
+#: differences and of f_t (in n_rhs too), singular stage matrices
+(CN_JAC, CN_LU, CN_EXTRA, CN_SING) = range(4)
+NCNT = 4
+#: the flags of ``rp``: clamped, bending, W/D have dynamics, their rows by differences, autonomous
+(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def band_lu(ab, n, kl, ku, piv):
+    """LU with partial pivoting of the n x n band matrix in LAPACK band storage (``A[i, j]``
+    at ``ab[kl + ku + i - j, j]``, the first kl rows room for the fill-in, zero on entry):
+    the multipliers below the diagonal, U above (upper bandwidth kl + ku), ``piv[k]`` the row
+    swapped with row k. Returns 0, or k + 1 when the k-th pivot is zero (as ``dgbtrf``)."""
+    m = kl + ku
+    for k in range(n):
+        ilast = min(n - 1, k + kl)
+        p = k
+        vmax = abs(ab[m, k])
+        for i in range(k + 1, ilast + 1):
+            v = abs(ab[m + i - k, k])
+            if v > vmax:
+                vmax = v
+                p = i
+        piv[k] = p
+        if vmax == 0.0 or not (vmax - vmax == 0.0):
+            return k + 1
+        jlast = min(n - 1, k + m)
+        if p != k:
+            for j in range(k, jlast + 1):
+                tmp = ab[m + k - j, j]
+                ab[m + k - j, j] = ab[m + p - j, j]
+                ab[m + p - j, j] = tmp
+        inv = 1.0 / ab[m, k]
+        for i in range(k + 1, ilast + 1):
+            l = ab[m + i - k, k] * inv
+            ab[m + i - k, k] = l
+            if l != 0.0:
+                for j in range(k + 1, jlast + 1):
+                    ab[m + i - j, j] -= l * ab[m + k - j, j]
+    return 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def band_solve(ab, n, kl, ku, piv, b):
+    """Solve ``A x = b`` in place with the factors of :func:`band_lu`."""
+    m = kl + ku
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+        bk = b[k]
+        for i in range(k + 1, min(n - 1, k + kl) + 1):
+            b[i] -= ab[m + i - k, k] * bk
+    for k in range(n - 1, -1, -1):
+        b[k] /= ab[m, k]
+        bk = b[k]
+        for i in range(max(0, k - m), k):
+            b[i] -= ab[m + i - k, k] * bk
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
+    """The coloured banded derivatives of the rows (:meth:`stiff_system.Residual.jacobian`)
+    at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``."""
+    par, h, invm, invh, snode, tab = mdl
+    phi = 0.0
+    phid = 0.0
+    if rp[RP_CLAMP] != 0.0:
+        phi, phid = FR.clamp_angle(t, par, tab)
+    _, _, _, _, pax, pay = G.pin_kinematics(t, par, tab)
+    th = np.empty(N, dtype=np.complex128)
+    om = np.empty(N, dtype=np.complex128)
+    a = np.empty(N, dtype=np.complex128)
+    T = np.empty(N, dtype=np.complex128)
+    for i in range(N):
+        th[i] = y[i]
+        om[i] = y[N + i]
+        a[i] = f[N + i]
+        T[i] = sig[i]
+    _jacobian(N, th, om, a, T, h, invm, barr[3, :N], invh, barr[0], barr[1], barr[2], rp[RP_CLAMP] != 0.0,
+              rp[RP_BEND] != 0.0, phi, phid, pax, pay - par[G.P_G], Dj)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
+    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`)."""
+    for i in range(N):
+        tmp[i] = b[i] + gh * b[N + i]
+    for i in range(2 * N):
+        rhs[i] = 0.0
+    _matvec(N, Dj[0], tmp, rhs)
+    _matvec(N, Dj[1], b[N:2 * N], rhs)
+    for i in range(2 * N):
+        rhs[i] *= gh
+    band_solve(ab, 2 * N, KL, KU, piv, rhs)
+    for j in range(N):
+        uom = gh * (b[N + j] - rhs[2 * j])
+        U[N + j] = uom
+        U[j] = gh * (b[j] + uom)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s, S, cp, dp, sig, tol, mdl, barr, rp,
+               cnt):
+    """One RODAS4 step of size h from (t, y0) with ``St[S_F0] = f(t, y0)``, the Jacobian
+    ``Dj`` there and (non-autonomous problems) ``ft`` the time derivative of f: the stages
+    ``U_1 .. U_6`` into ``St[1:7]``, the new state into ``y1``. Returns the scaled error in
+    the max norm (NaN or inf: a failed step), and the number of evaluations it made."""
+    n = y0.shape[0]
+    n2 = 2 * N
+    gh = GAMMA * h
+    nev = 0
+    for i in range(ab.shape[0]):
+        for j in range(ab.shape[1]):
+            ab[i, j] = 0.0
+    _assemble(N, Dj, gh, ab)
+    cnt[CN_LU] += 1.0
+    if band_lu(ab, n2, KL, KU, piv) != 0:
+        cnt[CN_SING] += 1.0
+        return np.inf, nev
+    f0 = St[S_F0]
+    par, hh, invm, invh, snode, tab = mdl
+    El = barr[2]
+    for st in range(6):
+        U = St[1 + st]
+        if st == 0:
+            for i in range(n):
+                btmp[i] = f0[i]
+        else:
+            for i in range(n):
+                acc = y0[i]
+                for j in range(st):
+                    acc += A_ST[st, j] * St[1 + j, i]
+                ytmp[i] = acc
+            MD.model_rhs(N, t + C_NODE[st] * h, ytmp, btmp, c, s, S, cp, dp, sig, mdl)
+            nev += 1
+            for i in range(n):
+                acc = btmp[i]
+                for j in range(st):
+                    acc += (C_ST[st, j] / h) * St[1 + j, i]
+                btmp[i] = acc
+        if rp[RP_AUTO] == 0.0 and D_TIME[st] != 0.0:
+            dh = D_TIME[st] * h
+            for i in range(n):
+                btmp[i] += dh * ft[i]
+        _stage_solve(N, Dj, gh, ab, piv, btmp, U, rhs, tmp)
+        bw = btmp[n2]
+        bd = btmp[n2 + 1]
+        if rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0:  # dD'/domega U_omega, exact
+            acc = 0.0
+            for j in range(1, N):
+                acc += El[j] * (y0[N + j] - y0[N + j - 1]) * (U[N + j] - U[N + j - 1])
+            bd += 2.0 * acc
+            if rp[RP_CLAMP] != 0.0:
+                _, phid = FR.clamp_angle(t, par, tab)
+                bd -= 2.0 * El[N] * (phid - y0[n2 - 1]) * U[n2 - 1]
+        elif rp[RP_QUAD] != 0.0:  # by one forward difference along U_x
+            nu = 0.0
+            ny = 0.0
+            for i in range(n2):
+                nu += U[i] * U[i]
+                ny += y0[i] * y0[i]
+            nu = math.sqrt(nu / n2)
+            if nu > 0.0:
+                dl = 1e-7 * (1.0 + math.sqrt(ny / n2)) / nu
+                for i in range(n):
+                    ytmp[i] = y0[i] + dl * U[i] if i < n2 else y0[i]
+                MD.model_rhs(N, t, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+                nev += 1
+                cnt[CN_EXTRA] += 1.0
+                bw += (tmp[n2] - f0[n2]) / dl
+                bd += (tmp[n2 + 1] - f0[n2 + 1]) / dl
+        U[n2] = gh * bw
+        U[n2 + 1] = gh * bd
+    err = 0.0
+    for i in range(n):
+        acc = y0[i]
+        for j in range(5):
+            acc += A_ST[5, j] * St[1 + j, i]
+        y1[i] = acc + St[6, i]
+    for i in range(n):
+        sc = tol * (1.0 + max(abs(y0[i]), abs(y1[i])))
+        e = abs(St[6, i]) / sc
+        if not (e - e == 0.0):
+            return np.inf, nev
+        if e > err:
+            err = e
+    return err, nev
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def dense_eval(x, y0, y1, St, out):
+    """The continuous extension of order 3 at the fraction x in [0, 1] of a step."""
+    n = y0.shape[0]
+    for i in range(n):
+        c2 = 0.0
+        c3 = 0.0
+        for j in range(5):
+            c2 += D2[j] * St[1 + j, i]
+            c3 += D3[j] * St[1 + j, i]
+        out[i] = y0[i] * (1.0 - x) + x * (y1[i] + (1.0 - x) * (c2 + x * c3))
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def time_derivative(N, t, y, f0, ft, ytmp, c, s, S, cp, dp, sig, mdl):
+    """``ft = (f(t + dt, y) - f0)/dt``, dt = 1e-7 max(1, |t|) (a moving held end or clamp)."""
+    dt = 1e-7 * max(1.0, abs(t))
+    MD.model_rhs(N, t + dt, y, ft, c, s, S, cp, dp, sig, mdl)
+    for i in range(y.shape[0]):
+        ft[i] = (ft[i] - f0[i]) / dt
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def advance_rodas(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas, mdl,
+                  Dj, ab, piv, btmp, rhs, tmp, ft, barr, rp, cnt):
+    """Advance the chain with RODAS4 until something needs Python (the return codes and
+    the two step slots of :func:`snapping.simulate.rk.advance_rk`; ``KK[slot]`` holds f at
+    the step's start, its stages ``U_1 .. U_6`` and f at its end). ``Dj`` is the Jacobian
+    at the current state (taken after every accepted step, and again at the right limit
+    of a breakpoint of the held end's motion)."""
+    n = Y0.shape[1]
+    tol = ctl[R.Q_TOL]
+    ctl[R.Q_NCALL] = 0.0
+    while True:
+        sl = int(ctl[R.Q_SLOT])
+        ns = 1 - sl
+        h, last = R.step_size(ctl)
+        y0 = Y0[ns]
+        ycur = Y1[sl]
+        for i in range(n):
+            y0[i] = ycur[i]
+        t = ctl[R.Q_T]
+        extra = 0.0
+        if t == ctl[R.Q_LASTBRK]:
+            # a step from a breakpoint of the held end's motion: f and J just after it
+            t = np.nextafter(t, np.inf)
+            MD.model_rhs(N, t, y0, KK[ns, S_F0], c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            jacobian_at(N, t, y0, KK[ns, S_F0], sig, Dj, mdl, barr, rp)
+            cnt[CN_JAC] += 1.0
+        else:
+            for i in range(n):
+                KK[ns, S_F0, i] = KK[sl, S_F1, i]
+        if rp[RP_AUTO] == 0.0:
+            time_derivative(N, t, y0, KK[ns, S_F0], ft, ytmp, c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            cnt[CN_EXTRA] += 1.0
+        err, nev = rodas_step(N, t, h, y0, Y1[ns], KK[ns], ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s, S, cp, dp,
+                              sig, tol, mdl, barr, rp, cnt)
+        extra += float(nev)
+        if R.accepted(err):
+            tn = ctl[R.Q_TEND] if last else ctl[R.Q_T] + h
+            # f at the new state (the next step's first stage; c, s, sig then belong to it)
+            MD.model_rhs(N, tn, Y1[ns], KK[ns, S_F1], c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            jacobian_at(N, tn, Y1[ns], KK[ns, S_F1], sig, Dj, mdl, barr, rp)
+            cnt[CN_JAC] += 1.0
+        code = R.after_attempt_with(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk,
+                                    meas, mdl, ERR_EXPONENT, MAX_FACTOR, extra)
+        if code >= 0:
+            return code
