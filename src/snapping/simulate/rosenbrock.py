@@ -31,9 +31,9 @@ from . import general as G
 from . import models as MD
 from . import rk as R
 from .stiff import RODAS4
-from .stiff_system import KL, KU, NCOL, _assemble, _jacobian, _matvec
+from .stiff_system import KL, KU, NCOL, _jacobian, _matvec
 
-__all__ = ["band_lu", "band_solve", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at", "NSTG",
+__all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at", "NSTG",
            "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3"]
 
 GAMMA = RODAS4["gamma"]
@@ -63,44 +63,54 @@ NCNT = 4
 (RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
 
 
+#: width of a row of the factored stage matrix: lower band, upper band and the fill-in
+WROW = 2 * KL + KU + 1
+
+
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def band_lu(ab, n, kl, ku, piv):
-    """LU with partial pivoting of the n x n band matrix in LAPACK band storage (``A[i, j]``
-    at ``ab[kl + ku + i - j, j]``, the first kl rows room for the fill-in, zero on entry):
-    the multipliers below the diagonal, U above (upper bandwidth kl + ku), ``piv[k]`` the row
-    swapped with row k. Returns 0, or k + 1 when the k-th pivot is zero (as ``dgbtrf``)."""
+def band_lu(A, n, kl, ku, piv):
+    """LU with partial pivoting of the n x n band matrix stored by rows: ``A[i, j]`` at
+    ``R[i, j - i + kl]`` (width ``2 kl + ku + 1``: the last kl columns are room for the
+    fill-in and zero on entry). On return the multipliers are below the diagonal, U above
+    (upper bandwidth kl + ku), ``piv[k]`` the row swapped with row k (LAPACK's ``dgbtrf``,
+    laid out so that the row operations run on contiguous memory). Returns 0, or k + 1 when
+    the k-th pivot is zero or not finite."""
+    R = A
     m = kl + ku
     for k in range(n):
         ilast = min(n - 1, k + kl)
         p = k
-        vmax = abs(ab[m, k])
+        vmax = abs(R[k, kl])
         for i in range(k + 1, ilast + 1):
-            v = abs(ab[m + i - k, k])
+            v = abs(R[i, k - i + kl])
             if v > vmax:
                 vmax = v
                 p = i
         piv[k] = p
         if vmax == 0.0 or not (vmax - vmax == 0.0):
             return k + 1
-        jlast = min(n - 1, k + m)
+        w = min(n - 1, k + m) - k + 1  # columns k .. k + w - 1
         if p != k:
-            for j in range(k, jlast + 1):
-                tmp = ab[m + k - j, j]
-                ab[m + k - j, j] = ab[m + p - j, j]
-                ab[m + p - j, j] = tmp
-        inv = 1.0 / ab[m, k]
+            op = k - p + kl
+            for d in range(w):
+                tmp = R[k, kl + d]
+                R[k, kl + d] = R[p, op + d]
+                R[p, op + d] = tmp
+        inv = 1.0 / R[k, kl]
         for i in range(k + 1, ilast + 1):
-            l = ab[m + i - k, k] * inv
-            ab[m + i - k, k] = l
+            oi = k - i + kl
+            l = R[i, oi] * inv
+            R[i, oi] = l
             if l != 0.0:
-                for j in range(k + 1, jlast + 1):
-                    ab[m + i - j, j] -= l * ab[m + k - j, j]
+                for d in range(1, w):
+                    R[i, oi + d] -= l * R[k, kl + d]
     return 0
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def band_solve(ab, n, kl, ku, piv, b):
+def band_solve(A, n, kl, ku, piv, b):
     """Solve ``A x = b`` in place with the factors of :func:`band_lu`."""
+    R = A
     m = kl + ku
     for k in range(n):
         p = piv[k]
@@ -110,12 +120,31 @@ def band_solve(ab, n, kl, ku, piv, b):
             b[p] = tmp
         bk = b[k]
         for i in range(k + 1, min(n - 1, k + kl) + 1):
-            b[i] -= ab[m + i - k, k] * bk
+            b[i] -= R[i, k - i + kl] * bk
     for k in range(n - 1, -1, -1):
-        b[k] /= ab[m, k]
-        bk = b[k]
-        for i in range(max(0, k - m), k):
-            b[i] -= ab[m + i - k, k] * bk
+        acc = b[k]
+        for d in range(1, min(n - 1, k + m) - k + 1):
+            acc -= R[k, kl + d] * b[k + d]
+        b[k] = acc / R[k, kl]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def assemble(N, D, gh, A):
+    """The stage matrix (:func:`stiff_system._assemble`) stored by rows for :func:`band_lu`:
+    row i, column j at ``A[i, j - i + KL]``; the rest of A zeroed."""
+    for i in range(A.shape[0]):
+        for d in range(A.shape[1]):
+            A[i, d] = 0.0
+    for i in range(2 * N):
+        j = i // 2
+        for k in range(NCOL):
+            d = (k - j) % NCOL
+            if d > 2:
+                d -= NCOL
+            lk = j + d
+            if 0 <= lk < N:
+                A[i, 2 * lk - i + KL] = D[2, k, i] + gh * gh * D[0, k, i] + gh * D[1, k, i]
+                A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -170,10 +199,7 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
     n2 = 2 * N
     gh = GAMMA * h
     nev = 0
-    for i in range(ab.shape[0]):
-        for j in range(ab.shape[1]):
-            ab[i, j] = 0.0
-    _assemble(N, Dj, gh, ab)
+    assemble(N, Dj, gh, ab)
     cnt[CN_LU] += 1.0
     if band_lu(ab, n2, KL, KU, piv) != 0:
         cnt[CN_SING] += 1.0

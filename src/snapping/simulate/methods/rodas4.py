@@ -35,7 +35,7 @@ from .. import models as MD
 from .. import rk as R
 from .. import rosenbrock as RB
 from .._engine_common import checkpoint_getter
-from ..stiff_system import KL, KU, NCOL
+from ..stiff_system import NCOL
 from . import dop853 as DP
 
 __all__ = ["Engine", "setup", "complete", "NAMES", "CHECKPOINT_VARS", "DEFAULT_TOL"]
@@ -85,7 +85,7 @@ class Engine(DP.Engine):
         qfd = quad and ((not auto) or par[FR.P_HASDRAG] != 0.0)
         self.rp = np.array([clamped, par[FR.P_HASBEND] != 0.0, quad, qfd, auto], dtype=float)
         self.Dj = np.zeros((4, NCOL, 2 * N))
-        self.ab = np.zeros((2 * KL + KU + 1, 2 * N))
+        self.ab = np.zeros((2 * N, RB.WROW))
         self.piv = np.zeros(2 * N, dtype=np.int64)
         self.btmp = np.zeros(n)
         self.rhs = np.zeros(2 * N)
