@@ -137,6 +137,16 @@ PROBLEM_ATTRS: dict[str, str] = {
              "nondimensional), runs of a problem with a body only"),
 }
 
+#: Global attributes of runs of the stiff method, or of a problem with bending run with
+#: ``method='fast'`` (which then chooses between dop853 and rodas4:
+#: :mod:`snapping.simulate.stiffness`); absent elsewhere.
+METHOD_ATTRS: dict[str, str] = {
+    "method_choice": ("why method='fast' ran this method ('method' names it): the shortest bending wave's "
+                      "frequency and damping ratio, and the explicit method's estimated steps"),
+    "n_jacobians": "Jacobians of the stiff method (rodas4; each 20 complex-step evaluations of the rows)",
+    "n_factorizations": "banded LU factorisations of the stiff method's stage matrix (rodas4)",
+}
+
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
 INPUT_ATTRS: dict[str, str] = {
     "chi": "initial end-to-end separation (fraction of the length), in (0, 1)",

@@ -42,8 +42,10 @@ __all__ = ["Engine", "setup", "complete", "NAMES", "CHECKPOINT_VARS", "DEFAULT_T
 
 #: the names this method answers to
 NAMES = ("rodas4", "stiff")
-#: tolerance of a run that gives none (max norm, relative and absolute, per step)
-DEFAULT_TOL = 1e-7
+#: tolerance of a run that gives none (max norm, relative and absolute, per step): the peaks
+#: v, a, sigma were within 0.1-1.8 tol of dop853 at tol 1e-11 for tol 1e-4 .. 1e-7 (chi 0.25,
+#: N 100 and 300, beta 1e-6 .. 1e-2, damping ratio 0 and 1), so 3e-7 keeps them within 1e-6
+DEFAULT_TOL = 3e-7
 
 
 def _checkpoint_names():

@@ -1,0 +1,108 @@
+"""The stiffness of a chain with bending (snapping.simulate.stiffness): the shortest wave
+against the eigenvalues of the exact Jacobian, DOP853's stability boundary from its tableau
+and from its measured steps, the automatic choice of ``method="fast"`` on both sides of its
+threshold, and the cost message of an explicit method named on a stiff problem."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from snapping._validate import SnappingInputError
+from snapping.simulate import Body, Problem, run
+from snapping.simulate import stiff_system as SS
+from snapping.simulate import stiffness as SF
+
+
+def _stability_boundary(direction):
+    """Where DOP853's stability function first leaves the unit disc along ``direction`` (its
+    Butcher tableau, scipy's coefficients; independent of the module)."""
+    from scipy.integrate._ivp import dop853_coefficients as dc
+
+    A, b = dc.A[:12, :12], dc.B
+    for r in np.arange(0.01, 10.0, 0.01):
+        z = r * direction
+        if abs(1 + z * b @ np.linalg.solve(np.eye(12) - z * A, np.ones(12))) > 1 + 1e-9:
+            return r - 0.01
+    return 10.0
+
+
+def test_dop853_stability_boundary():
+    assert SF.R_DOP853 == pytest.approx(min(_stability_boundary(1j), _stability_boundary(-1.0)), abs=0.02)
+
+
+def _problem(N, beta, zeta, **kw):
+    return Problem.catenary(0.25, N, body=Body(bending=beta, damping=zeta * np.sqrt(beta) / (2 * N ** 2)), **kw)
+
+
+@pytest.mark.parametrize("N,beta", [(20, 1e-2), (40, 1e-2), (40, 1e-3)])
+def test_shortest_wave_is_the_jacobians_largest_eigenvalue(N, beta):
+    """omega_max against the eigenvalues of the exact (dense) Jacobian at the catenary; the
+    damping ratio against that eigenvalue's angle (bending-dominated: -zeta omega)."""
+    for zeta in (0.0, 1.0):
+        p = _problem(N, beta, zeta)
+        mdl, y = SS.body_model(p)
+        res = SS.Residual(mdl)
+        f = np.empty_like(y)
+        res.rhs(0.0, y, f)
+        ev = np.linalg.eigvals(SS.dense_ode_jacobian(res, 0.0, y, res.jacobian(0.0, y, f)))
+        om, z = SF.shortest_wave(p.model())
+        top = ev[np.argmax(np.abs(ev))]
+        assert 0.9 < abs(top) / om < 1.1
+        assert z == pytest.approx(-top.real / abs(top), abs=0.08)  # (the eigenvalue -zeta omega + i ...; T overestimated)
+        assert z > 0.9 if zeta else z == 0.0
+
+
+def test_dop853_steps_sit_at_the_stability_limit_when_the_waves_are_damped():
+    """Damping ratio 1: dop853's median accepted step is R_DOP853/omega_max (stability, not
+    accuracy, sets it: 6.3/omega measured); undamped it is smaller (the excited waves)."""
+    p = _problem(100, 1e-2, 1.0)
+    om, _ = SF.shortest_wave(p.model())
+    dt = run(p, method="dop853", t_end=0.2).dataset["dt"].values[1:]
+    assert 0.9 < np.median(dt) * om / SF.R_DOP853 < 1.2
+    dt0 = run(_problem(100, 1e-2, 0.0), method="dop853", t_end=0.2).dataset["dt"].values[1:]
+    assert np.median(dt0) * om < 0.4 * SF.R_DOP853
+
+
+#: a RODAS4 step's price in evaluations of the right-hand side (5 evaluations, 6 banded solves of
+#: ~5 evaluations each, a factorisation, a Jacobian ~14): measured with process time at N = 300
+RODAS4_STEP = 60.0
+
+
+@pytest.mark.parametrize("beta,expect", [(0.02, "dop853"), (1.0, "rodas4")])
+def test_fast_chooses_the_cheaper_method_on_either_side_of_the_threshold(beta, expect):
+    """N = 100, damping ratio 1: beta = 0.02 (explicit limit ~0.4 of the threshold) is
+    dop853's, beta = 1 (~2.5 x the threshold) rodas4's; both methods run to t = 0.3 and the
+    chosen one costs less (evaluations, a RODAS4 step priced at RODAS4_STEP)."""
+    p = _problem(100, beta, 1.0)
+    method, why = SF.choose(p, t_end=0.3)
+    assert SF.choose(p)[0] == method
+    assert method == expect and why.startswith(f"{expect} chosen by method='fast'")
+    ds = run(p, t_end=0.3).dataset
+    assert ds.attrs["method"] == expect and ds.attrs["method_choice"] == why
+    d = run(p, method="dop853", t_end=0.3).dataset.attrs
+    r = run(p, method="rodas4", t_end=0.3).dataset.attrs
+    cost = {"dop853": d["n_rhs"], "rodas4": RODAS4_STEP * (r["n_steps"] + r["n_rejected"])}
+    assert cost[expect] < cost["rodas4" if expect == "dop853" else "dop853"], cost
+
+
+def test_runs_without_bending_keep_dop853_and_no_choice_attribute():
+    for p in (Problem.catenary(0.25, 10), Problem.catenary(0.25, 10, body=Body(drag_normal=0.5))):
+        a = run(p, t_end=0.05).dataset.attrs
+        assert a["method"] == "dop853" and "method_choice" not in a
+
+
+def test_cost_message_warns_then_refuses_and_names_the_stiff_method():
+    stiff = _problem(2000, 1e-2, 1.0)  # ~1.6e5 explicit steps per unit time
+    n = SF.explicit_steps(stiff.model(), 1.2)
+    assert SF.WARN_STEPS < 20 * n < SF.REFUSE_STEPS
+    with pytest.warns(SF.CostWarning, match=r"method='dop853'.*at least ~.* steps.*method='rodas4'"):
+        SF.check_cost(stiff, "dop853", t_end=1.2 * 20)
+    with pytest.raises(SnappingInputError, match=r"method='dop853'.*refused above 1e\+09 steps.*method='rodas4'"):
+        run(stiff, method="dop853", t_end=1.2 * 2e4 / n * 1e5, t_end_max=1e9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        SF.check_cost(stiff, "dop853", t_end=0.1)  # (a short run: no message)
+        SF.check_cost(Problem.catenary(0.25, 2000), "dop853", t_end=100.0)
