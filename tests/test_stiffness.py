@@ -13,6 +13,7 @@ import pytest
 from snapping._validate import SnappingInputError
 from snapping.simulate import Body, Problem, run
 from snapping.simulate import stiff_system as SS
+from snapping.cli import main  # noqa: F401 (test_files' _cli)
 from snapping.simulate import stiffness as SF
 
 
@@ -88,6 +89,27 @@ def test_fast_chooses_the_cheaper_method_on_either_side_of_the_threshold(beta, e
     assert cost[expect] < cost["rodas4" if expect == "dop853" else "dop853"], cost
 
 
+def test_undamped_bending_waves_keep_dop853():
+    """Undamped, the release's grid-scale waves limit RODAS4 by accuracy too (it then needs
+    8-10x dop853's steps, benchmarks/bench_stiff.py): fast stays explicit, however stiff."""
+    p = _problem(1000, 1e-2, 0.0)
+    assert SF.explicit_steps(p.model(), 1.2) > 2 * SF.CHOICE_RATIO * SF.accuracy_steps(1000, 1e-6)
+    method, why = SF.choose(p)
+    assert method == "dop853" and "undamped" in why
+
+
+def test_cli_names_the_stiff_method(capsys):
+    from test_files import _cli, _one_line_error
+
+    code, out, err = _cli(["simulate", "--N", "12", "--chi", "0.3", "--bending", "1e-3", "--method", "stiff",
+                           "--t-end", "0.05", "--json", "--no-progress"], capsys)
+    assert code == 0, err
+    assert '"method": "rodas4"' in out
+    code, out, err = _cli(["simulate", "--N", "12", "--chi", "0.3", "--method", "stiff", "--t-end", "0.05",
+                           "--no-progress"], capsys)
+    assert code == 2 and "method='rodas4' (stiff) solves chains with a body" in _one_line_error(err)
+
+
 def test_runs_without_bending_keep_dop853_and_no_choice_attribute():
     for p in (Problem.catenary(0.25, 10), Problem.catenary(0.25, 10, body=Body(drag_normal=0.5))):
         a = run(p, t_end=0.05).dataset.attrs
@@ -100,7 +122,7 @@ def test_cost_message_warns_then_refuses_and_names_the_stiff_method():
     assert SF.WARN_STEPS < 20 * n < SF.REFUSE_STEPS
     with pytest.warns(SF.CostWarning, match=r"method='dop853'.*at least ~.* steps.*method='rodas4'"):
         SF.check_cost(stiff, "dop853", t_end=1.2 * 20)
-    with pytest.raises(SnappingInputError, match=r"method='dop853'.*refused above 1e\+09 steps.*method='rodas4'"):
+    with pytest.raises(SnappingInputError, match=r"method='dop853'.*at least.*method='rodas4'.*refused above 1e\+09 steps"):
         run(stiff, method="dop853", t_end=1.2 * 2e4 / n * 1e5, t_end_max=1e9)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
