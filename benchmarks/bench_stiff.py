@@ -41,7 +41,8 @@ from bench_simulate import print_machine  # noqa: E402
 CHI = 0.25
 Q = ("v", "a", "sigma")
 CAP = [600.0]
-#: tolerance of the reference runs (dop853 at 1e-8: peaks within ~5e-9 of tol 1e-11, docs/benchmarks/bench_default_tol.txt)
+#: tolerance of the reference runs (dop853 at 1e-8: peaks within ~5e-9 of tol 1e-11,
+#: docs/benchmarks/bench_default_tol.txt)
 REF_TOL = 1e-8
 
 

@@ -13,7 +13,6 @@ import pytest
 from snapping._validate import SnappingInputError
 from snapping.simulate import Body, Problem, run
 from snapping.simulate import stiff_system as SS
-from snapping.cli import main  # noqa: F401 (test_files' _cli)
 from snapping.simulate import stiffness as SF
 
 
@@ -52,7 +51,7 @@ def test_shortest_wave_is_the_jacobians_largest_eigenvalue(N, beta):
         om, z = SF.shortest_wave(p.model())
         top = ev[np.argmax(np.abs(ev))]
         assert 0.9 < abs(top) / om < 1.1
-        assert z == pytest.approx(-top.real / abs(top), abs=0.08)  # (the eigenvalue -zeta omega + i ...; T overestimated)
+        assert z == pytest.approx(-top.real / abs(top), abs=0.08)  # (-zeta omega + i ...; T overestimated)
         assert z > 0.9 if zeta else z == 0.0
 
 
@@ -122,7 +121,8 @@ def test_cost_message_warns_then_refuses_and_names_the_stiff_method():
     assert SF.WARN_STEPS < 20 * n < SF.REFUSE_STEPS
     with pytest.warns(SF.CostWarning, match=r"method='dop853'.*at least ~.* steps.*method='rodas4'"):
         SF.check_cost(stiff, "dop853", t_end=1.2 * 20)
-    with pytest.raises(SnappingInputError, match=r"method='dop853'.*at least.*method='rodas4'.*refused above 1e\+09 steps"):
+    with pytest.raises(SnappingInputError,
+                       match=r"method='dop853'.*at least.*method='rodas4'.*refused above 1e\+09 steps"):
         run(stiff, method="dop853", t_end=1.2 * 2e4 / n * 1e5, t_end_max=1e9)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

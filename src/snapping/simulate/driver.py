@@ -230,10 +230,15 @@ def run(
         Stepper tolerance (default: the method's ``DEFAULT_TOL``, :func:`default_tol`:
         Euler-Richardson the paper's eps_tol 1e-8; fast/dop853 1e-6, whose peaks agree
         with tol 1e-11 to 3e-8, measured by ``benchmarks/bench_default_tol.py``).
-    method : {"fast", "dop853", "euler-richardson", "euler-richardson-fixed"}
-        ``fast`` (default): the project's best exact method (now ``dop853``, link
-        angles); ``euler-richardson``: the paper's adaptive scheme (reference);
-        ``euler-richardson-fixed``: the same step with fixed dt = dt0.
+    method : {"fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed"}
+        ``fast`` (default): the project's best exact method (``dop853``, link angles; for
+        a problem with a body whose damped bending waves make dop853 stiff, ``rodas4``:
+        :mod:`snapping.simulate.stiffness`, the reason in the attribute ``method_choice``);
+        ``rodas4``/``stiff``: linearly implicit, L-stable, for problems with a body;
+        ``euler-richardson``: the paper's adaptive scheme (reference);
+        ``euler-richardson-fixed``: the same step with fixed dt = dt0. An explicit method
+        on a problem whose bending stiffness needs more than ~1e6 steps warns
+        (:class:`snapping.simulate.stiffness.CostWarning`), more than 1e9 is refused.
     dt0 : float, optional
         Initial (fixed-mode: constant) time step.
     t_end : float, optional

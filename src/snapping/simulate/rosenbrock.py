@@ -33,7 +33,8 @@ from . import rk as R
 from .stiff import RODAS4
 from .stiff_system import KL, KU, NCOL, _jacobian, _matvec
 
-__all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at", "NSTG",
+__all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
+           "NSTG",
            "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3"]
 
 GAMMA = RODAS4["gamma"]
