@@ -132,7 +132,7 @@ def main():
                 print(f"  N={N} beta={beta:g} zeta={zeta:g} eta={eta:.3g}: reference dop853 {REF_TOL:g} rhs {R['rhs']} "
                       f"({R['wall']:.0f} s, t_final {R['t_end']:.4f}); fast runs {fast['method']}", flush=True)
                 d = ladder("dop853", p, ref, acc, [1e-6, 1e-7, 1e-8])
-                s = ladder("rodas4", p, ref, acc, [1e-6, 3e-7, 1e-7])
+                s = ladder("rodas4", p, ref, acc, [1e-5, 3e-6, 1e-6, 3e-7, 1e-7])
                 rows.append((N, beta, zeta, base, d, s, fast["method"]))
     print("\n| N | beta | zeta | fast | dop853 beta=0: tol, rhs | dop853: tol, rhs, steps, wall | "
           "rodas4: tol, rhs, steps, wall, jac | dop853/rodas4 rhs | rodas4/(beta=0) rhs | dop853/rodas4 wall |")

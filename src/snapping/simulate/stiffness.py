@@ -23,16 +23,24 @@ accepted step is 6.3/omega_max (stability-limited: the eigenvalue is -omega_max)
 follows: accuracy-limited by them, below the stability limit). The Euler-Richardson scheme
 (real-axis boundary 2, none on the imaginary axis) takes only the paper's chain, no body.
 
-The choice (:func:`choose`, what ``method="fast"`` does for a problem with a body). RODAS4
-(``method="rodas4"``) is L-stable, but a step costs about as much as five DOP853 steps in
-wall time at N = 300 (5 evaluations, 6 banded solves, a factorisation and a complex-step
-Jacobian) and it needs ~5-10x DOP853's steps for the same accuracy (order 4 against 8).
-Undamped grid-scale waves limit both methods by accuracy (RODAS4 then needs 8-10x more
-steps: ``benchmarks/bench_stiff.py``). So ``fast`` takes RODAS4 only when the shortest
-wave is damped (``zeta >= ZETA_MIN``) and the explicit stability limit alone would cost
-DOP853 more than :data:`CHOICE_RATIO` times its accuracy-limited steps
-(:func:`explicit_steps` against :func:`accuracy_steps`); else DOP853, bit for bit as
-before. Runs without a body, or whose body has no bending, never consult this module.
+With damping ratio zeta > 1 the damping itself is stiff: the fastest eigenvalue is
+``-omega (zeta + sqrt(zeta^2 - 1))`` (:func:`largest_eigenvalue`; measured dt omega_max 1.1
+at zeta 3, 0.32 at zeta 10).
+
+The choice (:func:`choose`, what ``method="fast"`` does for a problem with bending). RODAS4
+(``method="rodas4"``) is L-stable, but it follows, by accuracy, the bending waves that the
+damping leaves (damping ratio ``zeta omega_k/omega_max`` for Kelvin-Voigt damping): measured
+``13500 sqrt(beta) N^0.37 zeta^-0.42`` steps per unit time (:func:`stiff_steps`), e.g.
+N = 1000, zeta = 1: 3.4x (beta 1e-4) and 3.9x (beta 1e-2) fewer steps than DOP853; and a
+step costs ~7 DOP853 steps of wall time (:data:`RODAS4_PRICE`: 5 evaluations, 6 banded
+solves, a factorisation, a complex-step Jacobian). Undamped, the release's grid-scale waves
+limit both methods by accuracy and RODAS4 needs 4-8x DOP853's steps. So ``fast`` takes
+RODAS4 when the shortest wave is damped (``zeta >= ZETA_MIN``) and DOP853's estimated steps
+(the larger of the stability limit and the accuracy-limited :func:`accuracy_steps`) exceed
+``CHOICE_RATIO x RODAS4_PRICE`` times RODAS4's; else DOP853, bit for bit as before (with
+the reason in the run's ``method_choice``). At N = 300, beta = 1e-2: zeta 3 stays DOP853
+(4.5x fewer RODAS4 steps: not enough), zeta 10 is RODAS4's (25x). Runs without a body, or
+whose body has no bending, never consult this module.
 """
 
 from __future__ import annotations
@@ -46,16 +54,19 @@ from .. import _validate as V
 from . import forced as FR
 from . import general as G
 
-__all__ = ["R_DOP853", "ZETA_MIN", "CHOICE_RATIO", "WARN_STEPS", "REFUSE_STEPS", "shortest_wave", "explicit_steps",
-           "accuracy_steps", "choose", "check_cost", "CostWarning"]
+__all__ = ["R_DOP853", "ZETA_MIN", "CHOICE_RATIO", "RODAS4_PRICE", "WARN_STEPS", "REFUSE_STEPS", "shortest_wave",
+           "largest_eigenvalue", "explicit_steps", "stiff_steps", "accuracy_steps", "choose", "check_cost",
+           "CostWarning"]
 
 #: DOP853's stability boundary (min over the imaginary and negative real axes, from its tableau)
 R_DOP853 = 5.96
 #: damping ratio of the shortest bending wave from which the stiff method is chosen
 ZETA_MIN = 0.5
-#: the stiff method is chosen when the explicit stability limit costs more than this many
-#: times DOP853's accuracy-limited steps (a RODAS4 step ~5 DOP853 steps of wall time, ~8x the steps)
-CHOICE_RATIO = 40.0
+#: a RODAS4 step's wall time in DOP853 steps (measured: 5.4, 6.0, 6.6 in CPU time at N = 100,
+#: 300, 1000, benchmarks/bench_stiff_costs.py; 7 in the wall times of bench_stiff.py at N = 1000)
+RODAS4_PRICE = 7.0
+#: the stiff method is chosen when it is estimated this much cheaper (a margin for the estimates)
+CHOICE_RATIO = 1.5
 #: estimated explicit steps above which a run of an explicit method warns / is refused
 WARN_STEPS = 1e6
 REFUSE_STEPS = 1e9
@@ -91,10 +102,26 @@ def shortest_wave(mdl) -> tuple[float, float]:
     return om, zeta
 
 
+def largest_eigenvalue(om: float, zeta: float) -> float:
+    """|lambda| of the shortest wave's fastest eigenvalue: omega, or overdamped (zeta > 1)
+    ``omega (zeta + sqrt(zeta^2 - 1))`` (the damping itself is then the stiffness)."""
+    return om * (zeta + math.sqrt(zeta * zeta - 1.0)) if zeta > 1.0 else om
+
+
 def explicit_steps(mdl, t_span: float) -> float:
     """DOP853's steps over ``t_span`` at its stability limit (a lower bound of its cost)."""
-    om, _ = shortest_wave(mdl)
-    return t_span * om / R_DOP853
+    om, zeta = shortest_wave(mdl)
+    return t_span * largest_eigenvalue(om, zeta) / R_DOP853
+
+
+def stiff_steps(N: int, om: float, zeta: float, t_span: float) -> float:
+    """RODAS4's steps over ``t_span`` (default tol) on a chain whose shortest waves are damped:
+    it follows the waves the damping leaves (damping ratio ~ zeta omega_k/omega_max), a rate
+    measured as ``13500 sqrt(beta) N^0.37 zeta^-0.42`` per unit time (beta from omega_max =
+    4 N^2 sqrt(beta); chi 0.25: N 300 and 1000, beta 1e-4 and 1e-2, zeta 1, 3, 10;
+    ``benchmarks/bench_stiff.py``; within 1.1x there, 3x low for beta = 1 at N = 100)."""
+    sqrt_beta = om / (4.0 * N * N)
+    return t_span * 13500.0 * sqrt_beta * N ** 0.37 * max(zeta, 1.0) ** -0.42
 
 
 def accuracy_steps(N: int, tol: float) -> float:
@@ -116,11 +143,13 @@ def choose(problem, *, tol: float = 1e-6, t_end=None) -> tuple[str, str]:
         return "dop853", ""
     mdl = problem.model()
     om, zeta = shortest_wave(mdl)
-    n_ex = explicit_steps(mdl, _span(t_end))
-    n_acc = accuracy_steps(problem.N, tol) * _span(t_end) / T_SNAP  # (the same ratio for any span)
-    stiff = zeta >= ZETA_MIN and n_ex > CHOICE_RATIO * n_acc
-    what = (f"shortest bending wave omega_max={om:.3g}, damping ratio {zeta:.2g}; explicit stability limit "
-            f"~{n_ex:.3g} dop853 steps against ~{n_acc:.3g} for accuracy")
+    span = _span(t_end)
+    n_acc = accuracy_steps(problem.N, tol) * span / T_SNAP
+    n_ex = max(explicit_steps(mdl, span), n_acc)
+    n_st = max(stiff_steps(problem.N, om, zeta, span), n_acc)
+    stiff = zeta >= ZETA_MIN and n_ex > CHOICE_RATIO * RODAS4_PRICE * n_st
+    what = (f"shortest bending wave omega_max={om:.3g}, damping ratio {zeta:.2g}; ~{n_ex:.3g} dop853 steps "
+            f"against ~{n_st:.3g} rodas4 steps of ~{RODAS4_PRICE:g} times the cost")
     if stiff:
         return "rodas4", f"rodas4 chosen by method='fast' (stiff: {what})"
     why = "undamped bending waves limit every method by accuracy" if zeta < ZETA_MIN else "not stiff enough"
@@ -142,7 +171,8 @@ def check_cost(problem, method: str, *, t_end=None) -> None:
     if n <= WARN_STEPS:
         return
     N = problem.N
-    msg = (f"method='{method}': the bending stiffness limits its steps to dt < {R_DOP853 / om:.3g} (shortest wave "
+    lim = R_DOP853 / largest_eigenvalue(om, zeta)
+    msg = (f"method='{method}': the bending stiffness limits its steps to dt < {lim:.3g} (shortest wave "
            f"omega_max={om:.3g} at N={N}): at least ~{n:.3g} steps ({12 * n:.3g} evaluations of {N} links) to "
            f"t={span:g}; method='rodas4' (stiff, L-stable) is not limited by it")
     if zeta < ZETA_MIN:
