@@ -42,6 +42,25 @@ def test_band_lu_solves_a_banded_system_that_needs_pivoting():
     assert RB.band_lu(sing, n, kl, ku, piv) == 1
 
 
+@pytest.mark.parametrize("case", ["clamp", "pull"])
+def test_jacobian_is_the_complex_step_one(case):
+    """rosenbrock.jacobian_at (d/da and d/dT in closed form) against Residual.jacobian (complex
+    steps in every variable) at a perturbed state, with a moving clamp or held end."""
+    kw = {"clamp": dict(body=Body(bending=1e-3, damping=1e-4, clamp=0.3)),
+          "pull": dict(body=Body(bending=1e-3, drag_normal=0.3), pin=PinMotion.pull((0.3, -0.2)))}[case]
+    p = Problem.catenary(0.3, 13, **kw)
+    eng = _engine(p)
+    res = ST.Residual(ST.body_model(p)[0])
+    y = p.initial_angles() + 0.01 * np.random.default_rng(1).normal(size=eng.Y0.shape[1])
+    f = np.empty_like(y)
+    res.rhs(0.1, y, f)
+    D = res.jacobian(0.1, y, f)
+    mine = np.zeros_like(D)
+    RB.jacobian_at(eng.N, 0.1, y, f, res.sig, mine, eng.mdl, eng.barr, eng.rp)
+    np.testing.assert_allclose(mine, D, rtol=0, atol=1e-13 * np.max(np.abs(D)))
+    assert np.count_nonzero(D[3]) == np.count_nonzero(mine[3]) > 0
+
+
 def test_assembled_stage_matrix_is_the_lapack_one():
     """rosenbrock.assemble (rows) holds the entries of stiff_system.StageMatrix (LAPACK bands)."""
     p = Problem.catenary(0.3, 11, body=Body(bending=1e-3, damping=1e-4))

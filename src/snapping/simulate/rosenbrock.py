@@ -31,7 +31,8 @@ from . import general as G
 from . import models as MD
 from . import rk as R
 from .stiff import RODAS4
-from .stiff_system import KL, KU, NCOL, _jacobian, _matvec
+from .stiff_system import _EPS_CS as EPS_CS
+from .stiff_system import KL, KU, NCOL, _rows
 
 __all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
            "NSTG",
@@ -130,45 +131,99 @@ def band_solve(A, n, kl, ku, piv, b):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def matvec(N, Dv, x, out):
+    """``out += (dR/d var) x`` from the coloured columns ``Dv`` (:func:`stiff_system._matvec`
+    column by column: link l's column, colour l mod 5, touches the rows of links l - 2 .. l + 2;
+    no integer division in the loop)."""
+    k = 0
+    for l in range(N):
+        xl = x[l]
+        i0 = max(0, 2 * l - 4)
+        i1 = min(2 * N, 2 * l + 6)
+        for i in range(i0, i1):
+            out[i] += Dv[k, i] * xl
+        k += 1
+        if k == NCOL:
+            k = 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def assemble(N, D, gh, A):
     """The stage matrix (:func:`stiff_system._assemble`) stored by rows for :func:`band_lu`:
     row i, column j at ``A[i, j - i + KL]``; the rest of A zeroed."""
     for i in range(A.shape[0]):
         for d in range(A.shape[1]):
             A[i, d] = 0.0
-    for i in range(2 * N):
-        j = i // 2
-        for k in range(NCOL):
-            d = (k - j) % NCOL
-            if d > 2:
-                d -= NCOL
-            lk = j + d
-            if 0 <= lk < N:
-                A[i, 2 * lk - i + KL] = D[2, k, i] + gh * gh * D[0, k, i] + gh * D[1, k, i]
-                A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
+    gh2 = gh * gh
+    k = 0
+    for lk in range(N):  # (column by column, as matvec)
+        for i in range(max(0, 2 * lk - 4), min(2 * N, 2 * lk + 6)):
+            A[i, 2 * lk - i + KL] = D[2, k, i] + gh2 * D[0, k, i] + gh * D[1, k, i]
+            A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
+        k += 1
+        if k == NCOL:
+            k = 0
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
     """The coloured banded derivatives of the rows (:meth:`stiff_system.Residual.jacobian`)
-    at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``."""
+    at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``:
+    ``dR/dtheta`` and ``dR/domega`` by complex steps (10 complex evaluations of the compiled
+    rows), ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the
+    node forces depend on neither)."""
     par, h, invm, invh, snode, tab = mdl
     phi = 0.0
     phid = 0.0
     if rp[RP_CLAMP] != 0.0:
         phi, phid = FR.clamp_angle(t, par, tab)
     _, _, _, _, pax, pay = G.pin_kinematics(t, par, tab)
-    th = np.empty(N, dtype=np.complex128)
-    om = np.empty(N, dtype=np.complex128)
-    a = np.empty(N, dtype=np.complex128)
-    T = np.empty(N, dtype=np.complex128)
+    payg = pay - par[G.P_G]
+    invm_next = barr[3, :N]
+    M = np.zeros(N + 1, dtype=np.complex128)
+    FX = np.zeros(N + 1, dtype=np.complex128)
+    FY = np.zeros(N + 1, dtype=np.complex128)
+    out = np.zeros(2 * N, dtype=np.complex128)
+    x = np.zeros((4, N), dtype=np.complex128)
     for i in range(N):
-        th[i] = y[i]
-        om[i] = y[N + i]
-        a[i] = f[N + i]
-        T[i] = sig[i]
-    _jacobian(N, th, om, a, T, h, invm, barr[3, :N], invh, barr[0], barr[1], barr[2], rp[RP_CLAMP] != 0.0,
-              rp[RP_BEND] != 0.0, phi, phid, pax, pay - par[G.P_G], Dj)
+        x[0, i] = y[i]
+        x[1, i] = y[N + i]
+        x[2, i] = f[N + i]
+        x[3, i] = sig[i]
+    C0 = np.cos(y[:N])
+    S0 = np.sin(y[:N])
+    Cd0 = np.cos(y[1:N] - y[:N - 1])
+    Sd0 = np.sin(y[1:N] - y[:N - 1])
+    clamped = rp[RP_CLAMP] != 0.0
+    hasbend = rp[RP_BEND] != 0.0
+    for v in range(2):
+        for k in range(NCOL):
+            for j in range(k, N, NCOL):
+                x[v, j] += 1j * EPS_CS
+            _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, barr[0], barr[1], barr[2], clamped, hasbend,
+                  phi, phid, pax, payg, M, FX, FY, out, C0, S0, Cd0, Sd0)
+            for i in range(2 * N):
+                Dj[v, k, i] = out[i].imag / EPS_CS
+            for j in range(k, N, NCOL):
+                x[v, j] -= 1j * EPS_CS
+    for v in range(2, 4):
+        for k in range(NCOL):
+            for i in range(2 * N):
+                Dj[v, k, i] = 0.0
+    k = 0
+    for j in range(N):  # link j has colour k = j mod 5
+        Dj[2, k, 2 * j] = h[j]  # angle row: h_j a_j
+        Dj[3, k, 2 * j + 1] = -(invm[j] + invm_next[j])  # tension row: its own tension
+        k += 1
+        if k == NCOL:
+            k = 0
+    for j in range(N - 1):  # row j against T_{j+1} (colour of j + 1), row j + 1 against T_j (colour of j)
+        kn = (j + 1) % NCOL
+        kj = j % NCOL
+        Dj[3, kn, 2 * j] = -Sd0[j] * invm[j + 1]
+        Dj[3, kn, 2 * j + 1] = Cd0[j] * invm[j + 1]
+        Dj[3, kj, 2 * j + 2] = Sd0[j] * invm[j + 1]
+        Dj[3, kj, 2 * j + 3] = Cd0[j] * invm[j + 1]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -178,8 +233,8 @@ def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
         tmp[i] = b[i] + gh * b[N + i]
     for i in range(2 * N):
         rhs[i] = 0.0
-    _matvec(N, Dj[0], tmp, rhs)
-    _matvec(N, Dj[1], b[N:2 * N], rhs)
+    matvec(N, Dj[0], tmp, rhs)
+    matvec(N, Dj[1], b[N:2 * N], rhs)
     for i in range(2 * N):
         rhs[i] *= gh
     band_solve(ab, 2 * N, KL, KU, piv, rhs)
