@@ -11,8 +11,8 @@ second difference, 4/h^2)::
 (2/h)^2`` once bending dominates) with T the chain's weight, the tension scale of a hanging
 chain. Kelvin-Voigt damping ``eta_i`` damps it with the ratio ``zeta_i = 8 (eta_i/l_i) /
 (m_i h_i^2 omega_i)``. Checked against the eigenvalues of the chain's exact Jacobian
-(``tests/test_stiffness.py``: 1.0-1.3 omega_max at the catenary, the excess from its
-tension profile).
+(``tests/test_stiffness.py``: within 10% at the catenary, N 20 and 40, beta 1e-3 and
+1e-2; the damping ratio within 0.08 of the eigenvalue's).
 
 The explicit limit. DOP853's region of absolute stability reaches ``|z| = 5.96`` on the
 imaginary axis and 6.39 on the negative real axis (computed from its tableau,
