@@ -14,6 +14,12 @@ give only some ten frames; :func:`dense_snapshot_times` suggests times for
 the time to the snap), and ``snapping animate`` prints the command when a run has
 fewer than :data:`DENSE_FRAMES` snapshots up to the snap.
 
+A run with bending stiffness (a :class:`snapping.simulate.Body`) is coloured instead by the
+magnitude of the bending moment at each link (the mean of its nodes': :func:`bending_moments`,
+``B (turning angle - natural) / l`` at a node, zero at a free end), and its ends are marked:
+the tip body (a tip mass or a tip drag) as a circle, a clamped held end as a short thick
+handle along the clamp's direction (it turns with a prescribed clamp motion).
+
 GIF is written with matplotlib's PillowWriter (pillow comes with matplotlib), MP4
 with FFMpegWriter when ``ffmpeg`` is on PATH.
 
@@ -36,7 +42,7 @@ import numpy as np
 
 from . import _validate as V
 
-__all__ = ["dense_snapshot_times", "frames_of", "animate", "DENSE_FRAMES", "SUFFIXES"]
+__all__ = ["dense_snapshot_times", "frames_of", "animate", "bending_moments", "clamp_angle", "DENSE_FRAMES", "SUFFIXES"]
 
 #: Fewer snapshots than this up to the snap make a jerky animation: ``snapping animate`` says how to get more.
 DENSE_FRAMES = 24
@@ -130,6 +136,56 @@ def denser_run_hint(ds, path: str, n: int = 60) -> str | None:
     return f"{head}: add to the command that made it\n  --snapshot-times {times}"
 
 
+def _body_of(ds):
+    """The run's :class:`snapping.simulate.Body` and link lengths, or (None, None) without one."""
+    import json
+
+    text = ds.attrs.get("body")
+    if not text or "link_length" not in ds:
+        return None, None
+    from .simulate.body import Body
+
+    h = np.asarray(ds["link_length"].values, dtype=float)
+    return Body.from_describe(json.loads(text), h), h
+
+
+def clamp_angle(body, t: float) -> float:
+    """The direction (radians, from +x towards +y downward) in which a clamped held end holds
+    the line at time ``t``: the clamp's angle, or its prescribed motion (the cubic spline with
+    zero rate at both ends that the run follows, constant after the last sample)."""
+    if isinstance(body.clamp, tuple):
+        from scipy.interpolate import CubicSpline
+
+        ts, a = body.clamp
+        return float(CubicSpline(ts, a, bc_type="clamped")(min(max(float(t), 0.0), float(ts[-1]))))
+    return float(body.clamp)
+
+
+def bending_moments(x, y, body, h, t: float = 0.0) -> np.ndarray:
+    """|bending moment| at the N + 1 nodes of one snapshot (positions ``x, y``, index 0 the
+    free end) of a line with ``body`` and links ``h``: ``B_j |phi_j - kappa0_j l_j| / l_j`` with
+    ``phi_j`` the turning angle between the node's two links and ``l_j`` its share of length
+    (the moment whose energy the run records as ``bending_energy``); 0 at the free end, and at
+    the held end unless it is clamped (then ``phi`` is measured from the clamp's direction at
+    ``t``). Units of M g L (nondimensional)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    N = h.size
+    th = np.arctan2(np.diff(y), np.diff(x))  # link j: from node j to node j + 1
+    l = np.zeros(N + 1)
+    l[0], l[N] = 0.5 * h[0], 0.5 * h[N - 1]
+    l[1:N] = 0.5 * (h[:-1] + h[1:])
+    phi = np.zeros(N + 1)
+    phi[1:N] = np.angle(np.exp(1j * (th[1:] - th[:-1])))
+    inner = np.zeros(N + 1)
+    inner[1:N] = 1.0
+    if body.clamp is not None and not isinstance(body.clamp, str):
+        leave = math.atan2(y[N - 1] - y[N], x[N - 1] - x[N])  # the direction the line leaves the held end
+        phi[N] = np.angle(np.exp(1j * (clamp_angle(body, t) - leave)))
+        inner[N] = 1.0
+    B, k0 = body.node_values("bending", h), body.node_values("curvature", h)
+    return inner * B * np.abs(phi - k0 * l) / l
+
+
 def _writer(suffix: str, fps: float):
     from matplotlib import animation as A
 
@@ -167,9 +223,11 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     the LineCollection ``chain``, the colour ``norm``, the ``frames`` (snapshot indices) and
     the time ``text``, for inspection.
 
-    Colours: the speed of each link (mean of its nodes' speeds) on a LogNorm from the
-    largest speed of all frames down to ``vmin_fraction`` of it (or the smallest positive
-    speed, if larger); slower links (the chain at rest at t = 0) take the lowest colour."""
+    Colours: the speed of each link (mean of its nodes' speeds), or with bending stiffness
+    the bending moment's magnitude (mean of its nodes' :func:`bending_moments`), on a LogNorm
+    from the largest value of all frames down to ``vmin_fraction`` of it (or the smallest
+    positive value, if larger); smaller values take the lowest colour. ``artists`` then has
+    the tip body's marker ``tip`` and the clamped handle ``handle`` (None where there is none)."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -183,7 +241,13 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     H = -np.asarray(ds["y"].values, dtype=float)[frames]  # y points down: height = -y
     S = np.asarray(ds["speed"].values, dtype=float)[frames]
     T = np.asarray(ds["t_snapshot"].values, dtype=float)[frames]
-    seg_speed = 0.5 * (S[:, 1:] + S[:, :-1])
+    body, h = _body_of(ds)
+    bending = body is not None and body.has_bending
+    if bending:  # the colour: the bending moment (its mean over each link's two nodes)
+        mom = np.array([bending_moments(X[i], -H[i], body, h, T[i]) for i in range(len(frames))])
+        seg_speed = 0.5 * (mom[:, 1:] + mom[:, :-1])
+    else:
+        seg_speed = 0.5 * (S[:, 1:] + S[:, :-1])
     finite = seg_speed[np.isfinite(seg_speed)]
     vmax = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
     pos = finite[finite > 0]
@@ -214,13 +278,30 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     chain.set_array(np.maximum(seg_speed[0], vmin))
     ax.add_collection(chain)
     pin, = ax.plot([X[0, -1]], [H[0, -1]], "ks", ms=6, zorder=3)
+    clamped = body is not None and body.clamp is not None and not isinstance(body.clamp, str)
+    hl = 0.08 * max(xr, hr)  # the handle's drawn length
+
+    def handle_xy(i):  # behind the held end, opposite to the direction the clamp holds the line
+        a = clamp_angle(body, T[i])
+        return [X[i, -1], X[i, -1] - hl * math.cos(a)], [H[i, -1], H[i, -1] + hl * math.sin(a)]
+
+    handle = ax.plot(*handle_xy(0), color="saddlebrown", lw=6, solid_capstyle="round", zorder=2,
+                     label="clamped handle")[0] if clamped else None
+    tip_body = float(ds.attrs.get("tip_mass", 0.0) or 0.0) > 0 or (body is not None and body.tip_drag > 0)
+    tip = ax.plot([X[0, 0]], [H[0, 0]], "o", color="tab:red", mec="k", ms=7, zorder=4,
+                  label="tip body")[0] if tip_body else None
+    if clamped or tip_body:
+        ax.legend(loc="lower left", fontsize=8)
     cb = fig.colorbar(chain, ax=ax, shrink=0.85, pad=0.02)
-    cb.set_label(r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
+    cb.set_label(r"bending moment $|M|$  [$M g \ell$]  (log scale)" if bending
+                 else r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
     t_snap = float(ds.attrs.get("t_snap_v", np.nan))
     text = ax.set_title("", fontsize=9, family="monospace", loc="left")
     from .figures import run_label
 
-    fig.suptitle(f"falling chain, {run_label(ds)} (nondimensional)", fontsize=10)
+    import textwrap
+
+    fig.suptitle("\n".join(textwrap.wrap(f"falling chain, {run_label(ds)} (nondimensional)", 70)), fontsize=10)
 
     def label(i):
         s = f"t = {T[i]:.6f}"
@@ -237,12 +318,17 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         chain.set_segments(segments(i))
         chain.set_array(np.maximum(seg_speed[i], vmin))
         pin.set_data([X[i, -1]], [H[i, -1]])
+        if handle is not None:
+            handle.set_data(*handle_xy(i))
+        if tip is not None:
+            tip.set_data([X[i, 0]], [H[i, 0]])
         text.set_text(label(i))
         return chain, pin, text
 
     anim = A.FuncAnimation(fig, update, frames=len(frames), blit=False, repeat=False)
     return fig, anim, {"chain": chain, "norm": norm, "frames": frames, "text": text, "update": update,
-                       "segment_speed": seg_speed}
+                       "segment_speed": seg_speed, "colour": "bending moment" if bending else "speed",
+                       "tip": tip, "handle": handle}
 
 
 def animate(ds, output, *, fps: float = 8.0, max_frames: int | None = None, overwrite: bool = False) -> str:

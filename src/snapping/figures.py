@@ -15,7 +15,7 @@ import numpy as np
 from .estimates import Chain, PAPER_CHAIN
 
 __all__ = ["shapes", "pin_force", "profiles", "overview", "peak_speed_vs_N", "convergence_figure", "save",
-           "run_label"]
+           "run_label", "energy_terms"]
 
 
 def _plt():
@@ -125,6 +125,8 @@ def run_label(ds) -> str:
     if chain.get("kind") == "taper":
         power = float(chain.get("power", 1.0))
         parts.append(f"taper {float(chain['ratio']):g}" + ("" if power == 1.0 else f":{power:g}"))
+    elif chain.get("kind") == "line":
+        parts.append(str(chain.get("line", "line")))
     elif chain.get("kind") not in (None, "uniform", "paper"):
         parts.append(f"{chain['kind']} links")
     if pin.get("kind") in ("pull", "flick"):
@@ -136,6 +138,15 @@ def run_label(ds) -> str:
         parts.append(f"held end: {pin['kind']}")
     if "gravity" in prob and float(prob["gravity"]) != 1.0:
         parts.append(f"gravity {float(prob['gravity']):g}")
+    if a.get("body"):
+        from .simulate.body import summarize
+
+        try:
+            b = summarize(a["body"])
+        except (TypeError, ValueError):
+            b = {}
+        parts.append(" + ".join(name for k, name in (("beta", "bending"), ("drag_normal", "drag"),
+                                                     ("tip_drag", "tip drag"), ("clamp", "clamped")) if k in b))
     return ", ".join(p for p in parts if p)
 
 
@@ -243,14 +254,16 @@ def overview(ds, n: int = 7):
     """One run at a glance (``snapping plot``): (a) the chain's shapes at up to ``n``
     snapshots up to the snap, the held end marked (it may move); (b) speed and (c) tension
     along the chain at the same snapshots; (d) the maxima over the chain (speed,
-    acceleration, tension) against time, with the snapping time. Nondimensional.
-    Returns the Figure."""
+    acceleration, tension) against time, with the snapping time; a run with a body
+    (bending, drag: :class:`snapping.simulate.Body`) adds (e) its energy terms and (f) the
+    residual of their balance (:func:`energy_terms`). Nondimensional. Returns the Figure."""
     plt = _plt()
     u = _U["nondimensional"]
     idx = _snapshots_before(ds, n)
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.4))
-    fig.subplots_adjust(left=0.08, right=0.97, bottom=0.07, top=0.9, wspace=0.25, hspace=0.3)
-    (a_shape, a_speed), (a_tension, a_max) = axes
+    body = "dissipated" in ds and "bending_energy" in ds
+    fig, axes = plt.subplots(2, 3 if body else 2, figsize=(16.5 if body else 11, 8.4), squeeze=False)
+    fig.subplots_adjust(left=0.06 if body else 0.08, right=0.97, bottom=0.07, top=0.9, wspace=0.3, hspace=0.3)
+    (a_shape, a_speed, *a_e), (a_tension, a_max, *a_b) = axes
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(idx), 2)))
     s_node, s_link = ds["s_node"].values, ds["s_link"].values
     ident = lambda x: x  # noqa: E731
@@ -289,9 +302,62 @@ def overview(ds, n: int = 7):
     a_max.legend(fontsize=7, loc="upper left")
     for a in (a_speed, a_tension, a_max):
         a.grid(alpha=0.3)
+    if body:
+        _energy_panels(ds, a_e[0], a_b[0], t_snap)
     fig.suptitle(f"{run_label(ds)}: {ds.attrs.get('status', '')}, {ds.attrs.get('method', '')} "
                  f"(nondimensional)")
     return fig
+
+
+def energy_terms(ds) -> dict:
+    """The energy terms of a body run (units of M g L) against ``t``: ``mechanical``
+    (kinetic + gravity: ``energy - bending_energy``), ``bending`` (``bending_energy``),
+    ``pin_work``, ``dissipated``, the ``balance`` E - W + D (conserved), and ``residual``
+    = |balance - balance(0)| / |E(0)| (relative to the energy at t = 0; absolute if that is 0).
+
+    >>> import numpy as np, xarray as xr
+    >>> ds = xr.Dataset({"energy": ("step", [2.0, 1.5]), "bending_energy": ("step", [0.5, 0.25]),
+    ...                  "pin_work": ("step", [0.0, 0.0]), "dissipated": ("step", [0.0, 0.5 + 1e-9])},
+    ...                 coords={"t": ("step", [0.0, 1.0])})
+    >>> [float(x) for x in energy_terms(ds)["residual"]]
+    [0.0, 5e-10]
+    """
+    g = {k: np.asarray(ds[k].values, dtype=float) for k in ("energy", "bending_energy", "dissipated")}
+    w = np.asarray(ds["pin_work"].values, dtype=float) if "pin_work" in ds else np.zeros_like(g["energy"])
+    bal = g["energy"] - w + g["dissipated"]
+    e0 = abs(float(g["energy"][0]))
+    return {"t": np.asarray(ds["t"].values, dtype=float), "mechanical": g["energy"] - g["bending_energy"],
+            "bending": g["bending_energy"], "pin_work": w, "dissipated": g["dissipated"], "balance": bal,
+            "residual": np.abs(bal - bal[0]) / (e0 if e0 > 0 else 1.0)}
+
+
+def _energy_panels(ds, a_terms, a_res, t_snap) -> None:
+    """(e) the energy terms of a body run against time; (f) the residual of their balance."""
+    from .scaling.plots import thin_envelope
+
+    e = energy_terms(ds)
+    t = e["t"]
+    for name, lab, c in (("mechanical", "kinetic + gravity", "C0"), ("bending", "bending", "C1"),
+                         ("pin_work", "pin work W", "C2"), ("dissipated", "dissipated D (drag, damping)", "C3"),
+                         ("balance", "E - W + D (conserved)", "k")):
+        k = thin_envelope(t, e[name])
+        a_terms.plot(t[k], e[name][k], color=c, lw=1.0 if name != "balance" else 1.6, label=lab)
+    a_terms.set_xlabel(r"time $t$  [$\sqrt{\ell/g}$]")
+    a_terms.set_ylabel(r"energy  [$M g \ell$]")
+    a_terms.set_title("(e) energy terms (E = kinetic + gravity + bending)", loc="left", fontsize=10)
+    a_terms.legend(fontsize=7, loc="best")
+    r = e["residual"]
+    k = thin_envelope(t, r)
+    pos = k[r[k] > 0]  # (log axis: the exact zeros, t = 0 among them, are left out)
+    a_res.semilogy(t[pos], r[pos], color="k", lw=1.0, label=f"max {float(r.max()):.2g}")
+    a_res.set_xlabel(r"time $t$  [$\sqrt{\ell/g}$]")
+    a_res.set_ylabel(r"$|E - W + D - E_0| / E_0$")
+    a_res.set_title(f"(f) energy balance (tol {ds.attrs.get('tol', float('nan')):g})", loc="left", fontsize=10)
+    a_res.legend(fontsize=7, loc="lower right")
+    for a in (a_terms, a_res):
+        if np.isfinite(t_snap):
+            a.axvline(t_snap, color="k", lw=0.6, ls="--")
+        a.grid(alpha=0.3)
 
 
 def peak_speed_vs_N(table):

@@ -69,6 +69,9 @@ STEP_VARS: dict[str, dict[str, str]] = {
     "energy": _v("total mechanical energy (kinetic + potential, zero for the chain hanging at rest)"),
     "link_error": _v("largest relative link-length error max_k |N |r_k+1 - r_k| - 1|"),
     "error_estimate": _v("stepper error estimate of the accepted step"),
+    "sigma_min": _v("minimum link tension over the chain (negative: the rigid links carry compression, where a "
+                    "real line would go slack)"),
+    "s_sigma_min": _v("arclength of the midpoint of the link of minimum tension"),
 }
 
 #: Per snapshot profiles.
@@ -194,6 +197,15 @@ RESULT_ATTRS: dict[str, str] = {
     "sigma_peak": "peak of the maximum tension (if snap_reached is 0: its maximum over the run)",
     "kappa_peak": "peak of the maximum curvature (if snap_reached is 0: its maximum over the run)",
     "kappa_max_0": "maximum curvature at t = 0",
+    "min_tension": ("smallest link tension over the recorded steps (sigma_min; negative: the rigid links carried "
+                    "compression, where a real line would go slack)"),
+    "t_min_tension": "time of min_tension",
+    "s_min_tension": "arclength of the midpoint of the link of min_tension",
+    "t_compression": ("first recorded time at which the rigid links carried compression: sigma_min < "
+                      "-compression_tolerance max(1, sigma_max) (NaN: never; the history from then on "
+                      "is not what a real, slack-capable line does; snapping.simulate.compression)"),
+    "compression_tolerance": ("relative round-off bound of the link tensions, 8 (2N + 1)^2 eps (the condition "
+                              "number bound of the tension solve times a safety factor)"),
     "energy_drift": "max |E(t) - E(0)| over the run",
     "link_drift": "max relative link-length error against 1/N over the run",
     "link_drift_initial": "max relative link-length change against the initial chords",
@@ -220,8 +232,23 @@ def result_units(name: str) -> str:
     return RESULT_UNITS.get(name, "1")
 
 
+#: Per accepted step, runs of the extensible line only (:mod:`snapping.simulate.elastic`); their
+#: ``energy`` is kinetic + gravity + elastic, and ``energy - pin_work + dissipated`` is conserved.
+ELASTIC_STEP_VARS: dict[str, dict[str, str]] = {
+    "s_sigma_max": _v("arclength (at rest) of the midpoint of the link of largest tension"),
+    "elastic_energy": _v("elastic energy of the links (sum over taut links of h_j times the integral of the "
+                         "tension over the strain)"),
+    "strain_max": _v("largest link strain l_j/h_j - 1 (negative: every link shorter than at rest)"),
+    "n_slack": _v("number of slack links (tension 0)"),
+}
+#: Per snapshot (and per link) of the extensible line.
+ELASTIC_LINK_VARS: dict[str, dict[str, str]] = {
+    "strain": _v("link strain l_j/h_j - 1 (at most 0: slack)"),
+    "axial_stiffness": _v("axial stiffness EA of the link (the table's initial slope for a tension-strain table)"),
+}
+
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,
-            **BODY_STEP_VARS}
+            **BODY_STEP_VARS, **ELASTIC_STEP_VARS, **ELASTIC_LINK_VARS}
 
 # ---------------------------------------------------------------- checkpoints
 #: Status values of a run file that :func:`snapping.simulate.resume` continues.

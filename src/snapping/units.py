@@ -86,7 +86,7 @@ VARIABLE_KINDS: dict[str, str] = {
     # per step
     "dt": _T, "v_max": _V, "a_max": _A, "sigma_max": _F, "kappa_max": _K, "s_kappa_max": _L, "s_a_max": _L,
     "s_v_max": _L, "v_end": _V, "a_end": _A, "pin_force_x": _F, "pin_force_y": _F, "energy": _E,
-    "link_error": _1, "error_estimate": _1,
+    "link_error": _1, "error_estimate": _1, "sigma_min": _F, "s_sigma_min": _L,
     # profiles
     "x": _L, "y": _L, "vx": _V, "vy": _V, "ax": _A, "ay": _A, "speed": _V, "accel": _A, "curvature": _K,
     "tension": _F,
@@ -94,6 +94,9 @@ VARIABLE_KINDS: dict[str, str] = {
     "pin_x": _L, "pin_y": _L, "pin_vx": _V, "pin_vy": _V, "pin_work": _E, "v_rel_max": _V,
     # a run with a body (bending, drag)
     "bending_energy": _E, "dissipated": _E,
+    # the extensible line (snapping.simulate.elastic)
+    "s_sigma_max": _L, "elastic_energy": _E, "strain_max": _1, "n_slack": _1, "strain": _1,
+    "axial_stiffness": _F,
     # the problem of a general run
     "link_length": _L, "node_mass": _M, "start_x": _L, "start_y": _L, "start_vx": _V, "start_vy": _V,
     "pin_table_t": _T, "pin_table_x": _L, "pin_table_y": _L,
@@ -111,7 +114,8 @@ VALUE_KINDS: dict[str, str] = {
     "v_peak": _V, "a_peak": _A, "sigma_peak": _F, "kappa_peak": _K, "kappa_max_0": _K, "energy_drift": _E,
     "link_drift": _1, "link_drift_initial": _1, "length_drift": _1, "link_error_initial": _1, "t_final": _T,
     "energy_initial": _E, "dt_min_accepted": _T, "dt_max_accepted": _T, "n_steps": _1, "n_rejected": _1,
-    "n_rhs": _1,
+    "n_rhs": _1, "min_tension": _F, "t_min_tension": _T, "s_min_tension": _L, "t_compression": _T,
+    "compression_tolerance": _1,
 }
 
 #: Suffixes of a value that has the kind of the value it is appended to (an error bar, a limit).

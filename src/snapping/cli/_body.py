@@ -42,6 +42,10 @@ def add_body_options(p) -> None:
     g.add_argument("--clamped", dest="clamp", nargs="?", const="start", default=None, metavar="ANGLE",
                    help="clamp the held end at ANGLE (radians, the direction the line leaves it, from +x towards "
                         "+y downward; no ANGLE: the start's direction); needs --bending")
+    g.add_argument("--line", default=None, metavar="NAME",
+                   help="a real line of the catalogue (snapping.lines: ball-chain, nylon-monofilament, fly-line, "
+                        "bullwhip, climbing-rope, bungee-cord): its --length, --mass and SI body (and, with "
+                        "simulate, its tapered masses and tip body); every value overridable by the options")
     si = p.add_argument_group(
         "the line's body in SI (with --length METERS --mass KG [--g]; the nondimensional numbers are printed)",
         "drag per length 0.5 rho C_n d |v_n| v_n (normal) and 0.5 rho C_t pi d |v_t| v_t (tangential); "
@@ -58,6 +62,68 @@ def add_body_options(p) -> None:
     si.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",
                     help="drag area C_d A of the free end's tip body in m^2 (a fly, a popper)")
     si.add_argument("--wind-si", default=None, metavar="WX,WY", help="uniform wind in m/s (y downward)")
+
+
+#: the SI options a line fills (dest: the nondimensional options that replace it instead)
+_LINE_TWINS = {"ei": ("bending",), "diameter": ("drag_normal", "drag_tangential"), "cd_normal": (),
+               "cd_tangential": (), "tip_drag_area": ("tip_drag",)}
+
+
+def apply_line(args):
+    """Fill --length, --mass and the SI body options of ``args`` from --line NAME
+    (:mod:`snapping.lines`) where they were not given (an option given, or its nondimensional
+    twin, wins); returns the :class:`snapping.lines.Line` or None. A bad name lists the valid ones."""
+    from .. import lines
+    from .._validate import SnappingInputError
+
+    name = getattr(args, "line", None)
+    if name is None:
+        return None
+    try:
+        line = lines.get(name)
+    except SnappingInputError as exc:
+        raise SnappingInputError(f"--{exc}") from None  # (its message starts with line=)
+    if args.length is None:
+        args.length = line.length
+    if args.mass is None:
+        try:
+            args.mass = line.mass(args.length)
+        except SnappingInputError as exc:
+            raise SnappingInputError(f"--{exc}") from None
+    si = line.si(args.length)
+    for dest, twins in _LINE_TWINS.items():
+        if dest not in si or getattr(args, dest, None) is not None:
+            continue
+        if any(getattr(args, t, None) not in (None, 0.0) for t in twins):
+            continue
+        if dest.startswith("cd_") and args.diameter is None:
+            continue
+        setattr(args, dest, si[dest])
+    args.line_obj = line
+    return line
+
+
+def line_links(args):
+    """The chain of --line where the line has a taper or a tip body (None otherwise, or when
+    --taper/--tip-mass/--lumping were given: they win)."""
+    line = getattr(args, "line_obj", None)
+    if line is None or (line.taper is None and line.tip_mass == 0.0):
+        return None
+    if getattr(args, "taper", None) is not None or getattr(args, "tip_mass", 0.0) or getattr(args, "lumping", None):
+        return None
+    return line.links(args.N, args.length)
+
+
+def refuse_line_masses(args, command: str) -> None:
+    """``sweep`` and ``converge`` build their own uniform chains: a --line with a taper or a
+    tip body would run without its masses, so it is refused (its body alone: the SI options)."""
+    from .._validate import SnappingInputError
+
+    line = getattr(args, "line_obj", None)
+    if line is not None and (line.taper is not None or line.tip_mass):
+        raise SnappingInputError(f"--line {line.name} has tapered masses or a tip body, which snapping {command} "
+                                 f"does not build (uniform chains): use snapping simulate --line {line.name}, or "
+                                 f"give its body with the SI options (--ei, --diameter, ...)")
 
 
 def body_from_args(args):
@@ -172,6 +238,8 @@ def _si_numbers(args, si: dict) -> dict:
 
 
 def args_text(v) -> str:
+    if callable(v):
+        return _si_value(v)
     return ",".join(f"{x:g}" for x in v) if isinstance(v, (list, tuple)) else f"{v:g}"
 
 
@@ -179,7 +247,7 @@ def si_summary(si: dict | None) -> dict | None:
     """The SI body options as ``{name: {"value", "units"}}`` (for the summary), None without."""
     if not si:
         return None
-    out = {k: {"value": v, "units": SI_BODY[k][1]} for k, v in si.items()}
+    out = {k: {"value": _si_value(v), "units": SI_BODY[k][1]} for k, v in si.items()}
     if "diameter" in si or "tip_drag_area" in si:
         from .. import units
 
@@ -188,6 +256,11 @@ def si_summary(si: dict | None) -> dict | None:
             out.setdefault("cd_normal", {"value": units.CD_NORMAL, "units": "1"})
             out.setdefault("cd_tangential", {"value": units.CD_TANGENTIAL, "units": "1"})
     return out
+
+
+def _si_value(v):
+    """An SI option's value for the summary: a profile of a --line (a function of s) by its name."""
+    return f"profile: {getattr(v, '__name__', 'function of s')}" if callable(v) else v
 
 
 def attach_body(problem, body, args):

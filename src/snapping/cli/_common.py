@@ -104,7 +104,9 @@ def _si_scales(args):
     --length nor --mass is given; SnappingInputError naming the option when one is bad."""
     from .._validate import SnappingInputError
     from ..units import Scales
+    from ._body import apply_line
 
+    apply_line(args)  # --line NAME: its --length, --mass and SI body where not given
     if args.length is None and args.mass is None:
         if "g" in getattr(args, "_explicit", ()):
             raise SnappingInputError(f"--g {args.g!r} needs --length METERS and --mass KG (it only scales SI output)")
@@ -161,6 +163,43 @@ def _print_si(scales, rows, title: str = "") -> None:
     w = [max(len(r[i]) for r in table) for i in range(3)]
     for r in table:
         print(f"  {r[0]:<{w[0]}}  {r[1]:>{w[1]}}  {r[2]:>{w[2]}}  {r[3]}".rstrip())
+
+
+def _dimensionless(scales, args, *, N=None, tip_mass=None) -> dict | None:
+    """The line's dimensionless numbers (:func:`snapping.dimensionless.line_numbers`) from
+    --length/--mass/--g, the body's SI options where the command has them (--ei, --diameter,
+    --air-density, --cd-normal, --cd-tangential; --bending, --drag-normal, --drag-tangential as
+    given), --ea where it has it, ``N`` links and the ``tip_mass`` ratio (None: not said); None
+    without SI scales (``scales``: anything with ``length``, ``mass`` and ``g``)."""
+    if scales is None:
+        return None
+    from .. import dimensionless
+
+    kw = {}
+    if hasattr(args, "ei"):
+        from ._body import SI_BODY, body_si_inputs
+
+        # a tapered line (--line) gives profiles of s: its numbers are those at the held end, s = 0,
+        # as snapping.lines.Line.numbers
+        kw = {SI_BODY[k][0]: (v(0.0) if callable(v) else v) for k, v in (body_si_inputs(args) or {}).items()
+              if k in ("ei", "diameter", "air_density", "cd_normal", "cd_tangential")}
+    out = dimensionless.line_numbers(scales.length, scales.mass, scales.g, N=N, ea=getattr(args, "ea", None),
+                                     end_mass=None if tip_mass is None else tip_mass * scales.mass, **kw)
+    for dest, key in (("bending", "beta"), ("drag_normal", "drag_normal"), ("drag_tangential", "drag_tangential")):
+        v = getattr(args, dest, None)
+        if isinstance(v, float) and v != 0.0:  # (given nondimensional: the number itself)
+            out[key] = v
+    return {k: out[k] for k in dimensionless.NUMBERS if k in out}
+
+
+def _print_dimensionless(numbers) -> None:
+    """The block "Dimensionless numbers" of a text answer (nothing when ``numbers`` is None)."""
+    if not numbers:
+        return
+    from ..dimensionless import number_rows
+
+    print()
+    print_table(number_rows(numbers), title="Dimensionless numbers")
 
 
 # ------------------------------------------------------------- option values

@@ -255,6 +255,10 @@ def _cmd_plot(args) -> int:
 
         plt.close(fig)
     print(f"wrote {args.output}: {figures.run_label(ds).replace('$', '').replace(chr(92), '')}")
+    if "dissipated" in ds and "bending_energy" in ds:
+        r = figures.energy_terms(ds)["residual"]
+        print(f"energy balance: max |kinetic + gravity + bending - pin work + dissipated - E0| / E0 = "
+              f"{float(r.max()):.3g} (panel f)")
     return 0
 
 

@@ -3,7 +3,7 @@ the peaks of a chain's snap (computed and estimated) and the inverse design."""
 
 from __future__ import annotations
 
-from ._common import PLOT_BYTES, _add_g_option, _formatter, print_json
+from ._common import PLOT_BYTES, _add_g_option, _dimensionless, _formatter, _print_dimensionless, print_json
 
 
 # --------------------------------------------------------------------------- ideal
@@ -137,11 +137,19 @@ def _cmd_estimate(args) -> int:
         except table.OutsideTable as exc:
             raise table.OutsideTable(f"{exc}; {'drop --table and ' if args.table else ''}add --simulate to "
                                      f"compute this chain with one run of the fast method instead") from None
+    numbers = _numbers_of(chain, args, args.links if args.links is not None else args.N, args.tip_mass)
     if args.json:
-        print_json(est.to_dict())
+        print_json({**est.to_dict(), "dimensionless_numbers": numbers})
     else:
         estimates.print_estimate(est)
+        _print_dimensionless(numbers)
     return 0
+
+
+def _numbers_of(chain, args, N, tip_mass) -> dict:
+    """The dimensionless numbers (snapping.dimensionless) of the chain of --length/--mass/--g
+    (the chain stands for the SI scales: its length, mass and g)."""
+    return _dimensionless(chain, args, N=N, tip_mass=tip_mass)
 
 
 # -------------------------------------------------------------------------- design
@@ -193,10 +201,12 @@ def _cmd_design(args) -> int:
                         max_acceleration=args.max_acceleration, tip_mass=args.tip_mass)
     if args.plot is not None:
         design.plot_design(res, args.plot, overwrite=args.overwrite)
+    numbers = _numbers_of(chain, args, args.links, args.tip_mass)
     if args.json:
-        print_json({**res.to_dict(), "plot": args.plot})
+        print_json({**res.to_dict(), "plot": args.plot, "dimensionless_numbers": numbers})
     else:
         design.print_design(res)
+        _print_dimensionless(numbers)
         if args.plot is not None:
             print(f"wrote {args.plot}")
     return 0

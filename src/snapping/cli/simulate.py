@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import sys
 
-from ._common import (_add_si_options, _formatter, _nonfinite, _nonfinite_error, _numbers, _print_si, _si_scales,
-                      _with_si, print_json, print_table)
+from ._common import (_add_si_options, _dimensionless, _formatter, _nonfinite, _nonfinite_error, _numbers,
+                      _print_dimensionless, _print_si, _si_scales, _with_si, print_json, print_table)
 
 
 # ------------------------------------------------------------------------ simulate
@@ -60,6 +60,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
             "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
+            "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
@@ -150,10 +151,11 @@ def _cmd_simulate(args) -> int:
 
         taper = None if args.taper is None else _numbers("--taper", args.taper.replace(":", ","), 1, 2)
         supports = None if args.supports is None else _numbers("--supports", args.supports, 2, 2)
+        from ._body import attach_body, body_from_args, line_links
+
         problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
                                tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
-                               pin_motion=args.pin_motion, gravity=args.gravity)
-        from ._body import attach_body, body_from_args
+                               pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
         body = body_from_args(args)
         if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
@@ -200,19 +202,23 @@ def _cmd_simulate(args) -> int:
     body_si = si_summary(body_si_inputs(args)) if args.resume is None else None
     if body_si:
         summary["body_si"] = body_si  # the SI inputs the body's numbers ("body") were made from
+    if getattr(args, "line_obj", None) is not None and args.resume is None:
+        summary["line"] = args.line_obj.name  # (snapping.lines: the catalogue's line, as overridden)
     bad = _nonfinite(summary)
     if bad and failed is None:  # a completed run whose results are not numbers: not a result
         where = f" (the run file is {args.output})" if args.output else ""
         return _nonfinite_error("simulate", bad, where)
     reached = summary.get("snap_reached", True)
+    numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass) if args.resume is None else None
     if args.json:
-        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales)}))
+        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales),
+                                                      **({"dimensionless_numbers": numbers} if numbers else {})}))
     else:
         note_units = {"wall_time": "s"}
         precise = ("t_snap_v", "t_snap_a", "t_snap_sigma", "v_peak", "a_peak", "sigma_peak", "kappa_peak")
         rows = []
         for k, v in summary.items():
-            if k in ("snap_note", "peaks", "body", "body_si"):
+            if k in ("snap_note", "peaks", "body", "body_si", "compression_note"):
                 continue
             note = note_units.get(k)
             if v is None and k in precise:
@@ -227,8 +233,11 @@ def _cmd_simulate(args) -> int:
         )
         if not reached and summary.get("snap_note"):
             print(f"  note: {summary['snap_note']}")
+        if summary.get("compression_note"):
+            print(f"  note: {summary['compression_note']}")
         _print_body(summary)
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
+        _print_dimensionless(numbers)
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
@@ -257,7 +266,7 @@ _RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "s
 #: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
 _PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity", "bending", "damping",
                     "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp", "ei", "diameter",
-                    "air_density", "cd_normal", "cd_tangential", "tip_drag_area", "wind_si")
+                    "air_density", "cd_normal", "cd_tangential", "tip_drag_area", "wind_si", "line")
 
 
 def _given_text(args, key: str) -> str:

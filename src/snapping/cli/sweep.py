@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 import sys
 
-from ._common import (PLOT_BYTES, _add_si_options, _floats, _formatter, _ints, _nonfinite, _nonfinite_error,
-                      _print_si, _si_scales, _with_si, print_json)
+from ._common import (PLOT_BYTES, _add_si_options, _dimensionless, _floats, _formatter, _ints, _nonfinite,
+                      _nonfinite_error, _print_dimensionless, _print_si, _si_scales, _with_si, print_json)
 
 
 # --------------------------------------------------------------------------- sweep
@@ -67,8 +67,9 @@ def _cmd_sweep(args) -> int:
     scales = _si_scales(args)
     options = {k: v for k, v in (("tol", args.tol), ("method", args.method), ("chords", args.chords))
                if v is not None}
-    from ._body import body_from_args
+    from ._body import body_from_args, refuse_line_masses
 
+    refuse_line_masses(args, "sweep")
     body = body_from_args(args)
     if body is not None and body.active:
         options["body"] = body
@@ -137,6 +138,7 @@ def _cmd_sweep(args) -> int:
                 print("  no snap: the run ended before the snap (see its snap_note); its peaks are maxima over the run")
             _print_si(scales, [(f"chi={r['chi']:g} N={r['N']} {k}", *rest) for r in rows if scales
                                for k, *rest in units.si_rows(r, scales)])
+            _print_dimensionless(_dimensionless(scales, args, N=[int(n) for n in args.N], tip_mass=0.0))
         else:
             print(f"no run of the sweep completed; nothing combined in {args.output}")
     if failed is not None:
@@ -201,6 +203,15 @@ def _add_converge(sub) -> None:
     p.set_defaults(func=_cmd_converge)
 
 
+def _level_numbers(res, scales, args):
+    """The dimensionless numbers of a convergence study's line; its link scale: each level's
+    smallest link h_min/L (graded chains)."""
+    numbers = _dimensionless(scales, args)
+    if numbers is not None and "h_min" in res.dataset.variables:
+        numbers["link_scale"] = tuple(float(h) for h in res.dataset["h_min"].values)
+    return numbers
+
+
 def _cmd_converge(args) -> int:
     from .. import continuum, units
 
@@ -216,8 +227,9 @@ def _cmd_converge(args) -> int:
             check_writable(args.plot, name="plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
         except SnappingInputError as exc:
             raise SnappingInputError(f"--plot {args.plot!r}: {exc}") from None
-    from ._body import body_from_args
+    from ._body import body_from_args, refuse_line_masses
 
+    refuse_line_masses(args, "converge")
     body = body_from_args(args)
     if "n0" in getattr(args, "_explicit", ()) and body is None:
         raise SnappingInputError(f"--n0 {args.n0} needs a body (--bending, --drag-normal, ...): without one the "
@@ -237,4 +249,5 @@ def _cmd_converge(args) -> int:
     else:
         print(res.table())
         _print_si(scales, units.si_rows(res.summary(), scales) if scales else [])
+        _print_dimensionless(_level_numbers(res, scales, args))
     return 0

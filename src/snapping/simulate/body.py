@@ -217,6 +217,22 @@ class Body:
         return cls(kw.pop("bending"), drag_linear_normal=drag_linear_normal,
                    drag_linear_tangential=drag_linear_tangential, clamp=clamp, **kw)
 
+    @classmethod
+    def from_line(cls, name: str, length=None, g: float = 9.81, **overrides) -> "Body":
+        """The body of ``length`` m (default: the catalogue's typical length) of the real line
+        ``name`` of :mod:`snapping.lines` (``ball-chain``, ``fly-line``, ``bullwhip``, ...):
+        ``snapping.lines.get(name).body(length, g, **overrides)``; any keyword of
+        :meth:`from_si` overrides the catalogue's value. A tapered line's masses are
+        :meth:`snapping.lines.Line.links` (or build the whole problem with
+        :meth:`snapping.lines.Line.problem`).
+
+        >>> round(Body.from_line("nylon-monofilament", 2.0).bending, 9)   # 2 m of 0.30 mm nylon
+        0.000125744
+        """
+        from ..lines import get
+
+        return get(name).body(length, g, **overrides)
+
     def numbers(self, h=None) -> dict:
         """The body's nondimensional numbers, compactly, for a summary: every entry that is
         not zero (a profile that varies: its range ``[min, max]`` over the nodes; a function

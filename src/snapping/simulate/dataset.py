@@ -60,6 +60,7 @@ SUMMARY_KEYS = (
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
     "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
     "method_choice", "n_jacobians", "n_factorizations",  # (schema.METHOD_ATTRS: a body's method)
+    "min_tension", "t_compression",  # (files written before sigma_min existed have none)
 )
 
 
@@ -77,7 +78,8 @@ def summary(ds: xr.Dataset) -> dict:
     is False, the snapping times ``t_snap_*`` are None (absent, not a number) and
     ``snap_note`` says why; the ``*_peak`` values are then the maxima over the run.
     A snapping time whose peak was at the run's last step is None too. Files written
-    before ``snap_reached`` existed have none and are summarised as they are.
+    before ``snap_reached`` existed have none and are summarised as they are. Where the rigid
+    links carried compression, ``t_compression`` and ``compression_note`` say from when.
     """
     V.run_dataset("ds", ds)
     out = {}
@@ -91,6 +93,13 @@ def summary(ds: xr.Dataset) -> dict:
         from .body import summarize
 
         out["body"] = summarize(str(ds.attrs["body"]))
+    for k in ("min_tension", "t_compression"):  # NaN: no compression (or no sigma_min record): nothing to say
+        if isinstance(out.get(k), float) and np.isnan(out[k]):
+            out.pop(k)
+    if "t_compression" in out:
+        from .compression import compression_note
+
+        out["compression_note"] = compression_note(ds.attrs)
     if isinstance(out.get("chi"), float) and np.isnan(out["chi"]):
         out["chi"] = None  # a general problem's start is not a catenary of some chi ('start' says what it is)
     if "snap_reached" in out:
@@ -185,7 +194,7 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
 
     Parameters
     ----------
-    records : ndarray, shape (n_steps, 16)
+    records : ndarray, shape (n_steps, kernels.NREC [+ general, body columns])
         Per-step rows in the column order of ``kernels.RECORD_NAMES``.
     snapshots : list of (t, kind, Z)
         Full states in the (7, N + 1) kernel layout.
@@ -236,6 +245,9 @@ def build_dataset(records: np.ndarray, snapshots: list, N: int, inputs: dict, re
     attrs = {"title": "snapping: falling-chain run (nondimensional: length l, g, rho = 1)",
              "Conventions": "CF-1.8", "units": UNITS}
     results = snap_results(records, inputs, results)
+    from .compression import compression_results
+
+    results.update(compression_results(records, N))
     for k, v in {**inputs, **results}.items():
         attrs[k] = _attr_value(v)
     if problem is not None:

@@ -48,8 +48,9 @@ DEFAULT_CHORDS = "exact"
 #: default wall-clock seconds between checkpoints of a run with an output file
 CHECKPOINT_EVERY = 300.0
 #: layout version of the checkpoint variables (schema.CHECKPOINT_VARS); 2: the control array
-#: has the held end's breakpoints (39 entries) and the file carries its integrity digest
-CHECKPOINT_VERSION = 2
+#: has the held end's breakpoints (39 entries) and the file carries its integrity digest; 3: the
+#: measurements carry the minimum tension and its link (layout.M_SIGMIN, M_SSIGMIN)
+CHECKPOINT_VERSION = 3
 #: test hook: called with the engine after every return of the compiled loop; may
 #: return a signal number to act as if that signal had arrived
 _chunk_hook = None

@@ -409,11 +409,16 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
             amax2 = a2
             ia = i
     smax = -np.inf
+    smin = np.inf
+    jmin = 0
     emax = 0.0
     length = 0.0
     for j in range(N):
         if sig[j] > smax:
             smax = sig[j]
+        if sig[j] < smin:
+            smin = sig[j]
+            jmin = j
         ln = math.sqrt(c[j] * c[j] + s[j] * s[j])
         e = abs(ln - 1.0)
         if e > emax:
@@ -439,6 +444,8 @@ def general_measure(N, t, y, c, s, sig, Z, rinv0, meas, par, h, invm, invh, snod
     meas[K.M_AMAX] = math.sqrt(amax2)
     meas[K.M_SA] = snode[ia]
     meas[K.M_SIGMAX] = smax
+    meas[K.M_SIGMIN] = smin
+    meas[K.M_SSIGMIN] = 0.5 * (snode[jmin] + snode[jmin + 1])  # the midpoint of link jmin
     if ik >= 0:
         meas[K.M_KMAX] = kbest
         meas[K.M_SK] = snode[ik + 1]

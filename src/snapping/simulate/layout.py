@@ -15,16 +15,19 @@ NROWS = 7
 M_VMAX, M_SV, M_AMAX, M_SA, M_SIGMAX, M_KMAX, M_SK = 0, 1, 2, 3, 4, 5, 6
 M_VEND, M_AEND, M_PFX, M_PFY, M_ENERGY, M_LINKERR, M_LINKERR0 = 7, 8, 9, 10, 11, 12, 13
 M_LENGTH, M_FINITE = 14, 15
-NMEAS = 16
+# the minimum link tension over the chain (negative: the rigid links carry compression, where a real
+# line goes slack) and the arclength of its link's midpoint from the held end
+M_SIGMIN, M_SSIGMIN = 16, 17
+NMEAS = 18
 
 # ---------------------------------------------------------------- record rows
 # columns of the per-step record buffer, in the order of schema.STEP_VARS after t
 (R_T, R_DT, R_VMAX, R_AMAX, R_SIGMAX, R_KMAX, R_SK, R_SA, R_SV, R_VEND, R_AEND,
- R_PFX, R_PFY, R_ENERGY, R_LINKERR, R_EPS) = range(16)
-NREC = 16
+ R_PFX, R_PFY, R_ENERGY, R_LINKERR, R_EPS, R_SIGMIN, R_SSIGMIN) = range(18)
+NREC = 18
 RECORD_NAMES = ("t", "dt", "v_max", "a_max", "sigma_max", "kappa_max", "s_kappa_max", "s_a_max",
                 "s_v_max", "v_end", "a_end", "pin_force_x", "pin_force_y", "energy", "link_error",
-                "error_estimate")
+                "error_estimate", "sigma_min", "s_sigma_min")
 
 # ---------------------------------------------------------------- control array
 (C_T, C_DT, C_CUR, C_NSTEPS, C_NREJ, C_NRHS, C_NREC, C_TOL, C_FIXED, C_THIN, C_MAXLINK,

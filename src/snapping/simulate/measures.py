@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from .layout import (M_AEND, M_AMAX, M_ENERGY, M_FINITE, M_KMAX, M_LENGTH, M_LINKERR, M_LINKERR0, M_PFX, M_PFY, M_SA,
-                     M_SIGMAX, M_SK, M_SV, M_VEND, M_VMAX, RAX, RAY, RSIG, RVX, RVY, RX, RY)
+                     M_SIGMAX, M_SIGMIN, M_SK, M_SSIGMIN, M_SV, M_VEND, M_VMAX, RAX, RAY, RSIG, RVX, RVY, RX, RY)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False)
@@ -19,7 +19,8 @@ def measure(N, Z, rinv0, meas):
     """Per-step diagnostics of state ``Z`` into ``meas`` (see the ``M_*`` indices).
 
     Maxima over the chain of speed, acceleration, tension and |curvature| with
-    the arclength s = (N - i)/N of the node where they occur, free-end speed and
+    the arclength s = (N - i)/N of the node where they occur, the minimum tension
+    with the arclength of its link's midpoint, free-end speed and
     acceleration, the force of the chain on the pin (-sigma_N N d_N), the total
     energy (zero for the chain hanging at rest), the largest link-length error
     against 1/N and against the initial chords (``rinv0[j] = 1/|d_j(0)|^2``),
@@ -60,6 +61,8 @@ def measure(N, Z, rinv0, meas):
             ia = i
     # links and joints
     smax = -np.inf
+    smin = np.inf
+    jmin = 0
     emax = -np.inf
     emin = np.inf
     rmax = -np.inf
@@ -89,6 +92,9 @@ def measure(N, Z, rinv0, meas):
         length += math.sqrt(lp)
         if sig[j] > smax:
             smax = sig[j]
+        if sig[j] < smin:
+            smin = sig[j]
+            jmin = j
         dot = dxp * dxn + dyp * dyn
         cr = dxp * dyn - dyp * dxn
         q = cr * cr / (lp * ln)
@@ -111,11 +117,16 @@ def measure(N, Z, rinv0, meas):
     length += math.sqrt(lp)
     if sig[j] > smax:
         smax = sig[j]
+    if sig[j] < smin:
+        smin = sig[j]
+        jmin = j
     meas[M_VMAX] = math.sqrt(vmax2)
     meas[M_SV] = (fN - iv) / fN
     meas[M_AMAX] = math.sqrt(amax2)
     meas[M_SA] = (fN - ia) / fN
     meas[M_SIGMAX] = smax
+    meas[M_SIGMIN] = smin
+    meas[M_SSIGMIN] = (fN - jmin - 0.5) / fN  # the midpoint of link jmin (s_link)
     if ik >= 0:
         meas[M_KMAX] = fN * math.atan2(abs(kcr), kdot)
         meas[M_SK] = (fN - (ik + 1)) / fN

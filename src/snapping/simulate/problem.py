@@ -349,12 +349,15 @@ class Problem:
 
 # ---------------------------------------------------------------------------------- from options
 def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shape=None, tip_mass: float = 0.0,
-                 taper=None, lumping: str | None = None, pin_motion=None, gravity: float = 1.0) -> Problem | None:
+                 taper=None, lumping: str | None = None, pin_motion=None, gravity: float = 1.0,
+                 links: Links | None = None) -> Problem | None:
     """The problem the command-line options describe (``snapping simulate``), or None when
     they describe the paper's problem (then ``run(chi, N)``).
 
     ``supports``: ``(dx, dy)``; ``shape``: a file for :func:`read_shape`; ``taper``:
-    ``ratio`` or ``(ratio, power)``; ``pin_motion``: a spec for :func:`parse_pin_motion`.
+    ``ratio`` or ``(ratio, power)``; ``pin_motion``: a spec for :func:`parse_pin_motion`;
+    ``links``: the chain as built elsewhere (a real line's, :meth:`snapping.lines.Line.links`),
+    in place of ``N``, ``tip_mass``, ``taper`` and ``lumping``.
 
     >>> from_options(chi=0.3, N=10) is None
     True
@@ -362,7 +365,8 @@ def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shap
     0.5
     """
     starts = [k for k, v in (("chi", chi), ("supports", supports), ("shape", shape)) if v is not None]
-    if (starts == ["chi"] and taper is None and lumping in (None, "paper") and pin_motion in (None, "", "fixed")
+    if (starts == ["chi"] and links is None and taper is None and lumping in (None, "paper")
+            and pin_motion in (None, "", "fixed")
             and V.real("tip_mass", tip_mass) == 0.0 and V.real("gravity", gravity) == 1.0):
         return None  # the paper's problem: run(chi, N) (checks chi and N itself)
     if len(starts) != 1:
@@ -372,7 +376,9 @@ def from_options(*, chi=None, N=None, chords: str = "exact", supports=None, shap
         raise V.SnappingInputError(f"chords={chords!r} applies to the catenary start of chi only: the {starts[0]} "
                                    f"start places its nodes at exact chords")
     N = _links_count("N", N)
-    if taper is not None:
+    if links is not None:
+        _check_links(links)
+    elif taper is not None:
         tv = [taper] if np.ndim(taper) == 0 else list(taper)
         if not 1 <= len(tv) <= 2:
             raise V.SnappingInputError(f"taper={taper!r} must be a ratio or (ratio, power)")

@@ -1,0 +1,349 @@
+"""The extensible line: lumped masses joined by tension-only springs (what it is made of).
+
+A :class:`Problem` gives the geometry (link rest lengths ``h_j``, node masses ``m_j`` with the
+tip mass, the start, the held end's motion, gravity); an :class:`Elastic` gives what the links
+are made of: axial stiffness ``EA_j`` (a number or one per link) or a tension-strain table,
+and Kelvin-Voigt damping ``c_j``. Together they make an :class:`ElasticLine`: planar node
+positions with no constraint, link j carrying
+
+    T_j = max(0, f_j(e_j) + c_j de_j/dt)  while e_j = l_j/h_j - 1 > 0,   T_j = 0 otherwise,
+
+so a link shorter than its rest length carries nothing (slack) and a link never pushes. The
+node masses are the problem's (:class:`Links`: for ``lumping="shared"`` the consistent lumped
+masses), node 0 the free end, node N the held end, as everywhere in :mod:`snapping.simulate`.
+
+Units are the project's: the chain's length L, mass M and g are 1, forces in M g; for a line
+of mass per length lambda (= 1 for the uniform unit chain) ``EA`` in units of M g gives the
+longitudinal wave speed ``c = sqrt(EA/lambda)`` in units of sqrt(g L)
+(:meth:`Elastic.from_wave_speed`). Damping ``c_j`` is in M g sqrt(L/g) (a force per unit
+strain rate).
+
+Starts: ``"stretched"`` (default), the static equilibrium of the line hanging between the
+start's two end nodes (both held), found by minimising its potential energy (convex for
+tension-only links) with a damped Newton iteration on the banded stiffness; or
+``"unstretched"``, the nodes exactly at the problem's start (every link at its rest length:
+no tension at t = 0, so the whole line first falls freely).
+
+Example
+-------
+>>> from snapping.simulate.problem import Links, Problem
+>>> from snapping.simulate.elastic_model import Elastic, ElasticLine
+>>> line = ElasticLine(Problem.catenary(0.25, links=Links.uniform(20, lumping="shared")), Elastic.from_wave_speed(30.0))
+>>> round(float(line.ea[0]), 6), round(line.wave_speed, 6)
+(900.0, 30.0)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .. import _validate as V
+from . import elastic_kernels as EK
+
+__all__ = ["Elastic", "ElasticLine", "STARTS"]
+
+STARTS = ("stretched", "unstretched")
+#: largest axial stiffness accepted (units of M g): c = 1e8 sqrt(g L) and more is beyond the doubles' use
+EA_MAX = 1e16
+
+
+@dataclass(frozen=True, eq=False)
+class Elastic:
+    """What the links are made of: ``ea`` (axial stiffness EA, units of M g: a number or one
+    per link, index 0 at the free end), or ``table = (strain, tension)``, a tension-strain
+    curve for every link (strains increasing from 0, tensions non-decreasing from 0,
+    interpolated linearly, extended with the last slope; a first point other than (0, 0) is
+    joined to (0, 0)); ``damping``: Kelvin-Voigt c (a number or one per link, >= 0), the
+    tension ``+ c de/dt`` while taut (the total never below 0).
+
+    >>> Elastic(ea=100.0).describe()
+    {'ea': 100.0, 'damping': 0.0, 'table': None}
+    >>> Elastic(ea=-1.0)
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: ea=-1.0 is out of range: EA must be finite and in (0, 1e+16] (units of M g)
+    """
+
+    ea: object = None
+    damping: object = 0.0
+    table: tuple | None = None
+
+    def __post_init__(self):
+        if (self.ea is None) == (self.table is None):
+            raise V.SnappingInputError(f"give exactly one of ea (axial stiffness) and table (tension-strain curve); "
+                                       f"got ea={V._short(self.ea)}, table={V._short(self.table)}")
+        if self.ea is not None:
+            a = np.asarray(V.float_array("ea", self.ea), dtype=float)
+            if a.ndim > 1 or a.size == 0:
+                raise V.SnappingInputError(f"ea={V._short(self.ea)} must be a number or one number per link")
+            bad = np.flatnonzero(~(np.isfinite(a.ravel()) & (a.ravel() > 0.0) & (a.ravel() <= EA_MAX)))
+            if bad.size:
+                v = float(a.ravel()[bad[0]])
+                nm = "ea" if a.ndim == 0 else f"ea[{bad[0]}]"
+                raise V.SnappingInputError(f"{nm}={v!r} is out of range: EA must be finite and in (0, {EA_MAX:g}] "
+                                           f"(units of M g)")
+            object.__setattr__(self, "ea", float(a) if a.ndim == 0 else a.copy())
+        d = np.asarray(V.float_array("damping", self.damping), dtype=float)
+        if d.ndim > 1 or d.size == 0:
+            raise V.SnappingInputError(f"damping={V._short(self.damping)} must be a number or one number per link")
+        bad = np.flatnonzero(~(np.isfinite(d.ravel()) & (d.ravel() >= 0.0)))
+        if bad.size:
+            nm = "damping" if d.ndim == 0 else f"damping[{bad[0]}]"
+            raise V.SnappingInputError(f"{nm}={float(d.ravel()[bad[0]])!r} is out of range: Kelvin-Voigt damping "
+                                       f"must be finite and >= 0")
+        object.__setattr__(self, "damping", abs(float(d)) if d.ndim == 0 else d.copy())
+        if self.table is not None:
+            object.__setattr__(self, "table", _check_table(self.table))
+
+    @classmethod
+    def from_wave_speed(cls, c: float, *, lam: float = 1.0, damping=0.0) -> "Elastic":
+        """EA = lambda c^2 for the wave speed ``c`` (units of sqrt(g L)) on a line of mass per
+        length ``lam`` (units of M/L; 1 for the uniform unit chain).
+
+        >>> Elastic.from_wave_speed(300.0).ea
+        90000.0
+        """
+        c = V.positive("c", c)
+        lam = V.positive("lam", lam)
+        return cls(ea=lam * c * c, damping=damping)
+
+    def describe(self) -> dict:
+        def j(v):
+            return v if np.ndim(v) == 0 else np.asarray(v).tolist()
+
+        tab = None if self.table is None else [self.table[0].tolist(), self.table[1].tolist()]
+        return {"ea": None if self.ea is None else j(self.ea), "damping": j(self.damping), "table": tab}
+
+
+def _check_table(table) -> tuple:
+    try:
+        e, t = (np.asarray(V.float_array(f"table[{k}]", v), dtype=float).ravel() for k, v in
+                zip((0, 1), table))
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise
+        raise V.SnappingInputError(f"table={V._short(table)} must be (strain, tension): two arrays") from None
+    if e.size != t.size or e.size < 1:
+        raise V.SnappingInputError(f"table: strain and tension must have the same length >= 1; got {e.size}, "
+                                   f"{t.size}")
+    if not (np.all(np.isfinite(e)) and np.all(np.isfinite(t))):
+        raise V.SnappingInputError("table: strains and tensions must be finite")
+    if e[0] < 0.0 or t[0] < 0.0:
+        raise V.SnappingInputError(f"table: the first point ({e[0]!r}, {t[0]!r}) must have strain >= 0 and "
+                                   f"tension >= 0")
+    if e[0] == 0.0 and t[0] != 0.0:
+        raise V.SnappingInputError(f"table: at strain 0 the tension must be 0; got {t[0]!r}")
+    if e[0] > 0.0:
+        e, t = np.concatenate([[0.0], e]), np.concatenate([[0.0], t])
+    de, dt = np.diff(e), np.diff(t)
+    if np.any(de <= 0.0):
+        k = int(np.flatnonzero(de <= 0.0)[0])
+        raise V.SnappingInputError(f"table: strains must increase; strain[{k + 1}]={e[k + 1]!r} <= {e[k]!r}")
+    if np.any(dt < 0.0):
+        k = int(np.flatnonzero(dt < 0.0)[0])
+        raise V.SnappingInputError(f"table: tensions must not decrease (monotone); tension[{k + 1}]={t[k + 1]!r} "
+                                   f"< {t[k]!r}")
+    if dt[-1] <= 0.0:
+        raise V.SnappingInputError("table: the last segment must rise (it is extended with its slope)")
+    return e, t
+
+
+class ElasticLine:
+    """A :class:`Problem` made of :class:`Elastic` links: the compiled model's arrays.
+
+    Attributes: ``N``, ``h``, ``m`` (node masses, tip mass included), ``ea``, ``damp`` (per
+    link), ``tabe``, ``tabt``, ``tabw`` (the table, its energy; empty for a linear law),
+    ``snode`` (rest arclength of each node from the held end), ``lam`` (mass per length of each
+    link), ``g``, ``pin`` (the problem's :class:`PinMotion`).
+    """
+
+    def __init__(self, problem, elastic: Elastic):
+        from .problem import Problem
+
+        if not isinstance(problem, Problem):
+            raise V.SnappingInputError(f"problem={type(problem).__name__} is not a snapping.simulate.Problem")
+        if not isinstance(elastic, Elastic):
+            raise V.SnappingInputError(f"elastic={type(elastic).__name__} is not a snapping.simulate.elastic.Elastic")
+        if problem.body is not None:
+            raise V.SnappingInputError("problem.body: bending and drag are not built for the elastic line yet; "
+                                       "give a problem without a body")
+        self.problem, self.elastic = problem, elastic
+        links = problem.links
+        N = self.N = links.N
+        self.h = links.h.astype(float)
+        self.m = links.m.astype(float)
+        self.g = float(problem.gravity)
+        self.pin = problem.pin
+        self.lam = (links.link_mass if links.link_mass is not None else links.m) / self.h
+        self.snode = np.concatenate([np.cumsum(self.h[::-1])[::-1], [0.0]])[:N]
+
+        def per_link(name, v):
+            a = np.asarray(v, dtype=float)
+            if a.ndim == 0:
+                return np.full(N, float(a))
+            if a.size != N:
+                raise V.SnappingInputError(f"{name} has {a.size} entries; the line has {N} links")
+            return a.astype(float).copy()
+
+        self.damp = per_link("damping", elastic.damping)
+        if elastic.table is not None:
+            self.tabe, self.tabt = (np.ascontiguousarray(a) for a in elastic.table)
+            seg = np.diff(self.tabe) * 0.5 * (self.tabt[1:] + self.tabt[:-1])
+            self.tabw = np.concatenate([[0.0], np.cumsum(seg)])
+            self.ea = np.full(N, (self.tabt[1] - self.tabt[0]) / (self.tabe[1] - self.tabe[0]))
+        else:
+            self.tabe = self.tabt = self.tabw = np.zeros(0)
+            self.ea = per_link("ea", elastic.ea)
+        self._work = tuple(np.zeros(N) for _ in range(4))
+
+    @property
+    def wave_speed(self) -> float:
+        """The smallest longitudinal wave speed sqrt(EA_j/lambda_j) (initial slope for a table)."""
+        return float(np.sqrt(self.ea / self.lam).min())
+
+    # -- the state
+    def pin_state(self, t: float) -> np.ndarray:
+        x, y, vx, vy, _, _ = self.pin.kinematics(float(t))
+        return np.array([x, y, vx, vy])
+
+    def pack(self, x, y, vx, vy) -> np.ndarray:
+        """The state vector (:mod:`elastic_kernels`) of N + 1 node values (the last the held end's), W = D = 0."""
+        N = self.N
+        z = np.zeros(4 * N + 2)
+        z[0:4 * N:4], z[1:4 * N:4], z[2:4 * N:4], z[3:4 * N:4] = x[:N], y[:N], vx[:N], vy[:N]
+        return z
+
+    def unpack(self, z, t: float):
+        """(x, y, vx, vy) of the N + 1 nodes (the held end's from the pin motion)."""
+        p = self.pin_state(t)
+        N = self.N
+        return tuple(np.concatenate([z[k:4 * N:4], [p[k]]]) for k in range(4))
+
+    def start(self, kind: str = "stretched") -> np.ndarray:
+        """The state at t = 0: ``"unstretched"`` (the problem's nodes and velocities) or
+        ``"stretched"`` (the static equilibrium between the start's end nodes, at rest; only
+        for a start at rest)."""
+        if kind not in STARTS:
+            raise V.SnappingInputError(f"start={kind!r} is not one of {STARTS}")
+        p = self.problem
+        z = self.pack(p.x, p.y, p.vx, p.vy)
+        if kind == "stretched":
+            if np.any(p.vx != p.vx[-1]) or np.any(p.vy != p.vy[-1]) or p.vx[-1] != 0.0 or p.vy[-1] != 0.0:
+                raise V.SnappingInputError("start='stretched' needs a start at rest (use start='unstretched')")
+            z = self.statics(z, hold_free_end=True)
+        return z
+
+    # -- the compiled model
+    def rhs(self, t: float, z: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        dz = np.empty_like(z) if out is None else out
+        EK.rhs(self.N, z, self.pin_state(t), self.h, 1.0 / self.m, self.ea, self.damp, self.tabe, self.tabt, self.g,
+               dz, *self._work)
+        return dz
+
+    def _pattern(self):
+        """CSC structure of the block-tridiagonal Jacobian: (indices, indptr, order) so that
+        ``csc_matrix((blocks.ravel()[order], indices, indptr))`` is the Jacobian."""
+        if getattr(self, "_pat", None) is None:
+            N = self.N
+            i, k, r, c = np.meshgrid(np.arange(N), np.arange(3), np.arange(4), np.arange(4), indexing="ij")
+            col_node = i - 1 + k
+            rows = (4 * i + r).ravel()
+            cols = (4 * col_node + c).ravel()
+            keep = np.flatnonzero(((col_node >= 0) & (col_node < N)).ravel())
+            n = 4 * N + 2
+            M = sp.coo_matrix((keep + 1.0, (rows[keep], cols[keep])), shape=(n, n)).tocsc()
+            M.sort_indices()
+            self._pat = (M.indices.copy(), M.indptr.copy(), M.data.astype(np.int64) - 1)
+            self._blocks = np.zeros((N, 3, 4, 4))
+        return self._pat
+
+    def jac(self, t: float, z: np.ndarray) -> sp.csc_matrix:
+        """The Jacobian of :meth:`rhs` (analytic, banded: 7 sub- and super-diagonals), sparse."""
+        indices, indptr, order = self._pattern()
+        B = self._blocks
+        EK.jac_blocks(self.N, z, self.pin_state(t), self.h, 1.0 / self.m, self.ea, self.damp, self.tabe, self.tabt,
+                      B, *self._work)
+        n = 4 * self.N + 2
+        return sp.csc_matrix((B.ravel()[order], indices, indptr), shape=(n, n))
+
+    def measure(self, t: float, z: np.ndarray) -> np.ndarray:
+        out = np.zeros(EK.NMEAS)
+        EK.measure(self.N, z, self.pin_state(t), self.h, self.m, self.ea, self.damp, self.tabe, self.tabt,
+                   self.tabw, self.g, self.snode, np.empty_like(z), *self._work, out)
+        return out
+
+    def link_state(self, t: float, z: np.ndarray):
+        """(tension, strain, strain rate) of every link."""
+        T, E, ED, FV = (np.zeros(self.N) for _ in range(4))
+        EK.tensions(self.N, z, self.pin_state(t), self.h, self.ea, self.damp, self.tabe, self.tabt, T, E, ED, FV)
+        return T, E, ED
+
+    def energy(self, t: float, z: np.ndarray) -> float:
+        """Kinetic + gravity + elastic energy (zero hanging unstretched at rest from the origin)."""
+        mm = self.measure(t, z)
+        return float(mm[12] + mm[13] + mm[14])
+
+    # -- statics
+    def statics(self, z0: np.ndarray, *, hold_free_end: bool = False, tol: float = 1e-12,
+                max_iter: int = 200) -> np.ndarray:
+        """The static equilibrium nearest ``z0`` (velocities zero; the held end at its t = 0
+        position; with ``hold_free_end`` node 0 held too): the minimum of the potential energy
+        (elastic + gravity), convex for tension-only links, by Newton steps on the banded
+        stiffness, Levenberg-damped where the line has no stiffness yet (slack or at rest length)."""
+        N = self.N
+        z = z0.copy()
+        z[2:4 * N:4] = z[3:4 * N:4] = 0.0
+        z[4 * N:] = 0.0
+        free = np.ones(N, bool)
+        if hold_free_end:
+            free[0] = False
+        idx = np.sort(np.concatenate([4 * np.flatnonzero(free), 4 * np.flatnonzero(free) + 1]))
+        mrow = np.repeat(self.m[free], 2)
+
+        def potential(zz):
+            mm = self.measure(0.0, zz)
+            return float(mm[13] + mm[14])
+
+        def grad_hess(zz):
+            dz = self.rhs(0.0, zz)
+            J = self.jac(0.0, zz)
+            # forces (mass x acceleration) and the stiffness -dF/dr, on the free position unknowns
+            f = (dz[idx + 2] * mrow)
+            K = -(sp.diags(np.concatenate([np.repeat(self.m, 4), [1.0, 1.0]])) @ J).tocsr()[idx + 2][:, idx].tocsc()
+            return f, K
+
+        scale = float(self.m.sum()) * max(self.g, 1e-300)
+        # the force's round-off: a position's last bit times the stiffest link's EA/h
+        floor = 16.0 * np.finfo(float).eps * float((self.ea / self.h).max()) * max(1.0, float(np.abs(z).max()))
+        mu = 1e-3 * float(self.ea.max() / self.h.min())
+        P = potential(z)
+        for _ in range(max_iter):
+            f, K = grad_hess(z)
+            if np.abs(f).max() <= tol * scale + floor:
+                for _ in range(3):  # polish: plain Newton steps while the force still falls
+                    zt = z.copy()
+                    zt[idx] += sp.linalg.spsolve(K, f)
+                    ft, Kt = grad_hess(zt)
+                    if not np.abs(ft).max() < np.abs(f).max():
+                        break
+                    z, f, K = zt, ft, Kt
+                return z
+            A = (K + sp.diags(mu * mrow / self.m.mean())).tocsc()
+            step = sp.linalg.spsolve(A, f)
+            zt = z.copy()
+            zt[idx] += step
+            Pt = potential(zt)
+            # (near the minimum the potential's change drowns in round-off: the force decides)
+            if Pt < P - 1e-12 * (abs(P) + scale) or np.abs(grad_hess(zt)[0]).max() < np.abs(f).max():
+                z, P = zt, Pt
+                mu *= 0.1
+            else:
+                mu = max(mu * 10.0, 1e-12)
+        from .errors import SimulationError
+
+        raise SimulationError(f"statics: no equilibrium within {max_iter} Newton steps (largest force "
+                              f"{np.abs(grad_hess(z)[0]).max():.3g})")
+

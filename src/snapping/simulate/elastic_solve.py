@@ -1,0 +1,307 @@
+"""Stepping the extensible line (:mod:`snapping.simulate.elastic_model`): error-controlled, with
+steps that its stiffness does not dictate, recorded into a run Dataset.
+
+The default method is scipy's ``Radau`` (implicit Runge-Kutta, order 5, L-stable) with the
+analytic block-tridiagonal Jacobian as a sparse matrix: its LU factors are banded, O(N) per
+factorisation, so a stiff line (a large wave speed c) costs steps set by the accuracy of the
+motion, not by c. ``"DOP853"`` (scipy's explicit 8th-order method, the same compiled
+right-hand side) is there to compare: its steps are bounded by stability, dt ~ h/c.
+
+Slack-taut transitions make the force continuous with a jump in its derivative; the error
+control of the method meets them (steps shrink there); no events are used. The energy
+``kinetic + gravity + elastic - W + D`` (W the held end's work, D the damping's dissipation,
+both integrated with the state) is conserved to the method's accuracy, also through them;
+``energy_drift`` reports its largest change.
+
+Example
+-------
+>>> from snapping.simulate.problem import Links, Problem
+>>> from snapping.simulate.elastic import Elastic, solve
+>>> r = solve(Problem.catenary(0.25, links=Links.uniform(12, lumping="shared")), Elastic.from_wave_speed(20.0),
+...           t_end=0.3, tol=1e-6)
+>>> r.dataset.attrs["status"], bool(r.dataset.attrs["energy_drift"] < 1e-5)
+('completed', True)
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+import numpy as np
+import xarray as xr
+from scipy.integrate import DOP853, Radau
+
+from .. import _validate as V
+from .. import schema
+from .elastic_model import STARTS, Elastic, ElasticLine
+
+__all__ = ["solve", "ElasticRun", "METHODS"]
+
+METHODS = {"radau": Radau, "dop853": DOP853}
+#: points per step at which the dense output is sampled around each peak
+PEAK_SAMPLES = 24
+#: the per-step record's columns (the Dataset's step variables, in this order)
+STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
+              "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
+              "strain_max", "n_slack")
+
+
+class ElasticRun:
+    """Result of :func:`solve`: ``dataset`` (xarray), ``peaks`` (dict), ``state`` (the last
+    state vector), ``line`` (the :class:`ElasticLine`)."""
+
+    def __init__(self, dataset, peaks, state, line):
+        self.dataset, self.peaks, self.state, self.line = dataset, peaks, state, line
+
+    def summary(self) -> dict:
+        """Inputs and results as plain Python values."""
+        out = {}
+        for k, v in self.dataset.attrs.items():
+            out[k] = v.item() if isinstance(v, np.generic) else v
+        return out
+
+
+def _record(line, t, z, dt, mm):
+    """One row of STEP_NAMES from the measures ``mm`` of the state ``z`` at ``t``."""
+    s_node = np.concatenate([line.snode, [0.0]])
+    s_link = line.snode - 0.5 * line.h
+    W, D = z[4 * line.N], z[4 * line.N + 1]
+    return [dt, mm[0], mm[2], mm[4], s_node[int(mm[1])], s_node[int(mm[3])], s_link[int(mm[5])], mm[6], mm[8], mm[9],
+            mm[10], mm[11], mm[12] + mm[13] + mm[14], mm[14], W, D, mm[15], mm[16]]
+
+
+class _Peaks:
+    """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the dense
+    output of the steps on either side of each, to refine them afterwards."""
+
+    COLS = {"v": 0, "a": 2, "sigma": 4}
+
+    def __init__(self):
+        self.best = {k: (-np.inf, 0.0) for k in self.COLS}
+        self.keep = {k: [] for k in self.COLS}
+        self.after = dict.fromkeys(self.COLS, False)
+        self.prev = None
+
+    def update(self, t, mm, dense):
+        for k, c in self.COLS.items():
+            if self.after[k] and dense is not None:
+                self.keep[k].append(dense)
+                self.after[k] = False
+            if mm[c] > self.best[k][0]:
+                self.best[k] = (float(mm[c]), float(t))
+                self.keep[k] = [d for d in (self.prev, dense) if d is not None]
+                self.after[k] = True
+        self.prev = dense
+
+    def refine(self, line):
+        out = {}
+        for k, c in self.COLS.items():
+            val, tp = self.best[k]
+            for d in self.keep[k]:
+                for tt in np.linspace(d.t_old, d.t, PEAK_SAMPLES + 1)[1:-1]:
+                    mm = line.measure(tt, d(tt))
+                    if mm[c] > val:
+                        val, tp = float(mm[c]), float(tt)
+            out[k] = (val, tp)
+        return out
+
+
+def _initial(line, start, initial):
+    if initial is None:
+        return line.start(start)
+    try:
+        x, y, vx, vy = (np.asarray(V.float_array(n, a), dtype=float).ravel() for n, a in
+                        zip(("x", "y", "vx", "vy"), initial))
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise
+        raise V.SnappingInputError("initial must be (x, y, vx, vy), N + 1 node values each") from None
+    N = line.N
+    p = line.pin_state(0.0)
+    for name, a, pv in zip(("x", "y", "vx", "vy"), (x, y, vx, vy), p):
+        if a.size != N + 1 or not np.all(np.isfinite(a)):
+            raise V.SnappingInputError(f"initial {name}: expected {N + 1} finite node values; got {a.size}")
+        if a[-1] != pv:
+            raise V.SnappingInputError(f"initial {name}[N]={a[-1]!r} must be the held end's, {pv!r}, at t = 0")
+    return line.pack(x, y, vx, vy)
+
+
+def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float = 1e-8, method: str = "radau",
+          start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
+          snapshot_times=(), max_rhs: int = 50_000_000) -> ElasticRun:
+    """Integrate the elastic line of ``problem`` made of ``elastic`` links.
+
+    Parameters
+    ----------
+    problem : Problem
+        Links (rest lengths, masses, tip mass), start, held end's motion, gravity.
+    elastic : Elastic
+        Axial stiffness or table, Kelvin-Voigt damping.
+    t_end : float, optional
+        End time; by default the run stops at the snap, once v_max has fallen below
+        ``stop_fraction`` of its running peak (or at ``t_end_max``).
+    tol : float
+        Relative and absolute tolerance of the error control (rtol = atol).
+    method : {"radau", "dop853"}
+        scipy's Radau IIA (with the analytic banded Jacobian) or explicit DOP853.
+    start : {"stretched", "unstretched"}
+        See :mod:`snapping.simulate.elastic`; ignored when ``initial`` is given.
+    initial : (x, y, vx, vy), optional
+        Node values at t = 0 (N + 1 each, the last the held end's), any strains.
+    snapshot_times : sequence of float
+        Times of full profiles (besides t = 0, the peak of v_max and the end).
+    max_rhs : int
+        Right-hand-side evaluations after which the run stops (status 'failed').
+
+    Returns
+    -------
+    ElasticRun
+    """
+    line = ElasticLine(problem, elastic)
+    tol = V.positive("tol", tol)
+    if not 1e-13 <= tol <= 1e-2:
+        raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in [1e-13, 1e-2]")
+    if not isinstance(method, str) or method.lower() not in METHODS:
+        raise V.SnappingInputError(f"method={method!r} is not one of {tuple(METHODS)} (the elastic line's methods)")
+    method = method.lower()
+    if t_end is not None:
+        t_end = V.positive("t_end", t_end)
+    t_end_max = V.positive("t_end_max", t_end_max)
+    stop_fraction = V.real("stop_fraction", stop_fraction)
+    if not 0.0 < stop_fraction < 1.0:
+        raise V.SnappingInputError(f"stop_fraction={stop_fraction!r} is out of range: must lie in (0, 1)")
+    if start not in STARTS:
+        raise V.SnappingInputError(f"start={start!r} is not one of {STARTS}")
+    snaps = sorted(float(V.real("snapshot_times", s)) for s in np.atleast_1d(np.asarray(snapshot_times, float)))
+    max_rhs = V.integer("max_rhs", max_rhs, 1)
+
+    wall0 = time.perf_counter()
+    z0 = _initial(line, start, initial)
+    t_bound = t_end if t_end is not None else t_end_max
+    count = [0]
+
+    def fun(t, z):
+        count[0] += 1
+        return line.rhs(t, z)
+
+    kw = {"jac": line.jac} if method == "radau" else {}
+    solver = METHODS[method](fun, 0.0, z0, t_bound, rtol=tol, atol=tol, **kw)
+
+    mm0 = line.measure(0.0, z0)
+    rows = [_record(line, 0.0, z0, 0.0, mm0)]
+    times = [0.0]
+    E0 = rows[0][STEP_NAMES.index("energy")]
+    snap_t, snap_z, snap_kind = [0.0], [z0.copy()], ["initial"]
+    peaks = _Peaks()
+    peaks.update(0.0, mm0, None)
+    running, stop_reason, status = 0.0, "t_end" if t_end is not None else "t_end_max", "completed"
+    first_slack = np.nan
+    peak_state = (0.0, z0.copy())
+    while solver.status == "running":
+        msg = solver.step()
+        if solver.status == "failed":
+            status, stop_reason = "failed", f"step failed: {msg}"
+            break
+        t, z = float(solver.t), solver.y
+        dense = solver.dense_output()
+        while snaps and snaps[0] <= t:
+            ts = snaps.pop(0)
+            if ts >= 0.0:
+                snap_t.append(ts)
+                snap_z.append(dense(ts) if ts < t else z.copy())
+                snap_kind.append("requested")
+        mm = line.measure(t, z)
+        rows.append(_record(line, t, z, t - solver.t_old, mm))
+        times.append(t)
+        peaks.update(t, mm, dense)
+        if mm[16] > 0 and np.isnan(first_slack):
+            first_slack = t
+        if mm[0] > running:
+            running, peak_state = mm[0], (t, z.copy())
+        if not np.all(np.isfinite(z)):
+            status, stop_reason = "failed", "non-finite state"
+            break
+        if count[0] > max_rhs:
+            status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
+            break
+        if t_end is None and mm[0] < stop_fraction * running:
+            stop_reason = "snap"
+            break
+    t_final = times[-1]
+    zf = solver.y.copy()
+    snap_t += [peak_state[0], t_final]
+    snap_z += [peak_state[1], zf]
+    snap_kind += ["peak", "final"]
+    rec = np.asarray(rows, dtype=float)
+    ref = peaks.refine(line)
+    wall = time.perf_counter() - wall0
+
+    en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
+        rec[:, STEP_NAMES.index("dissipated")]
+    isig = int(np.argmax(rec[:, 3]))
+    slack_rows = np.flatnonzero(rec[:, STEP_NAMES.index("n_slack")] > 0)
+    results = {
+        "status": status, "stop_reason": stop_reason, "snap_reached": int(stop_reason == "snap"),
+        "v_peak": ref["v"][0], "t_snap_v": ref["v"][1], "a_peak": ref["a"][0], "t_snap_a": ref["a"][1],
+        "sigma_peak": ref["sigma"][0], "t_snap_sigma": ref["sigma"][1],
+        "s_sigma_peak": float(rec[isig, STEP_NAMES.index("s_sigma_max")]),
+        "strain_peak": float(rec[:, STEP_NAMES.index("strain_max")].max()),
+        "t_first_slack": float(first_slack), "n_slack_steps": int(slack_rows.size),
+        "energy_initial": float(E0), "energy_drift": float(np.abs(en - en[0]).max()),
+        "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
+        "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
+        "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
+        "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
+        "wall_time": wall, "wave_speed": line.wave_speed,
+    }
+    inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
+              "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
+              "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
+              "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
+              "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
+    ds = _dataset(line, np.asarray(times), rec, snap_t, snap_z, snap_kind, {**inputs, **results})
+    return ElasticRun(ds, {k: {"value": v[0], "t": v[1]} for k, v in ref.items()}, zf, line)
+
+
+def _attrs(name: str) -> dict:
+    for table in (schema.STEP_VARS, schema.PIN_STEP_VARS, schema.BODY_STEP_VARS, schema.ELASTIC_STEP_VARS,
+                  schema.NODE_PROFILE_VARS, schema.LINK_PROFILE_VARS, schema.ELASTIC_LINK_VARS,
+                  schema.COORDS, schema.PROBLEM_VARS):
+        if name in table:
+            return dict(table[name])
+    raise KeyError(name)
+
+
+def _dataset(line, times, rec, snap_t, snap_z, snap_kind, attrs) -> xr.Dataset:
+    """The run Dataset: per-step records, profiles at the snapshots, the problem's arrays."""
+    N = line.N
+    st, sd, nd, ld = schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_DIM
+    data = {name: ((st,), rec[:, k], _attrs(name)) for k, name in enumerate(STEP_NAMES)}
+    order = np.argsort(np.asarray(snap_t), kind="stable")
+    prof = {k: [] for k in ("x", "y", "vx", "vy", "ax", "ay", "speed", "accel", "tension", "strain")}
+    for i in order:
+        t, z = snap_t[i], snap_z[i]
+        x, y, vx, vy = line.unpack(z, t)
+        dz = line.rhs(t, z)
+        pa = line.pin.kinematics(float(t))
+        ax = np.concatenate([dz[2:4 * N:4], [pa[4]]])
+        ay = np.concatenate([dz[3:4 * N:4], [pa[5]]])
+        T, E, _ = line.link_state(t, z)
+        for k, v in (("x", x), ("y", y), ("vx", vx), ("vy", vy), ("ax", ax), ("ay", ay),
+                     ("speed", np.hypot(vx, vy)), ("accel", np.hypot(ax, ay)), ("tension", T), ("strain", E)):
+            prof[k].append(v)
+    for k, v in prof.items():
+        data[k] = ((sd, ld if k in ("tension", "strain") else nd), np.asarray(v), _attrs(k))
+    data["link_length"] = ((ld,), line.h, _attrs("link_length"))
+    data["node_mass"] = ((nd,), np.concatenate([line.m, [0.0]]), _attrs("node_mass"))
+    data["axial_stiffness"] = ((ld,), line.ea, _attrs("axial_stiffness"))
+    coords = {"t": ((st,), times, _attrs("t")),
+              "t_snapshot": ((sd,), np.asarray(snap_t)[order], _attrs("t_snapshot")),
+              "snapshot_kind": ((sd,), np.asarray(snap_kind)[order].astype(str), _attrs("snapshot_kind")),
+              "s_node": ((nd,), np.concatenate([line.snode, [0.0]]), _attrs("s_node")),
+              "s_link": ((ld,), line.snode - 0.5 * line.h, _attrs("s_link"))}
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update({k: (int(v) if isinstance(v, (bool, np.bool_)) else v) for k, v in attrs.items()})
+    ds.attrs["units"] = "nondimensional (length L, mass M, time sqrt(L/g), force M g)"
+    return ds

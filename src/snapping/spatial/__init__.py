@@ -1,0 +1,16 @@
+"""The chain in three dimensions (rigid links, directions in space, O(N) tension solve).
+
+* :mod:`snapping.spatial.chain3d`: the equations (tridiagonal tension system with the
+  cosines between neighbouring links), the compiled right-hand side and diagnostics;
+* :mod:`snapping.spatial.solve3d`: compiled DOP853 stepping with dense-output peaks, to the snap;
+* :mod:`snapping.spatial.starts3d`: :class:`Problem3D`, planar starts in space and the
+  out-of-plane perturbations only 3D has.
+
+It imports from :mod:`snapping.simulate` (links, the catenary, the DOP853 tableau); the
+planar simulator does not import it.
+"""
+
+from .solve3d import run3d
+from .starts3d import Pin3D, Problem3D
+
+__all__ = ["run3d", "Problem3D", "Pin3D"]

@@ -1,0 +1,264 @@
+"""What a 3D run solves: the chain, its start in space, its held end and gravity.
+
+:class:`Problem3D` holds node positions ``r`` and velocities ``v`` ((N + 1, 3), row N the
+held end at the origin), the chain (:class:`snapping.simulate.links.Links`: link lengths
+and lumped node masses, tip mass), the held end's motion (:class:`Pin3D`), gravity (a
+magnitude and a unit direction, default ``(0, 1, 0)``: ``y`` downward as in the planar
+problems) and the normal of the reference plane whose out-of-plane amplitude is measured
+(default ``(0, 0, 1)``).
+
+Starts: any planar :class:`snapping.simulate.problem.Problem` placed in the plane z = 0
+(:meth:`Problem3D.from_planar`), the paper's catenary (:meth:`Problem3D.catenary`), node
+coordinates (:meth:`Problem3D.nodes`), and the start only 3D has, a planar start with an
+out-of-plane velocity perturbation of amplitude ``eps`` (:meth:`Problem3D.perturbed`: the
+mode ``sin(pi s/L)`` of the arclength ``s`` from the held end, or random with a seed).
+
+Example
+-------
+>>> from snapping.spatial.starts3d import Problem3D
+>>> p = Problem3D.catenary(0.25, 50).perturbed(1e-4)
+>>> p.v.shape, float(abs(p.v[:, 2]).max()) <= 1e-4, p.start["perturbation"]["eps"]
+((51, 3), True, 0.0001)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .. import _validate as V
+from ..simulate.links import Links
+from . import chain3d as C
+
+__all__ = ["Problem3D", "Pin3D", "MODES"]
+
+#: perturbation modes of :meth:`Problem3D.perturbed`
+MODES = ("sin", "random")
+#: relative tolerance of a start's link lengths against the chain's, and of a unit direction's length
+SHAPE_RTOL = 1e-6
+UNIT_RTOL = 1e-9
+_PIN_KINDS = {"fixed": C.PIN_FIXED, "pull": C.PIN_PULL, "flick": C.PIN_FLICK}
+
+
+def _vec3(name: str, v) -> np.ndarray:
+    a = np.asarray(V.float_array(name, v), dtype=float).ravel()
+    if a.size != 3 or not np.all(np.isfinite(a)):
+        raise V.SnappingInputError(f"{name}={v!r} must be 3 finite numbers")
+    return a
+
+
+def _unit(name: str, v) -> np.ndarray:
+    a = _vec3(name, v)
+    n = float(np.linalg.norm(a))
+    if not abs(n - 1.0) <= UNIT_RTOL:
+        raise V.SnappingInputError(f"{name}={tuple(a.tolist())!r} has length {n:.6g}: it must be a unit vector "
+                                   f"(length 1 to within {UNIT_RTOL:g})")
+    return a
+
+
+@dataclass(frozen=True)
+class Pin3D:
+    """The held end's motion in space: ``fixed``, ``pull`` (acceleration ``accel`` from ``t0``
+    for ``duration``, then constant velocity) or ``flick`` (``accel sin(2 pi (t - t0)/duration)``
+    for one period). Starts at the origin, at rest."""
+
+    kind: str = "fixed"
+    accel: tuple = (0.0, 0.0, 0.0)
+    t0: float = 0.0
+    duration: float = math.inf
+
+    def __post_init__(self):
+        if self.kind not in _PIN_KINDS:
+            raise V.SnappingInputError(f"kind={self.kind!r} is not one of {tuple(_PIN_KINDS)}")
+        object.__setattr__(self, "accel", tuple(_vec3("accel", self.accel).tolist()))
+        t0 = V.real("t0", self.t0)
+        if not (math.isfinite(t0) and t0 >= 0.0):
+            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be finite and >= 0")
+        d = float(self.duration) if self.duration == math.inf else V.real("duration", self.duration)
+        if not d > 0.0 or (self.kind == "flick" and not math.isfinite(d)):
+            raise V.SnappingInputError(f"duration={d!r} is out of range: must be > 0 (finite for a flick)")
+
+    def model_args(self) -> tuple:
+        return (_PIN_KINDS[self.kind], self.accel, float(self.t0), float(self.duration))
+
+    def kinematics(self, t: float) -> tuple:
+        """(x, y, z, vx, vy, vz, ax, ay, az) at t (the compiled :func:`snapping.spatial.chain3d.pin3d`)."""
+        par = C.make_model([1.0], [1.0], pin=self.model_args())[0]
+        return C.pin3d(float(t), par)
+
+    @classmethod
+    def from_planar(cls, pin) -> "Pin3D":
+        """The planar :class:`snapping.simulate.pin.PinMotion` in the plane z = 0 (not a table)."""
+        if pin.kind == "table":
+            raise V.SnappingInputError("pin: a sampled (table) motion has no 3D form yet; use fixed, pull or flick")
+        ax, ay = pin.accel
+        return cls(pin.kind, (ax, ay, 0.0), pin.t0, pin.duration)
+
+
+@dataclass(frozen=True, eq=False)
+class Problem3D:
+    """A chain in space, its start (``r``, ``v``: (N + 1, 3), row N the held end at the
+    origin), its held end, gravity ``gravity * g_dir`` and the reference plane's normal."""
+
+    links: Links
+    r: np.ndarray
+    v: np.ndarray
+    pin: Pin3D = field(default_factory=Pin3D)
+    gravity: float = 1.0
+    g_dir: tuple = (0.0, 1.0, 0.0)
+    normal: tuple = (0.0, 0.0, 1.0)
+    start: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if not isinstance(self.links, Links):
+            raise V.SnappingInputError(f"links={self.links!r} is not a snapping.simulate.Links")
+        if not isinstance(self.pin, Pin3D):
+            raise V.SnappingInputError(f"pin={type(self.pin).__name__} is not a Pin3D")
+        N = self.links.N
+        for name in ("r", "v"):
+            a = np.array(V.float_array(name, getattr(self, name)), dtype=float)
+            if a.ndim != 2 or a.shape != (N + 1, 3):
+                raise V.SnappingInputError(f"{name} must be an array of shape ({N + 1}, 3) (N + 1 nodes, 3 columns "
+                                           f"x, y, z); got shape {a.shape}")
+            if not np.all(np.isfinite(a)):
+                raise V.SnappingInputError(f"{name} must be finite")
+            object.__setattr__(self, name, a)
+        g = V.real("gravity", self.gravity)
+        if not 0.0 <= g <= 1e6:
+            raise V.SnappingInputError(f"gravity={g!r} is out of range: must lie in [0, 1e6] (units of g)")
+        object.__setattr__(self, "gravity", abs(g))
+        object.__setattr__(self, "g_dir", tuple(_unit("g_dir", self.g_dir).tolist()))
+        object.__setattr__(self, "normal", tuple(_unit("normal", self.normal).tolist()))
+        r, v = self.r, self.v
+        if np.any(r[N] != 0.0):
+            raise V.SnappingInputError(f"r: the held end (node {N}) must start at the origin; got {r[N].tolist()}")
+        d = np.diff(r, axis=0)
+        lens = np.linalg.norm(d, axis=1)
+        rel = np.abs(lens - self.links.h) / self.links.h
+        if rel.max() > SHAPE_RTOL:
+            j = int(np.argmax(rel))
+            raise V.SnappingInputError(f"r: link {j} has length {lens[j]:.9g} but the chain's link is "
+                                       f"{self.links.h[j]:.9g} (relative difference {rel[j]:.3g} > {SHAPE_RTOL:g})")
+        if np.any(v[N] != 0.0):
+            raise V.SnappingInputError(f"v: the held end (node {N}) starts at rest; got {v[N].tolist()}")
+        stretch = np.abs(np.sum(d * np.diff(v, axis=0), axis=1)) / lens
+        if stretch.max() > 1e-9 * max(1.0, float(np.abs(v).max())):
+            j = int(np.argmax(stretch))
+            raise V.SnappingInputError(f"v: the initial velocities stretch link {j} at the rate {stretch[j]:.3g}: "
+                                       f"they must keep every link's length")
+
+    @property
+    def N(self) -> int:
+        return self.links.N
+
+    # -- constructors
+    @classmethod
+    def from_planar(cls, problem, **kw) -> "Problem3D":
+        """A planar :class:`snapping.simulate.problem.Problem` in the plane z = 0 (same chain,
+        nodes, velocities, held end and gravity; no body)."""
+        if problem.body is not None:
+            raise V.SnappingInputError("problem: a body (bending, drag) has no 3D form yet")
+        N = problem.N
+        r = np.column_stack([problem.x, problem.y, np.zeros(N + 1)])
+        v = np.column_stack([problem.vx, problem.vy, np.zeros(N + 1)])
+        return cls(problem.links, r, v, Pin3D.from_planar(problem.pin), problem.gravity,
+                   start={"kind": "planar", **problem.start}, **kw)
+
+    @classmethod
+    def catenary(cls, chi: float, N: int | None = None, **kw) -> "Problem3D":
+        """The planar catenary start (:meth:`snapping.simulate.problem.Problem.catenary`, same
+        keywords: ``links``, ``chords``, ``pin``, ``gravity``) in the plane z = 0."""
+        from ..simulate.problem import Problem
+
+        return cls.from_planar(Problem.catenary(chi, N, **kw))
+
+    def perturbed(self, eps: float, mode: str = "sin", *, seed: int | None = None) -> "Problem3D":
+        """This start with an out-of-plane velocity ``eps * phi(s) * normal`` added at every node
+        (``s``: arclength from the held end). ``mode="sin"``: ``phi = sin(pi s/L)`` (zero at
+        both ends); ``"random"``: independent normal values (``seed``), scaled to max 1, zero at
+        the held end. Relative link velocities stay normal to links lying in the plane."""
+        e = V.real("eps", eps)
+        if not math.isfinite(e) or abs(e) > 1e3:
+            raise V.SnappingInputError(f"eps={eps!r} is out of range: the perturbation amplitude must be finite, "
+                                       f"|eps| <= 1e3")
+        if mode not in MODES:
+            raise V.SnappingInputError(f"mode={mode!r} is not one of {MODES}")
+        h = self.links.h
+        s = np.concatenate([np.cumsum(h[::-1])[::-1], [0.0]])
+        if mode == "sin":
+            phi = np.sin(np.pi * s / s[0])
+        else:
+            phi = np.random.default_rng(seed).standard_normal(self.N + 1)
+            phi[-1] = 0.0
+            phi /= np.abs(phi).max()
+        n = np.asarray(self.normal)
+        v = self.v + e * phi[:, None] * n[None, :]
+        start = {**self.start, "perturbation": {"eps": e, "mode": mode, "seed": seed, "kind": "velocity"}}
+        return replace(self, v=v, start=start)
+
+    @classmethod
+    def whirling(cls, omega: float, N: int | None = None, *, links: Links | None = None, gravity: float = 1.0,
+                 **kw) -> "Problem3D":
+        """The chain rotating steadily at rate ``omega`` about the vertical (gravity's direction,
+        +y) through its held end, free end out (the first mode), in the plane z = 0 at t = 0
+        with velocities ``omega yhat x r``. Its discrete shape: node by node from the free end
+        (radius ``x0``), ``T_j e_j = T_{j-1} e_{j-1} - m_j (g yhat + omega^2 x_j xhat)``, with
+        ``x0`` found (bisection, then Brent) so that the held end lies on the axis. Below the
+        first critical rate (about ``1.2 sqrt(g/L)`` for a uniform chain) the only steady state
+        is hanging straight: SnappingInputError."""
+        from scipy.optimize import brentq
+
+        links = Links.uniform(V.integer("N", N, 1)) if links is None else links
+        w = V.real("omega", omega)
+        g = V.real("gravity", gravity)
+        h, m = links.h, links.m
+
+        def shoot(x0):
+            x, y, Fx, Fy = x0, 0.0, 0.0, 0.0
+            pts = [(x, y)]
+            for j in range(links.N):
+                Fx, Fy = Fx - m[j] * w * w * x, Fy - m[j] * g
+                T = math.hypot(Fx, Fy)
+                x, y = x + h[j] * Fx / T, y + h[j] * Fy / T
+                pts.append((x, y))
+            return np.array(pts)
+
+        L = links.length
+        xs = np.linspace(1e-6 * L, L, 2001)
+        xN = np.array([shoot(x)[-1, 0] for x in xs])
+        P = None
+        for k in np.flatnonzero(np.sign(xN[1:]) != np.sign(xN[:-1])) if w > 0.0 and g > 0.0 else []:
+            x0 = brentq(lambda x: shoot(x)[-1, 0], xs[k], xs[k + 1], xtol=1e-15 * L, rtol=1e-15)
+            Q = shoot(x0)
+            if np.all(Q[:, 0] - Q[-1, 0] >= -1e-12 * L):  # (the first mode: the chain does not cross the axis)
+                P = Q - Q[-1]
+                break
+        if P is None:
+            raise V.SnappingInputError(f"omega={omega!r} has no steady whirling shape (gravity {g:g}): the rate must "
+                                       f"exceed the chain's first critical rate (about 1.2 sqrt(g/L) uniform)")
+        r = np.column_stack([P[:, 0], P[:, 1], np.zeros(links.N + 1)])
+        v = np.column_stack([np.zeros(links.N + 1), np.zeros(links.N + 1), -w * P[:, 0]])
+        return cls(links, r, v, gravity=g, start={"kind": "whirling", "omega": w, "x0": float(P[0, 0])}, **kw)
+
+    @classmethod
+    def nodes(cls, r, v=None, *, links: Links | None = None, **kw) -> "Problem3D":
+        """Start from node coordinates ((N + 1, 3), row N the held end at the origin); ``links``
+        default: uniform links of the chords' length (the chords must be equal)."""
+        r = np.array(V.float_array("r", r), dtype=float)
+        if r.ndim != 2 or r.shape[1] != 3 or r.shape[0] < 2:
+            raise V.SnappingInputError(f"r must have 3 columns (x, y, z) and at least 2 rows; got shape {r.shape}")
+        if links is None:
+            links = Links.uniform(r.shape[0] - 1)
+        return cls(links, r, np.zeros_like(r) if v is None else v, **kw)
+
+    # -- the compiled form
+    def model(self):
+        """The model tuple ``(par, h, invm)`` of :mod:`snapping.spatial.chain3d`."""
+        g = self.gravity * np.asarray(self.g_dir)
+        return C.make_model(self.links.h, 1.0 / self.links.m, g=g, pin=self.pin.model_args(), normal=self.normal)
+
+    def initial_state(self) -> np.ndarray:
+        """``[e, u, W = 0]`` of the start (:func:`snapping.spatial.chain3d.nodes_to_state`)."""
+        return C.nodes_to_state(self.r, self.v, self.links.h)

@@ -1,0 +1,155 @@
+"""The peer-comparison scripts of ``benchmarks/peers/`` (issue 21): the problem they set up in
+each code against the same problem built independently (the catenary from its closed form,
+the lumped masses, the rod's stiffnesses), their peak finder against a parabola, and that
+they run. The PyElastica parts are skipped without the optional ``peers`` extra."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import os
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+ROOT = Path(__file__).resolve().parents[1]
+SCRIPT = ROOT / "benchmarks" / "peers" / "pyelastica_catenary.py"
+HAVE_ELASTICA = importlib.util.find_spec("elastica") is not None
+needs_elastica = pytest.mark.skipif(not HAVE_ELASTICA, reason="pyelastica (the 'peers' extra) is not installed")
+
+
+def _script():
+    if "pyelastica_catenary" in sys.modules:
+        return sys.modules["pyelastica_catenary"]
+    spec = importlib.util.spec_from_file_location("pyelastica_catenary", SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["pyelastica_catenary"] = mod  # (its dataclasses look their module up there)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def _env():
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT / "src") + os.pathsep + env.get("PYTHONPATH", "")
+    return env
+
+
+def _catenary(chi, N):
+    """Nodes 0..N (0 the free end, N the held end at the origin, y downward) of the level
+    catenary of length 1 and end separation chi, placed from the held end with chords exactly
+    1/N: y = a (cosh(chi/2a) - cosh((x - chi/2)/a)), 2 a sinh(chi/2a) = 1, each node found by
+    bisection on the circle of radius 1/N around the previous one."""
+    a = brentq(lambda a: 2 * a * math.sinh(chi / (2 * a)) - 1.0, 1e-3, 10.0, xtol=1e-16, rtol=8.9e-16)
+
+    def y(x):
+        return a * (math.cosh(chi / (2 * a)) - math.cosh((x - chi / 2) / a))
+
+    xs, ys = [0.0], [0.0]
+    for _ in range(N):
+        x0, y0 = xs[-1], ys[-1]
+        x1 = brentq(lambda x: math.hypot(x - x0, y(x) - y0) - 1.0 / N, x0 + 1e-12, x0 + 1.0 / N + 1e-9,
+                    xtol=1e-16, rtol=8.9e-16)
+        xs.append(x1)
+        ys.append(y(x1))
+    return np.array(xs[::-1]), np.array(ys[::-1])
+
+
+@pytest.mark.parametrize("script,option", [(SCRIPT, "--ea"), (SCRIPT.parent / "moordyn_catenary.py", "--c")])
+def test_help_without_the_peer(script, option):
+    """--help parses (and imports neither code's solver) whether or not the peer is there."""
+    out = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, env=_env(),
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "--quick" in out.stdout and option in out.stdout
+
+
+@pytest.mark.parametrize("N", [7, 40])
+def test_project_problem_is_the_catenary_with_shared_lumping(N):
+    P = _script()
+    p = P.project_problem(0.25, N, 1e-3)
+    x, y = _catenary(0.25, N)
+    assert np.abs(p.x - x).max() < 1e-12 and np.abs(p.y - y).max() < 1e-12
+    m = np.full(N, 1.0 / N)
+    m[0] = 0.5 / N  # PyElastica's lumping: half an element's mass at the free end
+    assert np.abs(p.links.m - m).max() < 1e-15
+    assert p.body.bending == 1e-3 and p.body.clamp is None
+
+
+def test_rod_directors_are_an_orthonormal_frame_along_the_chords():
+    P = _script()
+    p = P.project_problem(0.25, 12, 1e-4)
+    pos, dirs = P.rod_geometry(p)
+    t = np.diff(np.vstack([p.x, p.y, np.zeros_like(p.x)]), axis=1) * 12
+    assert np.abs(dirs[2] - t).max() < 1e-12
+    for k in range(12):
+        Q = dirs[:, :, k]
+        assert np.abs(Q @ Q.T - np.eye(3)).max() < 1e-14 and abs(np.linalg.det(Q) - 1.0) < 1e-14
+
+
+def test_vertex_of_a_parabola():
+    P = _script()
+    t = np.linspace(0.0, 1.0, 11)
+    v = 3.0 - 7.0 * (t - 0.537) ** 2
+    vp, tp = P.vertex(t, v)
+    assert abs(vp - 3.0) < 1e-12 and abs(tp - 0.537) < 1e-12
+    assert P.vertex(t, t) == (1.0, 1.0)  # a maximum at the end is the sample itself
+
+
+@needs_elastica
+@pytest.mark.parametrize("N,beta,ea", [(9, 1e-3, 1e3), (40, 1e-4, 1e2)])
+def test_pyelastica_rod_is_the_same_chain(N, beta, ea):
+    """The rod's nodes are the catenary's, its rest lengths 1/N, its node masses the chain's
+    (the held node's does not matter), bending stiffness beta, stretch and shear stiffness EA."""
+    P = _script()
+    sim, rod = P.build_pyelastica(0.25, N, beta, ea)
+    x, y = _catenary(0.25, N)
+    r = rod.position_collection
+    assert np.abs(r[0] - x).max() < 1e-12 and np.abs(r[1] - y).max() < 1e-12 and np.abs(r[2]).max() == 0.0
+    assert np.abs(rod.rest_lengths - 1.0 / N).max() < 1e-12
+    assert np.abs(rod.rest_voronoi_lengths - 1.0 / N).max() < 1e-12
+    m = np.full(N, 1.0 / N)
+    m[0] = 0.5 / N
+    assert np.abs(rod.mass[:N] - m).max() < 1e-14
+    assert np.allclose(rod.bend_matrix[0, 0], beta, rtol=1e-12) and np.allclose(rod.bend_matrix[1, 1], beta,
+                                                                                  rtol=1e-12)
+    for i in range(3):
+        assert np.allclose(rod.shear_matrix[i, i], ea, rtol=1e-12)
+
+
+@needs_elastica
+def test_pyelastica_rod_falls_under_gravity_with_its_end_pinned():
+    """One tiny step from rest: the held node stays put, and the mass-weighted mean acceleration
+    of the other nodes is g downward (+y) up to the pin's share (the rod is unstrained at the
+    release, so no tension acts yet; bending forces sum to the small pin reaction)."""
+    import elastica as ea_
+
+    P = _script()
+    N, dt = 30, 1e-7
+    sim, rod = P.build_pyelastica(0.25, N, 1e-4, 1e3)
+    held = rod.position_collection[:, -1].copy()
+    ea_.PositionVerlet().step(sim, 0.0, dt)
+    assert np.abs(rod.position_collection[:, -1] - held).max() == 0.0
+    v = rod.velocity_collection[:, :N]
+    a_mean = (rod.mass[:N] * v).sum(axis=1) / rod.mass[:N].sum() / dt
+    assert abs(a_mean[1] - 1.0) < 0.02 and abs(a_mean[0]) < 0.02 and a_mean[2] == 0.0
+
+
+@needs_elastica
+def test_quick_run():
+    """--quick runs (under 30 s of CPU), and PyElastica's stiffest rod there agrees with this
+    project's exact chain to its extensibility error (1e-2)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    out = subprocess.run([sys.executable, str(SCRIPT), "--quick"], capture_output=True, text=True, env=_env(),
+                         timeout=300)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    assert out.returncode == 0, out.stderr[-2000:]
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    assert cpu < 30.0, f"--quick took {cpu:.1f} s of CPU"
+    rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("PyElastica ")]
+    assert len(rows) == 2
+    assert float(rows[-1][-1]) < 1e-2
