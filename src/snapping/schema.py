@@ -140,6 +140,16 @@ PROBLEM_ATTRS: dict[str, str] = {
              "nondimensional), runs of a problem with a body only"),
 }
 
+#: Global attributes of runs of the stiff method, or of a problem with bending run with
+#: ``method='fast'`` (which then chooses between dop853 and rodas4:
+#: :mod:`snapping.simulate.stiffness`); absent elsewhere.
+METHOD_ATTRS: dict[str, str] = {
+    "method_choice": ("why method='fast' ran this method ('method' names it): the shortest bending wave's "
+                      "frequency and damping ratio, and the explicit method's estimated steps"),
+    "n_jacobians": "Jacobians of the stiff method (rodas4; each 20 complex-step evaluations of the rows)",
+    "n_factorizations": "banded LU factorisations of the stiff method's stage matrix (rodas4)",
+}
+
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
 INPUT_ATTRS: dict[str, str] = {
     "chi": "initial end-to-end separation (fraction of the length), in (0, 1)",
@@ -259,6 +269,11 @@ CHECKPOINT_DIMS = {
     "checkpoint_stage": "the 16 Runge-Kutta stages of a DOP853 step (12, and 4 of the dense output)",
     "checkpoint_dense": "the 7 coefficient vectors of a DOP853 step's dense output",
     "checkpoint_angle": "the 2N angle-form unknowns (link angles, then angular velocities)",
+    "checkpoint_rodas_stage": "f at a RODAS4 step's start, its 6 stage increments U_1 .. U_6, f at its end",
+    "checkpoint_jacobian_var": "the variables theta, omega, a, T of the rows' banded derivatives",
+    "checkpoint_jacobian_colour": "the 5 colours (links 5 apart) of the rows' banded derivatives",
+    "checkpoint_jacobian_row": "the 2N rows (angle and tension row of each link) of the banded derivatives",
+    "checkpoint_count": "the RODAS4 counters: Jacobians, factorisations, extra evaluations, singular matrices",
 }
 
 #: The complete state of an unfinished run, stored in the run file itself next to the
@@ -291,6 +306,26 @@ CHECKPOINT_VARS_DOP853: dict[str, dict[str, str]] = {
     "checkpoint_dense_ok": _v("1 where the dense output of a stored step has been built, else 0"),
     "checkpoint_Z": _v("positions, velocities, accelerations and tensions of the current state"),
     "checkpoint_peak_t": _v("time of the located peak of v_max (NaN: none yet)"),
+    **{k: CHECKPOINT_VARS[k] for k in ("checkpoint_peak_state", "checkpoint_ctl", "checkpoint_pk", "checkpoint_meas",
+                                       "checkpoint_meas0", "checkpoint_rinv0", "checkpoint_snapshot_state",
+                                       "checkpoint_snapshot_t", "checkpoint_requested",
+                                       "checkpoint_after_fractions")},
+}
+#: The complete state of an unfinished run of the stiff method (``method = 'rodas4'``): the
+#: step slots of the RODAS4 loop and the Jacobian at the current state (the shared names
+#: mean the same as in CHECKPOINT_VARS_DOP853).
+CHECKPOINT_VARS_RODAS4: dict[str, dict[str, str]] = {
+    "checkpoint_Y0": CHECKPOINT_VARS_DOP853["checkpoint_Y0"],
+    "checkpoint_Y1": CHECKPOINT_VARS_DOP853["checkpoint_Y1"],
+    "checkpoint_stages": _v("f at the start, the stage increments U_1 .. U_6 and f at the end of the two stored "
+                            "RODAS4 steps (they give the continuous extension)"),
+    "checkpoint_step_t": CHECKPOINT_VARS_DOP853["checkpoint_step_t"],
+    "checkpoint_step_h": CHECKPOINT_VARS_DOP853["checkpoint_step_h"],
+    "checkpoint_jacobian": _v("coloured banded derivatives of the rows at the current state (the next step's "
+                              "Jacobian)"),
+    "checkpoint_counts": _v("Jacobians, banded factorisations, extra evaluations and singular stage matrices so far"),
+    "checkpoint_Z": CHECKPOINT_VARS_DOP853["checkpoint_Z"],
+    "checkpoint_peak_t": CHECKPOINT_VARS_DOP853["checkpoint_peak_t"],
     **{k: CHECKPOINT_VARS[k] for k in ("checkpoint_peak_state", "checkpoint_ctl", "checkpoint_pk", "checkpoint_meas",
                                        "checkpoint_meas0", "checkpoint_rinv0", "checkpoint_snapshot_state",
                                        "checkpoint_snapshot_t", "checkpoint_requested",

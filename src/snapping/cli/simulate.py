@@ -34,7 +34,10 @@ def _add_simulate(sub) -> None:
             "  euler-richardson-fixed  the same step at the fixed dt = --dt0 (order studies)\n"
             "  dop853                  link-angle form (links exact to round-off), compiled 8th-order\n"
             "                          Dormand-Prince with dense output: 20-40x fewer evaluations\n"
-            "  fast                    always the project's best exact method (now dop853; the default)\n"
+            "  rodas4, stiff           linearly implicit, L-stable RODAS4 with banded O(N) solves: lines with\n"
+            "                          bending stiffness (a body), whose bending waves limit dop853's steps\n"
+            "  fast                    always the project's best exact method (the default): dop853, or\n"
+            "                          rodas4 for a body whose damped bending waves make dop853 stiff\n"
             "\n"
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
@@ -82,7 +85,7 @@ def _add_simulate(sub) -> None:
     p.add_argument("--tol", type=float, default=None,
                    help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson the paper's 1e-8)")
     p.add_argument("--method", default="fast",
-                   choices=["fast", "dop853", "euler-richardson", "euler-richardson-fixed"],
+                   choices=["fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed"],
                    help="time stepper (default: fast; every method is listed below)")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")

@@ -59,6 +59,7 @@ SUMMARY_KEYS = (
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
     "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
+    "method_choice", "n_jacobians", "n_factorizations",  # (schema.METHOD_ATTRS: a body's method)
     "min_tension", "t_compression",  # (files written before sigma_min existed have none)
 )
 
