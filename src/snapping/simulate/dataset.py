@@ -59,6 +59,7 @@ SUMMARY_KEYS = (
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
     "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
+    "start_rest",  # (problems with a body only)
 )
 
 
@@ -270,6 +271,10 @@ def _add_problem(problem, data_vars: dict, coords: dict, attrs: dict) -> None:
     attrs["gravity"] = float(problem.gravity)
     attrs["pin_motion"] = problem.pin.kind
     attrs["start"] = str(problem.start.get("kind", ""))
+    if getattr(problem, "body", None) is not None:  # (new names: the shape the line was released from)
+        kind = str(problem.start.get("kind", ""))
+        attrs["start_rest"] = str(problem.start.get("rest", "catenary" if kind in ("catenary", "supports") else
+                                                    "as given"))
 
 
 def check_writable(path, *, overwrite: bool = False, name: str = "output", need_bytes: float = 0.0) -> str:

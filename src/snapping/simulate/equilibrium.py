@@ -185,7 +185,7 @@ def _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_it
 
 
 def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None, tol: float = EQUILIBRIUM_TOL,
-                        max_iter: int = MAX_NEWTON) -> Equilibrium:
+                        max_iter: int | None = None) -> Equilibrium:
     """The line of ``links`` with ``body`` (a :class:`snapping.simulate.body.Body` or None)
     at rest, held at the origin (node N) and at ``(x[0], y[0])`` (node 0), under gravity
     ``gravity`` along +y: Newton from the shape ``x, y`` (the catenary), continuation in the
@@ -193,6 +193,7 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
     resolved first (:meth:`snapping.simulate.body.Body.resolved`). Raises
     :class:`snapping._validate.SnappingInputError` when no equilibrium is found, with the
     residual reached."""
+    max_iter = MAX_NEWTON if max_iter is None else int(max_iter)
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     N = links.N

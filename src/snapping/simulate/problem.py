@@ -391,9 +391,10 @@ def _rest_shape(start) -> None:
 
 def _at_rest(links, x, y, body, gravity, start, desc):
     """The start's nodes, description and body for ``start`` (None: the equilibrium when the
-    body has bending stiffness, else the catenary's nodes as given). With the equilibrium
-    the body's ``clamp="start"`` is resolved on the catenary (the handle's direction), and
-    the description records ``rest`` and ``rest_residual``."""
+    body has bending stiffness, else the catenary's nodes as given). With the equilibrium, a
+    body's ``clamp="start"`` holds the direction of the hinged equilibrium's held link (which
+    is then the clamped equilibrium too: no moment at the clamp), and the description records ``rest`` (the residual is below
+    :data:`snapping.simulate.equilibrium.EQUILIBRIUM_TOL`, else an error)."""
     _rest_shape(start)
     bends = False
     if isinstance(body, Body):
@@ -406,10 +407,11 @@ def _at_rest(links, x, y, body, gravity, start, desc):
     from .equilibrium import hanging_equilibrium
 
     g = _gravity(gravity)
-    if isinstance(body, Body):
-        body = body.resolved(x, y)
-    eq = hanging_equilibrium(links, body if isinstance(body, Body) and body.active else None, x, y, gravity=g)
-    return eq.x, eq.y, {**desc, "rest": "equilibrium", "rest_residual": eq.residual}, body
+    solve = body if isinstance(body, Body) and body.active else None
+    if solve is not None and isinstance(solve.clamp, str):  # "start": the clamp holds the rest shape's direction,
+        solve = solve.hinged()  # where the hinged equilibrium puts no moment on it (resolved on these nodes)
+    eq = hanging_equilibrium(links, solve, x, y, gravity=g)
+    return eq.x, eq.y, {**desc, "rest": "equilibrium"}, body
 
 
 # ---------------------------------------------------------------------------------- from options
