@@ -176,6 +176,13 @@ def test_bad_start_is_refused(kw, text):
         Problem.catenary(0.3, 20, **kw)
 
 
+def test_a_rest_shape_that_crosses_itself_is_refused():
+    """Ends 1e-3 apart and a stiff line: the elastica's arms cross (no valid start)."""
+    with pytest.raises(SnappingInputError, match="start='equilibrium': links .* intersect.*use start='catenary'"):
+        Problem.catenary(1e-3, 200, body=Body(1.0))
+    Problem.catenary(1e-3, 200, body=Body(1.0), start="catenary")  # (the catenary is valid)
+
+
 def test_no_convergence_says_so_with_the_residual(monkeypatch):
     from snapping.simulate import equilibrium as EQ
 

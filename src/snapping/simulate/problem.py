@@ -411,6 +411,13 @@ def _at_rest(links, x, y, body, gravity, start, desc):
     if solve is not None and isinstance(solve.clamp, str):  # "start": the clamp holds the rest shape's direction,
         solve = solve.hinged()  # where the hinged equilibrium puts no moment on it (resolved on these nodes)
     eq = hanging_equilibrium(links, solve, x, y, gravity=g)
+    from . import shapes
+
+    try:
+        shapes.check_curve(eq.x, eq.y, name="start='equilibrium'")
+    except V.SnappingInputError as exc:
+        raise V.SnappingInputError(f"{exc} (the line's rest shape with this bending is not a valid start; use "
+                                   f"start='catenary')") from None
     return eq.x, eq.y, {**desc, "rest": "equilibrium"}, body
 
 
