@@ -228,3 +228,24 @@ def test_automatic_stop_finds_the_peak_of_a_stiff_line():
     # early on the line falls from rest: no jolt of waves (the catenary start's v_max is 0.5 at once)
     early = run(p, t_end=0.05, progress=False).dataset
     assert float(early["v_max"].values[-1]) < 0.12
+
+
+# ---------------------------------------------------------------- the command line
+def test_cli_start_option(capsys, tmp_path):
+    from snapping.cli import main
+
+    base = ["simulate", "--chi", "0.3", "--N", "12", "--t-end", "0.1", "--json", "--no-progress"]
+    for extra, rest in (([], "equilibrium"), (["--start", "catenary"], "catenary"),
+                        (["--start", "equilibrium"], "equilibrium")):
+        assert main(base + ["--bending", "1e-3"] + extra) == 0
+        assert json.loads(capsys.readouterr().out)["start_rest"] == rest
+    assert main(base + ["--start", "equilibrium", "-o", str(tmp_path / "e.nc")]) == 0  # no body: the chain at rest
+    capsys.readouterr()
+    from snapping.simulate import load_run
+
+    assert json.loads(load_run(str(tmp_path / "e.nc")).attrs["problem"])["start"]["rest"] == "equilibrium"
+    shape = tmp_path / "s.csv"
+    shape.write_text("x,y\n0,0\n0.3,0.6\n0.6,1.2\n")
+    status = main(["simulate", "--shape", str(shape), "--N", "12", "--start", "equilibrium", "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "--start='equilibrium' applies to the catenary and supports" in err[0]
