@@ -59,9 +59,10 @@ def test_equilibrium_converges_to_the_heavy_elastica_at_second_order(case):
         body = Body(kw["B"], curvature=kw.get("kappa0", 0.0), clamp=kw.get("clamp"))
         e = hanging_equilibrium(links, body, p.x, p.y, support=(X, Y))
         s = _node_s(links)
-        if sol is None:
+        if sol is None:  # (the guess picks the branch: the catenary's can lead solve_bvp to an arch standing up)
+            g = (s[::-1], p.x[::-1], p.y[::-1]) if case == "hinged" else (s[::-1], e.x[::-1], e.y[::-1])
             sol = elastica(kw["B"], X, Y, tip=kw.get("tip", 0.0), kappa0=kw.get("kappa0", 0.0),
-                           clamp=kw.get("clamp"), guess=(s[::-1], p.x[::-1], p.y[::-1]))
+                           clamp=kw.get("clamp"), guess=g)
         xs, ys = sol.sol(s)[:2]
         errs.append(np.hypot(e.x - xs, e.y - ys).max())
         merrs.append(np.abs(e.reaction_free - sol.p).max())
@@ -124,6 +125,63 @@ def test_residual_vanishes_and_chords_are_exact():
     assert np.allclose(np.hypot(np.diff(p.x), np.diff(p.y)), links.h, rtol=0, atol=1e-14)
 
 
+# ---------------------------------------------------------------- stable: a local minimum
+def _dense_unstable(links, theta, mu, B, kappa0, clamp_link, g=1.0):
+    """Negative eigenvalues of the Lagrangian's Hessian on the constraints' tangent space, dense:
+    the energy written from node positions (turning angles by atan2), its Hessian by central
+    differences, the tangent space from the SVD of the constraint Jacobian."""
+    h, m = links.h, links.m
+    N = h.size
+    l = np.r_[0.0, 0.5 * (h[:-1] + h[1:]), 0.5 * h[-1]]
+
+    def energy(th):
+        d = h[:, None] * np.stack([np.cos(th), np.sin(th)], axis=1)
+        r = -np.cumsum(d[::-1], axis=0)[::-1]  # nodes 0..N-1 (node N at the origin)
+        v = -g * np.sum(m * r[:, 1])
+        turn = np.arctan2(d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0], np.sum(d[:-1] * d[1:], axis=1))
+        v += np.sum(B / (2 * l[1:N]) * (turn - kappa0 * l[1:N]) ** 2)
+        tc = math.remainder(clamp_link - th[-1], 2 * math.pi)
+        return v + B / (2 * l[N]) * (tc - kappa0 * l[N]) ** 2 + mu @ np.sum(d, axis=0)
+
+    e = 1e-4
+    H = np.zeros((N, N))
+    for i in range(N):
+        for j in range(i, N):
+            def f(a, b):
+                t = theta.copy()
+                t[i] += a
+                t[j] += b
+                return energy(t)
+            H[i, j] = H[j, i] = (f(e, e) - f(e, -e) - f(-e, e) + f(-e, -e)) / (4 * e * e)
+    C = np.stack([-h * np.sin(theta), h * np.cos(theta)], axis=1)
+    Z = np.linalg.svd(C.T)[2][2:].T
+    return int(np.sum(np.linalg.eigvalsh(Z.T @ H @ Z) < 0.0))
+
+
+def test_the_rest_shape_is_stable_where_newton_alone_finds_an_arch():
+    """Clamped at 1.2 rad with a natural curvature, Newton from the catenary converges to an
+    arch standing up (unstable); the solver's answer is the hanging shape, a local minimum.
+    The O(N) count of unstable directions agrees with a dense one on both."""
+    from snapping.simulate import equilibrium as EQ
+
+    links = Links.uniform(100)
+    p = Problem.catenary(0.25, links=links, start="catenary")
+    body = Body(3e-2, curvature=0.5, clamp=1.2)
+    th0 = np.unwrap(np.arctan2(np.diff(p.y), np.diff(p.x)))
+    h, Mc, Bl, K0L, phi, clamped = EQ._arrays(links, body, th0)
+    G0, _ = EQ._gradient(th0, np.zeros(2), h, Mc, 1.0, Bl, K0L, phi, clamped)  # (mu: least squares, as the solver)
+    mu0 = np.linalg.lstsq(np.stack([-np.sin(th0), np.cos(th0)], axis=1), -G0 / h, rcond=None)[0]
+    arch, mu_a, r, _, ok = EQ._newton(th0.copy(), mu0, h, Mc, 1.0, Bl, K0L, phi, clamped, (p.x[0], p.y[0]),
+                                      float(Mc[-1]), 1e-12, 60)
+    e = hanging_equilibrium(links, body, p.x, p.y)
+    assert ok and np.abs(arch - e.theta).max() > 0.5  # two equilibria
+    n_arch = EQ.unstable_directions(arch, mu_a, h, Mc, 1.0, Bl)
+    assert n_arch >= 1 and n_arch == _dense_unstable(links, arch, mu_a, 3e-2, 0.5, phi)
+    assert EQ.unstable_directions(e.theta, e.reaction_free, h, Mc, 1.0, Bl) == 0
+    assert _dense_unstable(links, e.theta, e.reaction_free, 3e-2, 0.5, phi) == 0
+    assert e.y.max() > 0.3 > -np.sum(links.h * np.sin(arch))  # it hangs; the arch stands up
+
+
 # ---------------------------------------------------------------- B -> 0: the catenary
 def test_without_bending_the_equilibrium_is_the_catenary():
     errs = []
@@ -176,9 +234,10 @@ def test_bad_start_is_refused(kw, text):
         Problem.catenary(0.3, 20, **kw)
 
 
-def test_a_rest_shape_that_crosses_itself_is_refused():
-    """Ends 1e-3 apart and a stiff line: the elastica's arms cross (no valid start)."""
-    with pytest.raises(SnappingInputError, match="start='equilibrium': links .* intersect.*use start='catenary'"):
+def test_no_valid_rest_shape_is_refused():
+    """Ends 1e-3 apart and a stiff line: the elastica's arms would cross (no valid start: the
+    continuation finds no stable shape, or one that crosses itself)."""
+    with pytest.raises(SnappingInputError, match="start='equilibrium': .*use start='catenary'"):
         Problem.catenary(1e-3, 200, body=Body(1.0))
     Problem.catenary(1e-3, 200, body=Body(1.0), start="catenary")  # (the catenary is valid)
 
@@ -187,7 +246,7 @@ def test_no_convergence_says_so_with_the_residual(monkeypatch):
     from snapping.simulate import equilibrium as EQ
 
     monkeypatch.setattr(EQ, "MAX_NEWTON", 1)
-    with pytest.raises(SnappingInputError, match=r"relative residual [0-9.e+-]+ > 1e-12; use start='catenary'"):
+    with pytest.raises(SnappingInputError, match=r"relative residual [0-9.e+-]+ \(at most 1e-12.*use start='catenary'"):
         Problem.catenary(0.3, 200, body=Body(1e-2))
 
 

@@ -30,8 +30,11 @@ neighbouring links; gravity and the constraint are diagonal), bordered by the tw
 constraint gradients ``C = dc/dtheta``; each Newton step solves ``H z = [G, C^T]`` with a
 banded LU (:func:`scipy.linalg.solve_banded`, O(N)) and a 2 x 2 Schur complement for
 ``mu``, with backtracking on the residual. The start is the given shape (the catenary);
-when Newton does not converge from there (stiff lines far from the catenary) the bending
-is switched on by continuation, ``B -> s B`` with ``s`` stepped from 0 to 1. Air drag and
+the result must be stable, a local minimum of the energy along the constraints (counted in
+O(N) by the inertia of the bordered Hessian: :func:`unstable_directions`; Newton alone may
+find an arch standing up). When Newton does not converge from the catenary to a stable
+shape, the bending is switched on by continuation, ``B -> s B`` with ``s`` stepped from 0
+to 1, every stage stable. Air drag and
 wind play no part (the line is held at rest in still air); damping none (at rest).
 
 Examples
@@ -57,7 +60,7 @@ from scipy.linalg import LinAlgError, solve_banded
 
 from .. import _validate as V
 
-__all__ = ["Equilibrium", "hanging_equilibrium", "discrete_residual", "EQUILIBRIUM_TOL"]
+__all__ = ["Equilibrium", "hanging_equilibrium", "discrete_residual", "unstable_directions", "EQUILIBRIUM_TOL"]
 
 #: relative residual at which Newton stops: each gradient row against the size of its terms (the line's
 #: weight times h_k, and (Bl_k + Bl_{k+1}) max|theta|, whose differences round at that size), the
@@ -133,6 +136,37 @@ def discrete_residual(theta, mu, links, body=None, target=(0.0, 0.0), gravity=1.
     return Gr, con
 
 
+def _hessian(th, mu, h, Mc, g, Bl):
+    """The Lagrangian's Hessian in theta (tridiagonal: diagonal ``a``, off-diagonal ``b``) and
+    the constraint gradients ``C`` (N, 2)."""
+    N = th.size
+    c, s = np.cos(th), np.sin(th)
+    a = -g * Mc * h * s - h * (mu[0] * c + mu[1] * s) + Bl[:N] + Bl[1:]
+    return a, -Bl[1:N], np.stack([-h * s, h * c], axis=1)
+
+
+def unstable_directions(th, mu, h, Mc, g, Bl) -> int:
+    """How many independent directions along the constraints lower the energy (0: a stable
+    rest shape, a local minimum): the negative eigenvalues of the bordered (KKT) matrix less
+    2, counted in O(N) as those of H (the pivots of its LDL^T, Sylvester) plus those of the
+    Schur complement ``-C^T H^-1 C`` (Haynsworth)."""
+    a, b, C = _hessian(th, mu, h, Mc, g, Bl)
+    N = th.size
+    d = np.empty(N)
+    d[0] = a[0]
+    for k in range(1, N):  # (a plain loop: O(N), called once per solve)
+        d[k] = a[k] - b[k - 1] ** 2 / d[k - 1] if d[k - 1] != 0.0 else a[k] - b[k - 1] ** 2 / 1e-300
+    neg = int(np.sum(d < 0.0))
+    ab = np.zeros((3, N))
+    ab[0, 1:], ab[1], ab[2, :-1] = b, a, b
+    try:
+        S = -C.T @ solve_banded((1, 1), ab, C)
+    except (LinAlgError, ValueError):
+        return N
+    neg += int(np.sum(np.linalg.eigvalsh(0.5 * (S + S.T)) < 0.0))
+    return neg - 2
+
+
 def _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_iter):
     """Newton with backtracking; returns (theta, mu, residual, iterations, converged)."""
     N = th.size
@@ -152,12 +186,9 @@ def _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_it
     it = 0
     while r > tol and it < max_iter:
         it += 1
-        c, s = np.cos(th), np.sin(th)
+        a, b, C = _hessian(th, mu, h, Mc, g, Bl)  # C: dc/dtheta, transposed (N, 2)
         ab = np.zeros((3, N))  # the tridiagonal Hessian, banded (upper, diagonal, lower)
-        ab[1] = -g * Mc * h * s - h * (mu[0] * c + mu[1] * s) + Bl[:N] + Bl[1:]
-        ab[0, 1:] = -Bl[1:N]
-        ab[2, :-1] = -Bl[1:N]
-        C = np.stack([-h * s, h * c], axis=1)  # dc/dtheta, transposed (N, 2)
+        ab[0, 1:], ab[1], ab[2, :-1] = b, a, b
         try:
             Z = solve_banded((1, 1), ab, np.column_stack([Gr, C]))
         except (LinAlgError, ValueError):
@@ -211,14 +242,17 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
         C = np.stack([-np.sin(th), np.cos(th)], axis=1)
         return np.linalg.lstsq(C, -Gr / h, rcond=None)[0]
 
+    def stable(th, mu, scale):
+        return unstable_directions(th, mu, h, Mc, g, scale * Bl) == 0
+
     total = 0
     th, mu = th0.copy(), initial_mu(th0, 1.0)
     th1, mu1, r, it, ok = _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_iter)
+    ok = ok and stable(th1, mu1, 1.0)  # (Newton may find an unstable shape: an arch standing up)
     total += it
     stages = 1
-    if not ok:  # continuation: the stiffness (and natural curvature) switched on by s = 0 -> 1
+    if not ok:  # continuation: the stiffness (and natural curvature) switched on by s = 0 -> 1, stable all along
         s, ds = 0.0, 1.0
-        kmul = np.ones(N + 1)
         th, mu = th0.copy(), initial_mu(th0, 0.0)
         th, mu, r, it, ok = _newton(th, mu, h, Mc, g, 0.0 * Bl, 0.0 * K0L, phi, False, target,
                                     max(g * float(Mc[-1]), 1e-300), tol, max_iter)
@@ -228,11 +262,11 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
             s1 = min(1.0, s + ds)
             # the clamp's angle moves from the free direction of the last link to phi with s
             ph = th[N - 1] + s1 * (phi - th[N - 1]) if clamped else phi
-            t2, m2, r2, it, ok2 = _newton(th.copy(), mu.copy(), h, Mc, g, s1 * Bl, s1 * kmul * K0L, ph, clamped,
+            t2, m2, r2, it, ok2 = _newton(th.copy(), mu.copy(), h, Mc, g, s1 * Bl, s1 * K0L, ph, clamped,
                                           target, max(g * float(Mc[-1]), float(np.max(s1 * Bl * np.r_[h, h[-1]]))
                                                       / L ** 2, 1e-300), tol, max_iter)
             total += it
-            if ok2:
+            if ok2 and stable(t2, m2, s1):
                 s, th, mu, r = s1, t2, m2, r2
                 ds = min(2.0 * ds, 1.0)
             else:
@@ -244,11 +278,12 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
         if ok:
             th1, mu1, r, it, ok = _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_iter)
             total += it
+            ok = ok and stable(th1, mu1, 1.0)
     if not ok:
         raise V.SnappingInputError(
-            f"start='equilibrium': no static equilibrium found for the line held at both ends (Newton from the "
-            f"catenary and {stages} continuation stages in the bending stiffness, {total} iterations): relative "
-            f"residual {r:.3g} > {tol:g}; use start='catenary'")
+            f"start='equilibrium': no stable static equilibrium found for the line held at both ends (Newton from "
+            f"the catenary and {stages} continuation stages in the bending stiffness, {total} iterations): relative "
+            f"residual {r:.3g} (at most {tol:g}, and a local minimum of the energy, wanted); use start='catenary'")
     xs = np.zeros(N + 1)
     ys = np.zeros(N + 1)
     xs[:N] = -np.cumsum((h * np.cos(th1))[::-1])[::-1]
