@@ -247,6 +247,11 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
 
     total = 0
     th, mu = th0.copy(), initial_mu(th0, 1.0)
+    if N <= 2:  # held at both ends, one or two links are a rigid frame: the start shape, its reactions
+        e = _result(h, th0, mu, g, Mc, 0.0, 0, 0)
+        return Equilibrium(x.copy(), y.copy(), *(getattr(e, k) for k in ("theta", "reaction_free", "reaction_held",
+                                                                         "residual", "iterations", "stages",
+                                                                         "converged")))
     th1, mu1, r, it, ok = _newton(th, mu, h, Mc, g, Bl, K0L, phi, clamped, target, fscale, tol, max_iter)
     ok = ok and stable(th1, mu1, 1.0)  # (Newton may find an unstable shape: an arch standing up)
     total += it
@@ -284,9 +289,14 @@ def hanging_equilibrium(links, body, x, y, *, gravity: float = 1.0, support=None
             f"start='equilibrium': no stable static equilibrium found for the line held at both ends (Newton from "
             f"the catenary and {stages} continuation stages in the bending stiffness, {total} iterations): relative "
             f"residual {r:.3g} (at most {tol:g}, and a local minimum of the energy, wanted); use start='catenary'")
+    return _result(h, th1, mu1, g, Mc, r, total, stages)
+
+
+def _result(h, th, mu, g, Mc, r, total, stages) -> Equilibrium:
+    N = h.size
     xs = np.zeros(N + 1)
     ys = np.zeros(N + 1)
-    xs[:N] = -np.cumsum((h * np.cos(th1))[::-1])[::-1]
-    ys[:N] = -np.cumsum((h * np.sin(th1))[::-1])[::-1]
-    held = -(mu1 + np.array([0.0, g * float(Mc[-1])]))
-    return Equilibrium(xs, ys, th1, mu1.copy(), held, float(r), int(total), int(stages), True)
+    xs[:N] = -np.cumsum((h * np.cos(th))[::-1])[::-1]
+    ys[:N] = -np.cumsum((h * np.sin(th))[::-1])[::-1]
+    held = -(mu + np.array([0.0, g * float(Mc[-1])]))
+    return Equilibrium(xs, ys, th, mu.copy(), held, float(r), int(total), int(stages), True)
