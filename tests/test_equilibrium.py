@@ -308,3 +308,10 @@ def test_cli_start_option(capsys, tmp_path):
     status = main(["simulate", "--shape", str(shape), "--N", "12", "--start", "equilibrium", "--no-progress"])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "--start='equilibrium' applies to the catenary and supports" in err[0]
+
+
+def test_one_or_two_links_held_at_both_ends_keep_their_start():
+    for N in (1, 2):
+        c = Problem.catenary(0.3, N)
+        p = Problem.catenary(0.3, N, body=Body(1e-2))
+        assert p.start["rest"] == "equilibrium" and np.array_equal(p.x, c.x) and np.array_equal(p.y, c.y)
