@@ -136,6 +136,10 @@ PROBLEM_ATTRS: dict[str, str] = {
     "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
                       "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
                       "to the held end) from then on, after it has risen above its value then"),
+    "start_rest": ("the shape a line with a body was released from, held at both ends at rest before: "
+                   "'equilibrium' (the discrete static equilibrium, with bending the heavy elastica, to a "
+                   "relative residual below 1e-12: snapping.simulate.equilibrium), 'catenary' (not in bending equilibrium), or 'as given' "
+                   "(a curve or nodes); runs of a problem with a body only"),
     "body": ("JSON description of the body (bending, curvature, damping, drag, wind, tip_drag, clamp; "
              "nondimensional), runs of a problem with a body only"),
 }

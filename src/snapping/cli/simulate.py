@@ -110,6 +110,11 @@ def _add_simulate(sub) -> None:
     p.add_argument("--pin-motion", default=None, metavar="SPEC",
                    help="held end: fixed (default), pull:AX,AY[,DURATION[,T0]] or flick:AX,AY,PERIOD[,T0]")
     p.add_argument("--gravity", type=float, default=1.0, help="gravity along +y in units of g (default 1; 0: none)")
+    p.add_argument("--start", default=None, choices=("catenary", "equilibrium"),
+                   help="the shape the line hangs in, held at both ends at rest, before its free end is released "
+                        "(--chi or --supports): the catenary, or the static equilibrium of the chain and its body "
+                        "(with bending the heavy elastica); default: the equilibrium when the line bends, else "
+                        "the catenary")
     from ._body import add_body_options
 
     add_body_options(p)
@@ -171,7 +176,7 @@ def _cmd_simulate(args) -> int:
                                pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
         body = body_from_args(args)
-        if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
+        if body is not None or args.start is not None:  # bending, drag, a clamp: a general problem (simulate.body)
             problem = attach_body(problem, body, args)
     try:
         if args.resume is not None:
