@@ -118,3 +118,33 @@ def test_verdict_is_computed_from_the_numbers():
 def test_bad_input_is_named(call, word):
     with pytest.raises(SnappingInputError, match=word.replace("(", r"\(")):
         call()
+
+
+def test_smooth_random_mode_is_the_same_field_at_every_N():
+    """mode "modes": eight sine modes with normal coefficients / mode number (computed here),
+    max 1 over the nodes; refining the chain samples the same field."""
+    a = np.random.default_rng(7).standard_normal(8) / np.arange(1, 9)
+    for N in (40, 80):
+        p = Problem3D.catenary(0.25, N)
+        q = p.perturbed(1e-3, "modes", seed=7)
+        s = np.concatenate([np.cumsum(p.links.h[::-1])[::-1], [0.0]])
+        phi = sum(a[j - 1] * np.sin(j * np.pi * s / s[0]) for j in range(1, 9))
+        phi[-1] = 0.0
+        np.testing.assert_allclose(q.v[:, 2], 1e-3 * phi / np.abs(phi).max(), rtol=0, atol=1e-17)
+    r40 = Problem3D.catenary(0.25, 40).perturbed(1e-3, "modes", seed=7).v[::2, 2]
+    r80 = Problem3D.catenary(0.25, 80).perturbed(1e-3, "modes", seed=7).v[::4, 2]
+    assert np.abs(r40[: r80.size] - r80).max() < 2e-2 * 1e-3  # (the max normalisation moves with N)
+
+
+def test_cli_shape_and_mode_number(capsys):
+    import json
+
+    from snapping.cli import main
+
+    assert main(["simulate", "--chi", "0.25", "--N", "12", "--perturb", "1e-4", "--perturb-kind", "shape",
+                 "--perturb-k", "2", "--tol", "1e-9", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    ref = run3d(Problem3D.catenary(0.25, 12).perturbed(1e-4, k=2, kind="shape"), tol=1e-9)
+    assert out["z_amp_snap"] == ref["z_amp_snap"] and out["v_peak"] == ref["v_peak"]
+    assert main(["simulate", "--chi", "0.25", "--N", "12", "--perturb", "1e-4", "--perturb-k", "-1"]) == 2
+    assert "k=-1" in capsys.readouterr().err

@@ -2,7 +2,8 @@
 
 A planar start (the catenary of ``chi``) perturbed out of its plane with amplitude ``eps``
 (:meth:`snapping.spatial.starts3d.Problem3D.perturbed`: a velocity ``eps sin(k pi s/L)``,
-a random one, or the shape displaced by ``eps L sin(pi s/L)`` and placed with exact chords)
+a smooth random one (eight sine modes, random coefficients: the same field at every N; the
+rough node-by-node ``"random"`` mode is a different field at every N and cannot be refined), or the shape displaced by ``eps L sin(pi s/L)`` and placed with exact chords)
 is run to the snap (:func:`snapping.spatial.solve3d.run3d`). In the linear regime (eps
 small: the problem is symmetric under z -> -z, so z/eps = G + O(eps^2)) the out-of-plane
 amplitude at the speed peak is ``G_z eps`` (largest distance of a node from the plane) and
@@ -44,7 +45,7 @@ __all__ = ["PERTURBATIONS", "start", "gains", "study", "classify", "linearity", 
 PERTURBATIONS = {
     "velocity sin": {"kind": "velocity", "mode": "sin", "k": 1},
     "velocity sin 3": {"kind": "velocity", "mode": "sin", "k": 3},
-    "velocity random": {"kind": "velocity", "mode": "random"},
+    "velocity random": {"kind": "velocity", "mode": "modes"},
     "shape sin": {"kind": "shape", "mode": "sin", "k": 1},
 }
 #: the seed of the random perturbation
@@ -182,7 +183,7 @@ def report_section(st: dict, lin: dict | None = None, figure_name: str | None = 
     Ns = st["N"]
     lines = ["## Beyond the paper: does the snap stay planar?", "",
              f"The catenary start of `snapping.spatial` perturbed out of its plane with amplitude eps = {st['eps']:g} "
-             f"(velocity eps sin(pi s/L), eps sin(3 pi s/L), random node values (seed {st['seed']}); shape: displaced "
+             f"(velocity eps sin(pi s/L), eps sin(3 pi s/L), random (8 sine modes, coefficients normal / mode number, seed {st['seed']}); shape: displaced "
              f"by eps L sin(pi s/L), exact chords), run to the snap at tol {st['tol']:g}. G_z = (largest distance of a "
              "node from the plane at the speed peak) / eps, G_vz = (largest out-of-plane speed there) / eps; limit: "
              "Richardson in 1/N with the observed order (`snapping.continuum.extrapolate`) where G converges, "

@@ -35,7 +35,9 @@ from . import chain3d as C
 __all__ = ["Problem3D", "Pin3D", "MODES"]
 
 #: perturbation modes of :meth:`Problem3D.perturbed`
-MODES = ("sin", "random")
+MODES = ("sin", "random", "modes")
+#: the number of sine modes of a smooth random perturbation (mode "modes")
+RANDOM_MODES = 8
 #: what :meth:`Problem3D.perturbed` perturbs
 KINDS = ("velocity", "shape")
 #: relative tolerance of a start's link lengths against the chain's, and of a unit direction's length
@@ -182,7 +184,10 @@ class Problem3D:
         mode shape ``phi(s)`` (``s``: arclength from the held end, ``L`` the chain's length):
         ``mode="sin"``: ``phi = sin(k pi s/L)`` (zero at both ends for every integer ``k``;
         ``k = 0``: no perturbation at all); ``"random"``: independent normal values (``seed``),
-        scaled to max 1, zero at the held end.
+        scaled to max 1, zero at the held end (rough: a different field for every N);
+        ``"modes"``: a smooth random field, ``sum_{j=1}^{8} a_j sin(j pi s/L) / j`` with normal
+        ``a_j`` (``seed``), scaled to max 1 over the nodes (the same field for every N, so that
+        a study can refine it).
 
         ``kind="velocity"``: ``eps * phi(s) * normal`` is added to every node's velocity
         (relative link velocities stay normal to links lying in the plane).
@@ -205,6 +210,12 @@ class Problem3D:
         s = np.concatenate([np.cumsum(h[::-1])[::-1], [0.0]])
         if mode == "sin":
             phi = np.sin(kk * np.pi * s / s[0])
+        elif mode == "modes":
+            a = np.random.default_rng(seed).standard_normal(RANDOM_MODES)
+            j = np.arange(1, RANDOM_MODES + 1)
+            phi = np.sin(np.pi * np.outer(s / s[0], j)) @ (a / j)
+            phi[-1] = 0.0
+            phi /= np.abs(phi).max()
         else:
             phi = np.random.default_rng(seed).standard_normal(self.N + 1)
             phi[-1] = 0.0
