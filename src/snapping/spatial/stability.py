@@ -126,7 +126,7 @@ def classify(N_values, G) -> dict:
     p = float(math.log(G[-1] / G[-2]) / math.log(N[-1] / N[-2]))
     bounded = bool(ex["converging"]) or p <= P_FLAT
     if ex["converging"]:
-        words = f"bounded: -> {ex['limit']:.4g} ± {ex['error']:.1g} (order {ex['order']:.2f})"
+        words = f"bounded: -> {ex['limit']:.4g} ± {ex['error']:.1g} (order {ex['order']:.2f}; N^{p:.3f} at the finest N)"
     elif bounded:
         words = f"bounded: no systematic growth (N^{p:+.3f} at the finest N)"
     else:
