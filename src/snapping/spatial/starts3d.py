@@ -10,8 +10,10 @@ problems) and the normal of the reference plane whose out-of-plane amplitude is 
 Starts: any planar :class:`snapping.simulate.problem.Problem` placed in the plane z = 0
 (:meth:`Problem3D.from_planar`), the paper's catenary (:meth:`Problem3D.catenary`), node
 coordinates (:meth:`Problem3D.nodes`), and the start only 3D has, a planar start with an
-out-of-plane velocity perturbation of amplitude ``eps`` (:meth:`Problem3D.perturbed`: the
-mode ``sin(pi s/L)`` of the arclength ``s`` from the held end, or random with a seed).
+out-of-plane perturbation of amplitude ``eps`` (:meth:`Problem3D.perturbed`) of its velocity
+or of its shape (displaced and placed again with exact chords): the mode ``sin(k pi s/L)`` of
+the arclength ``s`` from the held end, random node values with a seed, or a smooth random
+field of eight sine modes.
 
 Example
 -------
