@@ -59,7 +59,8 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     st, lin = saved["study"], saved["linearity"]
     assert st["N"] == [20, 40, 80] and st["chi"] == [0.25]
     assert f"**Verdict (computed): {S.verdict(st)['text']}.**" in text
-    for name in S.PERTURBATIONS:  # the row prints the study's numbers
+    assert st["perturbations"] == list(TINY.stability_perturbations)
+    for name in st["perturbations"]:  # the row prints the study's numbers
         row = next(l for l in text.splitlines() if l.startswith(f"| 0.25 | {name} |"))
         assert ", ".join(f"{x:.5g}" for x in S.series(st, 0.25, name, "z")) in row
     lin_row = next(l for l in text.splitlines() if l.startswith("| out-of-plane amplitude at the snap linear in eps"))

@@ -81,6 +81,9 @@ def test_classify_recovers_known_limits_and_exponents():
     assert w["bounded"] and not w["converging"]
     w = S.classify(N, 2.0 * n**(2 * S.P_FLAT))
     assert not w["bounded"]
+    slow = S.classify(N, 10.0 - 20.0 * n**-0.2)  # converging, but at order 0.2 < ORDER_MIN: not trusted
+    assert slow["converging"] and slow["order"] == pytest.approx(0.2, abs=1e-9) and slow["order"] < S.ORDER_MIN
+    assert not slow["bounded"] and slow["words"].startswith("growing as N^0.2")
     with pytest.raises(SnappingInputError):
         S.classify(N, [1.0, 0.0, 1.0, 1.0])
 
