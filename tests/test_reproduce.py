@@ -10,7 +10,8 @@ from snapping.reproduce import PLANS, Plan, expected_seconds, reproduce
 
 TINY = Plan(name="tiny", shapes_chi=(0.5, 0.25), shapes_N=40, speed_chi=(0.25,), speed_N=(20, 40),
             scaling_chi=(0.25, 0.4), scaling_N=40, tol_chi=0.25, tol_N=40, tols=(1e-7, 1e-8),
-            continuum_chi=(0.25,), continuum_levels=3, continuum_first=-3)
+            continuum_chi=(0.25,), continuum_levels=3, continuum_first=-3,
+            stability_chi=(0.25,), stability_N=(20, 40, 80), stability_lin=(0.25, 20))
 
 
 @pytest.fixture(scope="module")
@@ -47,6 +48,25 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     assert "method euler-richardson (the paper's), chords arclength" in text
     assert f"{float(u.attrs['v_peak']) / v_lim - 1:+.2%}" in row
     assert any(l.startswith("| 0.25 (") and "| kappa_max |" in l for l in text.splitlines())  # refitted exponents
+    # beyond the paper: the planar snap's stability, its figure, and its verdict from its numbers
+    import json
+
+    from snapping.spatial import stability as S
+
+    assert "## Beyond the paper: does the snap stay planar?" in text
+    assert (tmp_path / "figures" / "fig6_planar_stability.png").stat().st_size > 5000
+    saved = json.loads((tmp_path / "stability" / "study.json").read_text())
+    st, lin = saved["study"], saved["linearity"]
+    assert st["N"] == [20, 40, 80] and st["chi"] == [0.25]
+    assert f"**Verdict (computed): {S.verdict(st)['text']}.**" in text
+    assert st["perturbations"] == list(TINY.stability_perturbations)
+    for name in st["perturbations"]:  # the row prints the study's numbers
+        row = next(l for l in text.splitlines() if l.startswith(f"| 0.25 | {name} |"))
+        assert ", ".join(f"{x:.5g}" for x in S.series(st, 0.25, name, "z")) in row
+    lin_row = next(l for l in text.splitlines() if l.startswith("| out-of-plane amplitude at the snap linear in eps"))
+    assert lin_row.endswith(f"| {'linear' if lin['spread'] <= S.LINEAR_RTOL else 'not linear'} (spread "
+                            f"{'<=' if lin['spread'] <= S.LINEAR_RTOL else '>'} {S.LINEAR_RTOL:g}) |")
+    assert lin["linear"]
     # every claim row has four cells and a verdict
     rows = [l for l in text.splitlines() if l.startswith("| ") and not l.startswith("| claim") and "seconds" not in l]
     assert len(rows) >= 15
@@ -145,5 +165,5 @@ def test_wall_time_table_times_the_fits_and_each_figure_apart(tiny):
     _, text = tiny
     table = text.split("## Wall time")[1]
     for part in ("runs", "fits (Fig. 3/4 runs)", "fig1_shapes", "fig1e_pin_force", "fig2_profiles",
-                 "fig2d_peak_speed_vs_N", "fig3_maxima", "fig3_local_slopes", "fig4_delta", "total"):
+                 "fig2d_peak_speed_vs_N", "fig3_maxima", "fig3_local_slopes", "fig4_delta", "stability (3D)", "total"):
         assert re.search(rf"^\| {re.escape(part)} \| \d+\.\d \|$", table, re.M), part

@@ -20,6 +20,11 @@ magnitude of the bending moment at each link (the mean of its nodes': :func:`ben
 the tip body (a tip mass or a tip drag) as a circle, a clamped held end as a short thick
 handle along the clamp's direction (it turns with a prescribed clamp motion).
 
+A 3D run (:mod:`snapping.spatial.dataset3d`: its file has ``z``) gets a second panel: the
+chain seen along gravity, ``z`` (out of the start's plane) against ``x``, its scale fitted to
+the largest out-of-plane distance of all frames (a perturbation of 1e-6 stays visible),
+coloured as the first panel, which shows the chain projected on the start's plane.
+
 GIF is written with matplotlib's PillowWriter (pillow comes with matplotlib), MP4
 with FFMpegWriter when ``ffmpeg`` is on PATH.
 
@@ -261,8 +266,13 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     pad = 0.05 * max(xhi - xlo, hhi - hlo, 1e-9)
     xr, hr = xhi - xlo + 2 * pad, hhi - hlo + 2 * pad
     height = 5.0  # inches of the axes; the width follows the chain's extent (equal aspect) plus the colour bar
-    fig, ax = plt.subplots(figsize=(min(max(4.8, height * xr / hr + 2.2), 12.0), height + 1.0), dpi=100,
-                           layout="constrained")
+    spatial = "z" in ds.variables and int(ds.attrs.get("dims", 2)) == 3
+    width = min(max(4.8, height * xr / hr + 2.2), 12.0)
+    if spatial:  # the start's plane, and the chain seen along gravity
+        fig, (ax, az) = plt.subplots(1, 2, figsize=(width + 4.5, height + 1.0), dpi=100, layout="constrained",
+                                     gridspec_kw={"width_ratios": [max(width - 2.2, 2.6), 4.0]})
+    else:
+        fig, ax = plt.subplots(figsize=(width, height + 1.0), dpi=100, layout="constrained")
     ax.set_xlim(xlo - pad, xhi + pad)
     ax.set_ylim(hlo - pad, hhi + pad)
     ax.set_aspect("equal")
@@ -278,6 +288,27 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     chain.set_array(np.maximum(seg_speed[0], vmin))
     ax.add_collection(chain)
     pin, = ax.plot([X[0, -1]], [H[0, -1]], "ks", ms=6, zorder=3)
+    side = None
+    if spatial:
+        Z = np.asarray(ds["z"].values, dtype=float)[frames]
+
+        def side_segments(i):
+            pts = np.column_stack([X[i], Z[i]])
+            return np.stack([pts[:-1], pts[1:]], axis=1)
+
+        zmax = float(np.nanmax(np.abs(Z))) if np.any(np.isfinite(Z)) else 0.0
+        zlim = 1.1 * zmax if zmax > 0.0 else 1.0
+        side = LineCollection(side_segments(0), cmap="viridis", norm=norm, linewidths=2.0, capstyle="round")
+        side.set_array(np.maximum(seg_speed[0], vmin))
+        az.add_collection(side)
+        az.set_xlim(xlo - pad, xhi + pad)
+        az.set_ylim(-zlim, zlim)
+        az.axhline(0.0, color="0.6", lw=0.8)
+        az.set_xlabel(r"$x$  [$\ell$]")
+        az.set_ylabel(r"$z$ (out of the start's plane)  [$\ell$]")
+        az.set_title(f"seen along gravity (z scale: max |z| = {zmax:.3g})", fontsize=9)
+        az.grid(alpha=0.25)
+        ax.set_ylabel(r"height, in the start's plane  [$\ell$]")
     clamped = body is not None and body.clamp is not None and not isinstance(body.clamp, str)
     hl = 0.08 * max(xr, hr)  # the handle's drawn length
 
@@ -292,7 +323,7 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
                   label="tip body")[0] if tip_body else None
     if clamped or tip_body:
         ax.legend(loc="lower left", fontsize=8)
-    cb = fig.colorbar(chain, ax=ax, shrink=0.85, pad=0.02)
+    cb = fig.colorbar(chain, ax=[ax, az] if spatial else ax, shrink=0.85, pad=0.02)
     cb.set_label(r"bending moment $|M|$  [$M g \ell$]  (log scale)" if bending
                  else r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
     t_snap = float(ds.attrs.get("t_snap_v", np.nan))
@@ -301,7 +332,8 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
 
     import textwrap
 
-    fig.suptitle("\n".join(textwrap.wrap(f"falling chain, {run_label(ds)} (nondimensional)", 70)), fontsize=10)
+    fig.suptitle("\n".join(textwrap.wrap(f"falling chain{' in 3D' if spatial else ''}, {run_label(ds)} "
+                                         f"(nondimensional)", 70)), fontsize=10)
 
     def label(i):
         s = f"t = {T[i]:.6f}"
@@ -323,12 +355,15 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         if tip is not None:
             tip.set_data([X[i, 0]], [H[i, 0]])
         text.set_text(label(i))
+        if side is not None:
+            side.set_segments(side_segments(i))
+            side.set_array(np.maximum(seg_speed[i], vmin))
         return chain, pin, text
 
     anim = A.FuncAnimation(fig, update, frames=len(frames), blit=False, repeat=False)
     return fig, anim, {"chain": chain, "norm": norm, "frames": frames, "text": text, "update": update,
                        "segment_speed": seg_speed, "colour": "bending moment" if bending else "speed",
-                       "tip": tip, "handle": handle}
+                       "tip": tip, "handle": handle, "side": side}
 
 
 def animate(ds, output, *, fps: float = 8.0, max_frames: int | None = None, overwrite: bool = False) -> str:

@@ -59,6 +59,14 @@ class Plan:
     #: exact method with exact chords): Euler-Richardson from nodes at equal arclength
     method: str = "euler-richardson"
     chords: str = "arclength"
+    #: beyond the paper, the planar snap's stability (snapping.spatial.stability): chi, N
+    #: (doubling), the amplitude eps, and (chi, N) and the eps of the linearity check
+    stability_chi: tuple = (0.1, 0.25, 0.5)
+    stability_N: tuple = (100, 200, 400, 800)
+    stability_eps: float = 1e-6
+    stability_lin: tuple = (0.25, 100)
+    stability_lin_eps: tuple = (1e-6, 1e-5, 1e-4)
+    stability_perturbations: tuple = ("velocity sin", "velocity sin 3", "velocity random", "shape sin")
 
     def options(self, tol: float) -> dict:
         """The run options of every run of the plan at tolerance ``tol`` (the paper's method
@@ -110,6 +118,12 @@ PLANS = {
         continuum_levels=4,
         continuum_first=-1,
         record_thin=1e-3,
+        stability_chi=(0.25,),
+        stability_N=(50, 100, 200),
+        stability_lin=(0.25, 50),
+        # (the 8-mode random field is not resolved at N <= 200: its out-of-plane speed still
+        # grows as N^0.44 there, faster than the in-plane peak speed; --full has it at N = 800)
+        stability_perturbations=("velocity sin", "velocity sin 3", "shape sin"),
     ),
     "full": Plan(name="full"),
 }
@@ -132,6 +146,13 @@ def _continuum_seconds(plan: Plan) -> float:
     return sum(one.values()) + one[chi0]
 
 
+def _stability_seconds(plan: Plan) -> float:
+    """The stability study: 5 runs per chi and N at tol 1e-10, serial; 89 s for chi = 0.1, 0.25,
+    0.5 and N = 100-800 (1.49e6 evaluations) on the 2-core VM under load 7."""
+    runs = (1 + len(plan.stability_perturbations)) / 5.0
+    return 30.0 * runs * len(plan.stability_chi) * sum(plan.stability_N) / 1500.0 + 2.0
+
+
 def _rhs_evaluations(chi: float, N: int, tol: float) -> float:
     return 4.0e5 * (0.25 / chi) ** 0.9 * (N / 400.0) ** 0.35 * (1e-8 / tol) ** 0.5
 
@@ -140,7 +161,7 @@ def expected_seconds(plan: Plan, workers: int = 2) -> float:
     """A rough wall-time estimate of a plan's runs on ``workers`` cores (printed before a run starts)."""
     total = sum(_rhs_evaluations(c, n, t) * n * _NS_PER_NODE_EVAL * 1e-9 for c, n, t in plan.points())
     return ((total + _SECONDS_PER_RUN * len(plan.points())) / max(workers, 1) + _SECONDS_AFTER_RUNS
-            + _continuum_seconds(plan))
+            + _continuum_seconds(plan) + _stability_seconds(plan))
 
 
 def _path(out: Path, plan: Plan, chi: float, N: int, tol: float) -> Path:
@@ -488,6 +509,9 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     t1 = time.perf_counter()
     continuum_lines = _continuum(plan, out, figdir, log)
     timings["continuum limit"] = time.perf_counter() - t1
+    t1 = time.perf_counter()
+    stability_lines = _stability(plan, out, figdir, log)
+    timings["stability (3D)"] = time.perf_counter() - t1
 
     # ---------------------------------------------------------------- REPORT.md
     timings["total"] = time.perf_counter() - t0
@@ -498,6 +522,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
              "| claim | measured here | paper | verdict |", "|---|---|---|---|"]
     lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
     lines += [""] + continuum_lines + [""]
+    lines += stability_lines + [""]
     lines += ["", "## Fit report per run (Fig. 3 as numbers)", ""]
     for res in results:
         lines += [f"### chi = {res.chi:g}, N = {res.N}: t*_chi = {res.snap.t_star:.6f} ± {res.snap.t_star_err:.1e}", "", "```"]
@@ -513,7 +538,9 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
                       ("fig3_maxima", "Fig. 3: maxima against t*_chi - t with the folded-string scalings"),
                       ("fig3_local_slopes", "local log-log slopes and fit windows"),
                       ("fig4_delta", "Fig. 4: the scales delta and the predicted against computed peaks"),
-                      ("fig5_continuum", "the continuum limit: peaks against resolution, graded and uniform chains")):
+                      ("fig5_continuum", "the continuum limit: peaks against resolution, graded and uniform chains"),
+                      ("fig6_planar_stability", "beyond the paper: out-of-plane amplitude at the snap against eps, "
+                       "and its amplification against N with the in-plane focusing")):
         lines += [f"**{cap}**", "", f"![{name}](figures/{name}.png)", ""]
     lines += ["## Wall time", "", "| part | seconds |", "|---|---|"]
     lines += [f"| {k} | {v:.1f} |" for k, v in timings.items()]
@@ -557,3 +584,32 @@ def _continuum(plan: Plan, out: Path, figdir: Path, log) -> list[str]:
         except V.SnappingInputError as exc:  # e.g. too coarse a study to fit
             log(f"continuum limit chi = {chi:g}: no exponent fit on the finest level ({exc})")
     return continuum.report_section(studies, uniform, finest, fits)
+
+
+def _stability(plan: Plan, out: Path, figdir: Path, log) -> list[str]:
+    """Beyond the paper: the planar snap's stability (:mod:`snapping.spatial.stability`), its
+    figure and the report's section. The numbers are kept in ``out/stability/study.json``
+    and reused while the plan's stability parameters are the same."""
+    import json
+
+    from ._files import write_atomic
+    from .spatial import stability as S
+
+    params = {"chi": list(plan.stability_chi), "N": list(plan.stability_N), "eps": plan.stability_eps,
+              "perturbations": list(plan.stability_perturbations),
+              "lin": list(plan.stability_lin), "lin_eps": list(plan.stability_lin_eps), "tol": S.TOL, "seed": S.SEED}
+    path = out / "stability" / "study.json"
+    saved = json.loads(path.read_text()) if path.is_file() else {}
+    if saved.get("params") == params:
+        st, lin = saved["study"], saved["linearity"]
+    else:
+        st = S.study(plan.stability_chi, plan.stability_N, plan.stability_perturbations, eps=plan.stability_eps,
+                     tol=S.TOL, seed=S.SEED)
+        chi, N = plan.stability_lin
+        lin = S.linearity(chi, N, "velocity sin", plan.stability_lin_eps, tol=S.TOL, seed=S.SEED)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        text = json.dumps({"params": params, "study": st, "linearity": lin})
+        write_atomic(path, lambda tmp: Path(tmp).write_text(text), name="stability study")
+    figures.save(S.figure(st, lin), figdir / "fig6_planar_stability")
+    log(f"stability: {S.verdict(st)['text']}")
+    return S.report_section(st, lin)

@@ -19,9 +19,13 @@ def add_3d_options(p) -> None:
                    help="space dimensions: 3 runs the chain in space (snapping.spatial; implied by --perturb, --whirl)")
     p.add_argument("--perturb", type=float, default=None, metavar="EPS",
                    help="3D: add the out-of-plane start velocity EPS phi(s) (mode --perturb-mode)")
-    p.add_argument("--perturb-mode", default="sin", choices=["sin", "random"],
-                   help="3D: phi = sin(pi s/L) (default) or random node values (--seed), max 1")
-    p.add_argument("--seed", type=int, default=None, help="3D: seed of --perturb-mode random")
+    p.add_argument("--perturb-mode", default="sin", choices=["sin", "random", "modes"],
+                   help="3D: phi = sin(K pi s/L) (default), random node values, or 8 sine modes with random "
+                        "coefficients (--seed), max 1")
+    p.add_argument("--perturb-k", type=int, default=1, metavar="K", help="3D: the mode number K of --perturb-mode sin")
+    p.add_argument("--perturb-kind", default="velocity", choices=["velocity", "shape"],
+                   help="3D: perturb the start velocity (default) or the shape (displaced by EPS L phi(s), exact chords)")
+    p.add_argument("--seed", type=int, default=None, help="3D: seed of --perturb-mode random or modes")
     p.add_argument("--whirl", type=float, default=None, metavar="OMEGA",
                    help="3D: start whirling at the rate OMEGA about the vertical through the held end (steady shape)")
 
@@ -86,7 +90,8 @@ def cmd_simulate3d(args, times) -> int:
             planar = attach_body(planar, body, args)
         problem = Problem3D.from_planar(planar)
     if args.perturb is not None:
-        problem = problem.perturbed(args.perturb, args.perturb_mode, seed=args.seed)
+        problem = problem.perturbed(args.perturb, args.perturb_mode, seed=args.seed, k=args.perturb_k,
+                                    kind=args.perturb_kind)
     tol = 1e-8 if args.tol is None else args.tol
     ds = run3d_dataset(problem, tol=tol, t_end=args.t_end, stop_fraction=args.stop_fraction, snapshot_times=times,
                        output=args.output, overwrite=args.overwrite, max_link_error=min(args.max_link_error, 1e-6))

@@ -8,6 +8,8 @@
 * :mod:`snapping.spatial.dataset3d`: the run Dataset of a 3D run (the planar names, and
   ``z``, ``vz``, ``z_amp``, ... of ``snapping.schema.SPATIAL_VARS``);
 * :mod:`snapping.spatial.figures3d`: the out-of-plane amplitude against eps, the chain in space.
+* :mod:`snapping.spatial.stability`: does the planar snap stay planar? The out-of-plane
+  amplification at the snap against N, extrapolated, and a computed verdict.
 
 It imports from :mod:`snapping.simulate` (links, the catenary, the DOP853 tableau); the
 planar simulator does not import it.

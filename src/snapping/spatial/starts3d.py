@@ -10,8 +10,10 @@ problems) and the normal of the reference plane whose out-of-plane amplitude is 
 Starts: any planar :class:`snapping.simulate.problem.Problem` placed in the plane z = 0
 (:meth:`Problem3D.from_planar`), the paper's catenary (:meth:`Problem3D.catenary`), node
 coordinates (:meth:`Problem3D.nodes`), and the start only 3D has, a planar start with an
-out-of-plane velocity perturbation of amplitude ``eps`` (:meth:`Problem3D.perturbed`: the
-mode ``sin(pi s/L)`` of the arclength ``s`` from the held end, or random with a seed).
+out-of-plane perturbation of amplitude ``eps`` (:meth:`Problem3D.perturbed`) of its velocity
+or of its shape (displaced and placed again with exact chords): the mode ``sin(k pi s/L)`` of
+the arclength ``s`` from the held end, random node values with a seed, or a smooth random
+field of eight sine modes.
 
 Example
 -------
@@ -35,7 +37,11 @@ from . import chain3d as C
 __all__ = ["Problem3D", "Pin3D", "MODES"]
 
 #: perturbation modes of :meth:`Problem3D.perturbed`
-MODES = ("sin", "random")
+MODES = ("sin", "random", "modes")
+#: the number of sine modes of a smooth random perturbation (mode "modes")
+RANDOM_MODES = 8
+#: what :meth:`Problem3D.perturbed` perturbs
+KINDS = ("velocity", "shape")
 #: relative tolerance of a start's link lengths against the chain's, and of a unit direction's length
 SHAPE_RTOL = 1e-6
 UNIT_RTOL = 1e-9
@@ -174,29 +180,67 @@ class Problem3D:
 
         return cls.from_planar(Problem.catenary(chi, N, **kw))
 
-    def perturbed(self, eps: float, mode: str = "sin", *, seed: int | None = None) -> "Problem3D":
-        """This start with an out-of-plane velocity ``eps * phi(s) * normal`` added at every node
-        (``s``: arclength from the held end). ``mode="sin"``: ``phi = sin(pi s/L)`` (zero at
-        both ends); ``"random"``: independent normal values (``seed``), scaled to max 1, zero at
-        the held end. Relative link velocities stay normal to links lying in the plane."""
+    def perturbed(self, eps: float, mode: str = "sin", *, seed: int | None = None, k: int = 1,
+                  kind: str = "velocity") -> "Problem3D":
+        """This start perturbed out of its plane with amplitude ``eps`` along ``normal``, in the
+        mode shape ``phi(s)`` (``s``: arclength from the held end, ``L`` the chain's length):
+        ``mode="sin"``: ``phi = sin(k pi s/L)`` (zero at both ends for every integer ``k``;
+        ``k = 0``: no perturbation at all); ``"random"``: independent normal values (``seed``),
+        scaled to max 1, zero at the held end (rough: a different field for every N);
+        ``"modes"``: a smooth random field, ``sum_{j=1}^{8} a_j sin(j pi s/L) / j`` with normal
+        ``a_j`` (``seed``), scaled to max 1 over the nodes (the same field for every N, so that
+        a study can refine it).
+
+        ``kind="velocity"``: ``eps * phi(s) * normal`` is added to every node's velocity
+        (relative link velocities stay normal to links lying in the plane).
+        ``kind="shape"``: the start is displaced out of its plane by ``eps * L * phi(s) *
+        normal`` and placed again with exact chords (link j from the held end along the
+        displaced curve's chord direction, its length exactly the link's: every link turns
+        out of the plane by O(eps), the in-plane positions move at O(eps^2)); the velocities
+        keep their value where the new links allow it (each link's relative velocity made
+        normal to the link, summed from the held end; a start at rest stays at rest)."""
         e = V.real("eps", eps)
         if not math.isfinite(e) or abs(e) > 1e3:
             raise V.SnappingInputError(f"eps={eps!r} is out of range: the perturbation amplitude must be finite, "
                                        f"|eps| <= 1e3")
         if mode not in MODES:
             raise V.SnappingInputError(f"mode={mode!r} is not one of {MODES}")
+        if kind not in KINDS:
+            raise V.SnappingInputError(f"kind={kind!r} is not one of {KINDS}")
+        kk = V.integer("k", k, 0)
         h = self.links.h
         s = np.concatenate([np.cumsum(h[::-1])[::-1], [0.0]])
         if mode == "sin":
-            phi = np.sin(np.pi * s / s[0])
+            phi = np.sin(kk * np.pi * s / s[0])
+        elif mode == "modes":
+            a = np.random.default_rng(seed).standard_normal(RANDOM_MODES)
+            j = np.arange(1, RANDOM_MODES + 1)
+            phi = np.sin(np.pi * np.outer(s / s[0], j)) @ (a / j)
+            phi[-1] = 0.0
+            phi /= np.abs(phi).max()
         else:
             phi = np.random.default_rng(seed).standard_normal(self.N + 1)
             phi[-1] = 0.0
             phi /= np.abs(phi).max()
         n = np.asarray(self.normal)
-        v = self.v + e * phi[:, None] * n[None, :]
-        start = {**self.start, "perturbation": {"eps": e, "mode": mode, "seed": seed, "kind": "velocity"}}
-        return replace(self, v=v, start=start)
+        r, v = self.r, self.v
+        if kind == "velocity":
+            v = v + e * phi[:, None] * n[None, :]
+        elif e != 0.0 and np.any(phi != 0.0):  # (a zero displacement leaves the start as it is, bit for bit)
+            d = np.diff(r + (e * s[0]) * phi[:, None] * n[None, :], axis=0)  # link j: node j -> node j + 1
+            d = d / np.linalg.norm(d, axis=1)[:, None]
+            links = h[:, None] * d
+            r = np.zeros_like(self.r)
+            r[:-1] = -np.cumsum(links[::-1], axis=0)[::-1]  # from the held end (origin) outward
+            dv = np.diff(self.v, axis=0)
+            dv -= np.sum(dv * d, axis=1)[:, None] * d
+            v = np.zeros_like(self.v)
+            v[:-1] = -np.cumsum(dv[::-1], axis=0)[::-1]
+        pert = {"eps": e, "mode": mode, "seed": seed, "kind": kind}
+        if mode == "sin":
+            pert["k"] = kk
+        start = {**self.start, "perturbation": pert}
+        return replace(self, r=r, v=v, start=start)
 
     @classmethod
     def whirling(cls, omega: float, N: int | None = None, *, links: Links | None = None, gravity: float = 1.0,
