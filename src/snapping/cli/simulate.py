@@ -59,6 +59,11 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
+            "the extensible, tension-only line (links go slack; Radau on the banded Jacobian):\n"
+            "  snapping simulate --chi 0.25 --N 60 --stretching 30                 # c = 30 sqrt(gL)\n"
+            "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --ea 900 --damping 2  # SI: N, N s\n"
+            "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --strain-table rope.csv -o run.nc\n"
+            "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
@@ -104,6 +109,9 @@ def _add_simulate(sub) -> None:
     from ._body import add_body_options
 
     add_body_options(p)
+    from ._elastic import add_elastic_options
+
+    add_elastic_options(p)
     p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
@@ -138,6 +146,9 @@ def _cmd_simulate(args) -> int:
         _times(times)  # a bad time is named first
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} without -o RUN.nc: the snapshots are "
                                  f"profiles kept only in the run file; add -o RUN.nc (or leave out --snapshot-times)")
+    from ._elastic import elastic_from_args
+
+    elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
     if args.resume is None and (not start_given or args.N is None):
@@ -151,9 +162,12 @@ def _cmd_simulate(args) -> int:
         from ._body import attach_body, body_from_args, line_links
 
         problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
-                               tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
+                               tip_mass=args.tip_mass, taper=taper,
+                               lumping=args.lumping or ("shared" if elastic is not None else None),
                                pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
+        if elastic is not None:
+            return _simulate_elastic(args, problem, elastic, times, scales)
         body = body_from_args(args)
         if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
             problem = attach_body(problem, body, args)
@@ -237,6 +251,31 @@ def _cmd_simulate(args) -> int:
         _print_dimensionless(numbers)
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _simulate_elastic(args, problem, elastic, times, scales) -> int:
+    """The extensible line's run (snapping.simulate.elastic): its summary, -o its Dataset."""
+    from .. import units
+    from ._elastic import run_elastic
+
+    summary, ds = run_elastic(args, problem, elastic, times)
+    if args.output:
+        summary["output"] = args.output
+    numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass)
+    if args.json:
+        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales),
+                                                      **({"dimensionless_numbers": numbers} if numbers else {})}))
+    else:
+        rows = [(k, f"{v:.10g}" if isinstance(v, float) else v, None) for k, v in summary.items()
+                if k not in ("problem", "elastic")]
+        rows.append(("elastic", summary["elastic"], "EA and damping in M g, M g sqrt(L/g)"))
+        print_table(rows, title=f"snapping simulate (extensible line): N={args.N}, {_problem_title(summary)}")
+        _print_si(scales, units.si_rows(summary, scales) if scales else [])
+        _print_dimensionless(numbers)
+    if summary["status"] != "completed":
+        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}", file=sys.stderr)
         return 1
     return 0
 

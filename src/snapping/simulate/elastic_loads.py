@@ -40,7 +40,7 @@ def massless_peak_force(mass: float, fall_factor: float, ea: float, g: float = 9
     ``mass`` (kg) after a fall of ``fall_factor`` rope lengths (N, for ``ea`` in N).
 
     >>> round(massless_peak_force(80.0, 1.77, 20e3, 9.81), 3)
-    8412.906
+    8280.115
     """
     w = V.positive("mass", mass) * V.positive("g", g)
     return w * (1.0 + math.sqrt(1.0 + 2.0 * V.positive("fall_factor", fall_factor) * V.positive("ea", ea) / w))
