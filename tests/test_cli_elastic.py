@@ -29,11 +29,12 @@ def test_si_ea_and_damping_become_the_nondimensional_line(tmp_path, capsys):
     line), --damping D [N s] is D/(M g sqrt(L/g)); the run file holds the elastic names."""
     EA, D = 400.0, 0.7
     out = tmp_path / "run.nc"
-    s = _json(capsys, BASE + SI + ["--ea", str(EA), "--damping", str(D), "-o", str(out)])
+    s = _json(capsys, BASE + SI + ["--ea", str(EA), "--damping", str(D), "--grid-damping", "0.5", "-o", str(out)])
     assert s["wave_speed"] == pytest.approx(math.sqrt(EA / (M * G)), rel=1e-12)
     el = json.loads(s["elastic"])
     assert el["ea"] == pytest.approx(EA / (M * G), rel=1e-12)
     assert el["damping"] == pytest.approx(D / (M * G * math.sqrt(L / G)), rel=1e-12)
+    assert el["grid_damping"] == 0.5
     assert s["status"] == "completed" and s["model"] == "elastic"
     with xr.open_dataset(out) as ds:
         for name in ("strain", "elastic_energy", "axial_stiffness", "dissipated", "n_slack"):
@@ -67,6 +68,8 @@ def test_stretching_twin_and_a_linear_strain_table_give_the_same_run(tmp_path, c
     (["--stretching", "0"], "--stretching=0.0 is out of range"),
     (SI + ["--ea", "100", "--damping", "-1"], "--damping=-1.0 is out of range"),
     (["--stretching", "10", "--axial-damping", "nan"], "--axial-damping=nan is out of range"),
+    (["--stretching", "10", "--grid-damping", "-1"], "--grid-damping=-1.0 is out of range"),
+    (["--grid-damping", "1"], "exactly one of --ea"),
     (["--stretching", "10", "--method", "euler-richardson"], "--stretching (the extensible line) with --method euler"),
     (["--ea", "100"], "--ea is in SI: it needs --length"),
     (SI + ["--ea", "100", "--stretching", "3"], "exactly one of --ea"),

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 #: the dests of the elastic options (any of them given: the elastic model)
-ELASTIC_DESTS = ("ea", "stretching", "axial_damping_si", "axial_damping", "strain_table")
+ELASTIC_DESTS = ("ea", "stretching", "axial_damping_si", "axial_damping", "grid_damping", "strain_table")
 #: simulate options the elastic model does not take (dest: why)
 NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
                "record_thin": "--record-thin thins the rigid-link record",
@@ -30,6 +30,9 @@ def add_elastic_options(p) -> None:
                    help="Kelvin-Voigt axial damping, N s (tension + damping x strain rate while taut; SI)")
     g.add_argument("--axial-damping", dest="axial_damping", type=float, default=None, metavar="ETA",
                    help="Kelvin-Voigt axial damping in units of M g sqrt(L/g)")
+    g.add_argument("--grid-damping", dest="grid_damping", type=float, default=None, metavar="ZETA",
+                   help="damping ratio of the shortest longitudinal mode (added Kelvin-Voigt damping; ~1 damps "
+                        "the release's grid-scale ringing, the long waves by about ZETA pi/(4N))")
     g.add_argument("--strain-table", default=None, metavar="CSV",
                    help="tension-strain curve: rows strain,tension (tension in N with --length/--mass, else in "
                         "M g), strains increasing from 0; replaces --ea")
@@ -125,15 +128,18 @@ def elastic_from_args(args, scales):
         if not (math.isfinite(v) and v >= 0.0):
             raise SnappingInputError(f"{opt}={v!r} is out of range: the damping must be finite and >= 0")
         damping = v / (force * scales.time) if opt == "--damping" else v
+    zeta = 0.0 if args.grid_damping is None else args.grid_damping
+    if not (math.isfinite(zeta) and zeta >= 0.0):
+        raise SnappingInputError(f"--grid-damping={zeta!r} is out of range: the damping ratio must be finite and >= 0")
     if args.ea is not None:
         ea = _finite_positive("--ea", args.ea, "the axial stiffness EA (N)")
-        return Elastic(ea=ea / force, damping=damping)
+        return Elastic(ea=ea / force, damping=damping, grid_damping=zeta)
     if args.stretching is not None:
         c = _finite_positive("--stretching", args.stretching, "the wave speed c/sqrt(g L)")
-        return Elastic.from_wave_speed(c, damping=damping)
+        return Elastic.from_wave_speed(c, damping=damping, grid_damping=zeta)
     e, t = _read_table(args.strain_table)
     try:
-        return Elastic(table=(e, [v / force for v in t]), damping=damping)
+        return Elastic(table=(e, [v / force for v in t]), damping=damping, grid_damping=zeta)
     except SnappingInputError as exc:
         raise SnappingInputError(f"--strain-table={args.strain_table!r}: {exc}") from None
 

@@ -60,7 +60,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
             "the extensible, tension-only line (links go slack; Radau on the banded Jacobian):\n"
-            "  snapping simulate --chi 0.25 --N 60 --stretching 30                 # c = 30 sqrt(gL)\n"
+            "  snapping simulate --chi 0.25 --N 60 --stretching 30 --grid-damping 1  # c = 30 sqrt(gL)\n"
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --ea 900 --damping 2  # SI: N, N s\n"
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --strain-table rope.csv -o run.nc\n"
             "\n"
