@@ -42,9 +42,11 @@ def test_grid_damping_gives_each_longitudinal_mode_zeta_omega_over_omega_max(zet
 
 
 def test_grid_damping_adds_to_the_given_damping_and_is_described():
-    p = _hanging(5)
-    a = ElasticLine(p, Elastic(ea=100.0, damping=0.2, grid_damping=0.5))
-    np.testing.assert_allclose(a.damp, 0.2 + 0.5 * 0.2 * np.sqrt(100.0 * 1.0), rtol=1e-14)
+    rho = np.array([1.0, 2.0, 3.0, 4.0, 5.0])  # mass per length of each link (free end first)
+    links = Links.from_density(np.full(5, 0.2), rho)
+    y = np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]])
+    a = ElasticLine(Problem.nodes(np.zeros(6), y, links=links), Elastic(ea=100.0, damping=0.2, grid_damping=0.5))
+    np.testing.assert_allclose(a.damp, 0.2 + 0.5 * 0.2 * np.sqrt(100.0 * rho), rtol=1e-14)
     assert Elastic(ea=1.0, grid_damping=0.5).describe()["grid_damping"] == 0.5
     for bad in (-0.1, float("nan"), float("inf")):
         with pytest.raises(SnappingInputError, match="^grid_damping="):
