@@ -58,6 +58,9 @@ def test_stretching_twin_and_a_linear_strain_table_give_the_same_run(tmp_path, c
         assert t[k] == pytest.approx(a[k], rel=1e-7)
     # (the peak tension in N is sigma_peak M g)
     assert a["si"]["values"]["sigma_peak"]["value"] == pytest.approx(a["sigma_peak"] * M * G, rel=1e-12)
+    # the stretching number c/sqrt(g L) = sqrt(EA/(lambda g L)), lambda = M/L, from --ea and from the table
+    assert a["si"]["dimensionless_numbers"]["stretching"] == pytest.approx(c, rel=1e-12)
+    assert t["si"]["dimensionless_numbers"]["stretching"] == pytest.approx(c, rel=1e-12)
 
 
 @pytest.mark.parametrize("extra, needle", [

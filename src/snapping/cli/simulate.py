@@ -264,6 +264,11 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
     if args.output:
         summary["output"] = args.output
     numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass)
+    if numbers is not None and "stretching" not in numbers:  # (--stretching or --strain-table: the run's c)
+        from .. import dimensionless
+
+        numbers = {k: (summary["wave_speed"] if k == "stretching" else numbers.get(k)) for k in dimensionless.NUMBERS
+                   if k in numbers or k == "stretching"}
     if args.json:
         print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales),
                                                       **({"dimensionless_numbers": numbers} if numbers else {})}))
