@@ -367,7 +367,7 @@ def test_energy_balance_of_a_run_with_bending_damping_drag_wind_and_a_moving_cla
     bal = ds.energy - ds.pin_work + ds.dissipated
     drift = float(np.abs(bal - bal[0]).max())
     D = float(ds.dissipated[-1])
-    assert D > 0.05 and float(ds.bending_energy.max()) > 1e-3 and float(np.abs(ds.pin_work).max()) > 0.01
+    assert D > 0.05 and float(ds.bending_energy.max()) > 1e-3 and float(np.abs(ds.pin_work).max()) > 0.005
     assert drift < 1e-7 and drift == pytest.approx(ds.attrs["energy_drift"], rel=1e-6, abs=1e-15)
     # the stepper's check is on the balance: a bound below the dissipated energy is not hit
     run(p, t_end=1.0, tol=1e-9, max_energy_drift=1e-6, progress=False)
@@ -409,8 +409,9 @@ def test_per_node_profiles_are_checked_against_the_chain():
     assert d["bending"]["function"].startswith("taper") and len(d["nodes"]["bending"]) == 11
 
 
-def test_clamp_at_the_start_direction():
-    p = Problem.catenary(0.3, 10, body=Body(bending=1e-3, clamp="start"))
+@pytest.mark.parametrize("start", ["catenary", "equilibrium"])
+def test_clamp_at_the_start_direction(start):
+    p = Problem.catenary(0.3, 10, body=Body(bending=1e-3, clamp="start"), start=start)
     x, y = p.x, p.y
     assert p.body.clamp == math.atan2(y[-2] - y[-1], x[-2] - x[-1])
     assert math.pi / 4 < p.body.clamp < math.pi / 2  # (the catenary leaves the held end down and to the right)
@@ -545,7 +546,7 @@ def test_a_body_run_interrupted_resumes_bit_for_bit(tmp_path, monkeypatch):
 
     def hook(eng):
         calls.append(eng.t)
-        return signal_int if len(calls) == 3 else None
+        return signal_int if len(calls) == 2 else None  # (chunks of 20 steps; the run from rest takes 48)
 
     import signal
 

@@ -204,11 +204,12 @@ def test_cli_sweep_with_an_si_body(tmp_path, capsys):
 
 # ------------------------------------------------------------------- converge
 def test_converge_with_bending_converges_to_the_rod_at_second_order():
-    """Uniform chains of 50..400 links with beta = 1e-4 at chi = 0.25: the peak speed and
+    """Uniform chains of 50..400 links with beta = 1e-4 at chi = 0.25, released from the line's
+    rest shape (the heavy elastica, the default start with bending): the peak speed and
     acceleration and the snapping time converge with an observed order near 2 (measured:
-    1.89, 2.01, 2.07; consistent lumping). The peak tension and curvature do not yet: the
-    fold's radius sqrt(B/T) is ~3e-3 there, about one link of the finest level (with an
-    800-link level, v_peak 5.9133, order 1.86: the guide's table)."""
+    2.02, 2.12, 2.23; consistent lumping; from the catenary 1.89, 2.01, 2.07 to a limit of
+    5.909). The peak tension and curvature do not yet: the fold's radius sqrt(B/T) is ~3e-3
+    there, about one link of the finest level."""
     from snapping import continuum
 
     c = continuum.converge(0.25, levels=4, n0=50, body=Body(1e-4))
@@ -217,7 +218,7 @@ def test_converge_with_bending_converges_to_the_rod_at_second_order():
     assert c.summary()["body"] == {"beta": 1e-4}
     for q in ("v_peak", "a_peak", "t_snap_v"):
         assert 1.6 < a[f"{q}_order"] < 2.5, (q, a[f"{q}_order"])
-    assert a["v_peak_limit"] == pytest.approx(5.909, abs=0.01)
+    assert a["v_peak_limit"] == pytest.approx(5.788, abs=0.01)
     with pytest.raises(SnappingInputError, match="n0"):
         continuum.converge(0.25, levels=3, n0=50, ratio=0.3, body=Body(1e-4))
 

@@ -136,8 +136,22 @@ PROBLEM_ATTRS: dict[str, str] = {
     "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
                       "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
                       "to the held end) from then on, after it has risen above its value then"),
+    "start_rest": ("the shape a line with a body was released from, held at both ends at rest before: "
+                   "'equilibrium' (the discrete static equilibrium, with bending the heavy elastica, to a "
+                   "relative residual below 1e-12: snapping.simulate.equilibrium), 'catenary' (not in bending equilibrium), or 'as given' "
+                   "(a curve or nodes); runs of a problem with a body only"),
     "body": ("JSON description of the body (bending, curvature, damping, drag, wind, tip_drag, clamp; "
              "nondimensional), runs of a problem with a body only"),
+}
+
+#: Global attributes of runs of the stiff method, or of a problem with bending run with
+#: ``method='fast'`` (which then chooses between dop853 and rodas4:
+#: :mod:`snapping.simulate.stiffness`); absent elsewhere.
+METHOD_ATTRS: dict[str, str] = {
+    "method_choice": ("why method='fast' ran this method ('method' names it): the shortest bending wave's "
+                      "frequency and damping ratio, and the explicit method's estimated steps"),
+    "n_jacobians": "Jacobians of the stiff method (rodas4; each 20 complex-step evaluations of the rows)",
+    "n_factorizations": "banded LU factorisations of the stiff method's stage matrix (rodas4)",
 }
 
 #: Global attributes: inputs. A run file alone must be enough to rerun it.
@@ -259,6 +273,11 @@ CHECKPOINT_DIMS = {
     "checkpoint_stage": "the 16 Runge-Kutta stages of a DOP853 step (12, and 4 of the dense output)",
     "checkpoint_dense": "the 7 coefficient vectors of a DOP853 step's dense output",
     "checkpoint_angle": "the 2N angle-form unknowns (link angles, then angular velocities)",
+    "checkpoint_rodas_stage": "f at a RODAS4 step's start, its 6 stage increments U_1 .. U_6, f at its end",
+    "checkpoint_jacobian_var": "the variables theta, omega, a, T of the rows' banded derivatives",
+    "checkpoint_jacobian_colour": "the 5 colours (links 5 apart) of the rows' banded derivatives",
+    "checkpoint_jacobian_row": "the 2N rows (angle and tension row of each link) of the banded derivatives",
+    "checkpoint_count": "the RODAS4 counters: Jacobians, factorisations, extra evaluations, singular matrices",
 }
 
 #: The complete state of an unfinished run, stored in the run file itself next to the
@@ -296,6 +315,26 @@ CHECKPOINT_VARS_DOP853: dict[str, dict[str, str]] = {
                                        "checkpoint_snapshot_t", "checkpoint_requested",
                                        "checkpoint_after_fractions")},
 }
+#: The complete state of an unfinished run of the stiff method (``method = 'rodas4'``): the
+#: step slots of the RODAS4 loop and the Jacobian at the current state (the shared names
+#: mean the same as in CHECKPOINT_VARS_DOP853).
+CHECKPOINT_VARS_RODAS4: dict[str, dict[str, str]] = {
+    "checkpoint_Y0": CHECKPOINT_VARS_DOP853["checkpoint_Y0"],
+    "checkpoint_Y1": CHECKPOINT_VARS_DOP853["checkpoint_Y1"],
+    "checkpoint_stages": _v("f at the start, the stage increments U_1 .. U_6 and f at the end of the two stored "
+                            "RODAS4 steps (they give the continuous extension)"),
+    "checkpoint_step_t": CHECKPOINT_VARS_DOP853["checkpoint_step_t"],
+    "checkpoint_step_h": CHECKPOINT_VARS_DOP853["checkpoint_step_h"],
+    "checkpoint_jacobian": _v("coloured banded derivatives of the rows at the current state (the next step's "
+                              "Jacobian)"),
+    "checkpoint_counts": _v("Jacobians, banded factorisations, extra evaluations and singular stage matrices so far"),
+    "checkpoint_Z": CHECKPOINT_VARS_DOP853["checkpoint_Z"],
+    "checkpoint_peak_t": CHECKPOINT_VARS_DOP853["checkpoint_peak_t"],
+    **{k: CHECKPOINT_VARS[k] for k in ("checkpoint_peak_state", "checkpoint_ctl", "checkpoint_pk", "checkpoint_meas",
+                                       "checkpoint_meas0", "checkpoint_rinv0", "checkpoint_snapshot_state",
+                                       "checkpoint_snapshot_t", "checkpoint_requested",
+                                       "checkpoint_after_fractions")},
+}
 #: String variable (no units) holding the kinds of the snapshots so far.
 CHECKPOINT_KIND_VAR = "checkpoint_snapshot_kind"
 
@@ -312,3 +351,39 @@ CHECKPOINT_ATTRS: dict[str, str] = {
 #: values; :func:`snapping.simulate.dataset.content_digest`). A checkpoint whose digest
 #: does not match (an edited ``chi``, a damaged state) is not resumed.
 DIGEST_ATTR = "integrity_sha256"
+
+# ---------------------------------------------------------------- 3D runs
+#: Names that only a 3D run (:mod:`snapping.spatial`, :mod:`snapping.spatial.dataset3d`) has.
+#: A 3D run Dataset uses the planar names above where they mean the same (``x``, ``y``,
+#: ``vx``, ``v_max``, ``t_snap_v``, ...; ``y`` along gravity's default direction, downward)
+#: and these for the third coordinate and what only space has. A planar run has none of them.
+#: ``energy`` of a 3D run has the planar zero: the chain hanging straight down at rest from a
+#: held end at the origin.
+SPATIAL_STEP_VARS: dict[str, dict[str, str]] = {
+    "z_amp": _v("out-of-plane amplitude: largest distance of a node from the reference plane through the held end"),
+    "vz_amp": _v("largest out-of-plane node speed (velocity component along the reference plane's normal)"),
+    "angular_momentum_g": _v("angular momentum about the held end along gravity's direction"),
+}
+SPATIAL_NODE_PROFILE_VARS: dict[str, dict[str, str]] = {
+    "z": _v("node position, e3 component (out of the e1-e2 plane)"),
+    "vz": _v("node velocity, e3 component"),
+    "az": _v("node acceleration, e3 component"),
+}
+SPATIAL_PROBLEM_VARS: dict[str, dict[str, str]] = {
+    "start_z": _v("node position at t = 0, e3 component"),
+    "start_vz": _v("node velocity at t = 0, e3 component"),
+}
+#: Global attributes of a 3D run, besides the planar ones that mean the same.
+SPATIAL_ATTRS: dict[str, str] = {
+    "dims": "number of space dimensions of the run (3: snapping.spatial; planar runs have no such attribute)",
+    "g_dir": "unit direction of gravity (x, y, z)",
+    "normal": "unit normal of the reference plane whose out-of-plane amplitude z_amp measures",
+    "perturbation": "JSON description of the out-of-plane perturbation of the start ('' if none)",
+    "whirl": "rotation rate of a whirling start about the vertical through the held end (NaN: not whirling)",
+    "z_amp_snap": "out-of-plane amplitude at the speed peak (t_snap_v)",
+    "vz_amp_snap": "largest out-of-plane node speed at the speed peak",
+    "z_amp_max": "largest out-of-plane amplitude over the run",
+    "angular_momentum_drift": "max |angular_momentum_g(t) - angular_momentum_g(0)| (conserved: fixed end, gravity only)",
+    "link_error_max": "largest | |e_j| - 1 | at the end of an accepted step before its projection",
+}
+SPATIAL_VARS = {**SPATIAL_STEP_VARS, **SPATIAL_NODE_PROFILE_VARS, **SPATIAL_PROBLEM_VARS}

@@ -264,9 +264,10 @@ def _si_value(v):
 
 
 def attach_body(problem, body, args):
-    """The problem (None: the paper's, from --chi and --N) with the body of :func:`body_from_args`."""
+    """The problem (None: the paper's, from --chi and --N) with the body of :func:`body_from_args`
+    (and the start shape of ``--start`` where the command has it)."""
     from ..simulate import Problem
 
     if problem is None:
         problem = Problem.catenary(args.chi, args.N, chords=args.chords)
-    return problem.with_body(body)
+    return problem.with_body(body, start=getattr(args, "start", None))

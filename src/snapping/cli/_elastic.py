@@ -15,7 +15,8 @@ NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
                "record_thin": "--record-thin thins the rigid-link record",
                "dt0": "--dt0 sets the rigid-link methods' first step",
                "max_link_error": "--max-link-error checks rigid links", "chords": "--chords",
-               "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections"}
+               "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections",
+               "start": "--start (the bending line's start; the extensible line starts at its stretched equilibrium)"}
 
 
 def add_elastic_options(p) -> None:
@@ -107,7 +108,11 @@ def elastic_from_args(args, scales):
         if dest in getattr(args, "_explicit", ()) and getattr(args, dest, None) not in (None, False):
             raise SnappingInputError(f"{why} cannot be given with the extensible line (--ea/--stretching/...)")
     from ._body import body_from_args
+    from .simulate3d import wants_3d
 
+    if wants_3d(args):
+        raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
+                                 "--perturb or --whirl")
     if body_from_args(args) is not None:
         raise SnappingInputError("bending, drag and wind are not built for the extensible line yet: give --ea/"
                                  "--stretching without body options")

@@ -34,7 +34,10 @@ def _add_simulate(sub) -> None:
             "  euler-richardson-fixed  the same step at the fixed dt = --dt0 (order studies)\n"
             "  dop853                  link-angle form (links exact to round-off), compiled 8th-order\n"
             "                          Dormand-Prince with dense output: 20-40x fewer evaluations\n"
-            "  fast                    always the project's best exact method (now dop853; the default)\n"
+            "  rodas4, stiff           linearly implicit, L-stable RODAS4 with banded O(N) solves: lines with\n"
+            "                          bending stiffness (a body), whose bending waves limit dop853's steps\n"
+            "  fast                    always the project's best exact method (the default): dop853, or\n"
+            "                          rodas4 for a body whose damped bending waves make dop853 stiff\n"
             "\n"
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
@@ -64,6 +67,12 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --ea 900 --damping 2  # SI: N, N s\n"
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --strain-table rope.csv -o run.nc\n"
             "\n"
+            "in space (snapping.spatial; --dims 3, implied by --perturb and --whirl):\n"
+            "  snapping simulate --dims 3 --chi 0.25 --N 200 -o run3d.nc   # a planar start, run in 3D\n"
+            "  snapping simulate --chi 0.25 --N 200 --perturb 1e-4          # out-of-plane kick sin(pi s/L)\n"
+            "  snapping simulate --chi 0.25 --N 200 --perturb 1e-4 --perturb-mode random --seed 1\n"
+            "  snapping simulate --whirl 2.5 --N 30 --t-end 7.5             # a steadily whirling chain\n"
+            "\n"
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
@@ -81,7 +90,7 @@ def _add_simulate(sub) -> None:
     p.add_argument("--tol", type=float, default=None,
                    help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson the paper's 1e-8)")
     p.add_argument("--method", default="fast",
-                   choices=["fast", "dop853", "euler-richardson", "euler-richardson-fixed"],
+                   choices=["fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed"],
                    help="time stepper (default: fast; every method is listed below)")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")
@@ -106,6 +115,11 @@ def _add_simulate(sub) -> None:
     p.add_argument("--pin-motion", default=None, metavar="SPEC",
                    help="held end: fixed (default), pull:AX,AY[,DURATION[,T0]] or flick:AX,AY,PERIOD[,T0]")
     p.add_argument("--gravity", type=float, default=1.0, help="gravity along +y in units of g (default 1; 0: none)")
+    p.add_argument("--start", default=None, choices=("catenary", "equilibrium"),
+                   help="the shape the line hangs in, held at both ends at rest, before its free end is released "
+                        "(--chi or --supports): the catenary, or the static equilibrium of the chain and its body "
+                        "(with bending the heavy elastica); default: the equilibrium when the line bends, else "
+                        "the catenary")
     from ._body import add_body_options
 
     add_body_options(p)
@@ -127,6 +141,9 @@ def _add_simulate(sub) -> None:
                    help="fail after more than this many consecutive rejected steps (default 100)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (it is off anyway when not a tty)")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    from .simulate3d import add_3d_options
+
+    add_3d_options(p)
     _add_si_options(p)
     p.set_defaults(func=_cmd_simulate)
 
@@ -149,6 +166,10 @@ def _cmd_simulate(args) -> int:
     from ._elastic import elastic_from_args
 
     elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
+    from .simulate3d import cmd_simulate3d, wants_3d
+
+    if wants_3d(args):  # the chain in space (snapping.spatial)
+        return cmd_simulate3d(args, times)
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
     if args.resume is None and (not start_given or args.N is None):
@@ -169,7 +190,7 @@ def _cmd_simulate(args) -> int:
         if elastic is not None:
             return _simulate_elastic(args, problem, elastic, times, scales)
         body = body_from_args(args)
-        if body is not None:  # bending, drag, a clamp: a general problem (snapping.simulate.body)
+        if body is not None or args.start is not None:  # bending, drag, a clamp: a general problem (simulate.body)
             problem = attach_body(problem, body, args)
     try:
         if args.resume is not None:

@@ -39,7 +39,8 @@ def _add_sweep(sub) -> None:
     p.add_argument("--tol", type=float, default=None,
                    help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson 1e-8)")
     p.add_argument("--method", default=None,
-                   help="time-stepping method: fast (default), dop853, euler-richardson, euler-richardson-fixed")
+                   help="time-stepping method: fast (default), dop853, rodas4 (stiff), euler-richardson, "
+                        "euler-richardson-fixed")
     p.add_argument("--chords", default=None, choices=["exact", "arclength"],
                    help="initial nodes with exact chords 1/N (default) or at equal arclength (the paper's)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")

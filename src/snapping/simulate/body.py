@@ -294,6 +294,11 @@ class Body:
         return Body(self.bending, wind=self.wind, tip_drag=self.tip_drag,
                     clamp=math.atan2(float(y[-2] - y[-1]), float(x[-2] - x[-1])), **kw)
 
+    def hinged(self) -> "Body":
+        """This body with the held end a free hinge (no clamp)."""
+        kw = {k: getattr(self, k) for k in _PROFILES if k != "bending"}
+        return Body(self.bending, wind=self.wind, tip_drag=self.tip_drag, clamp=None, **kw)
+
     def model(self, mdl, h, theta0: float):
         """The compiled model (:func:`snapping.simulate.forced.make_body_model`) from the general
         model ``mdl`` of a chain with links ``h``; ``theta0``: the held link's angle at t = 0

@@ -59,7 +59,9 @@ SUMMARY_KEYS = (
     "energy_drift", "link_drift", "link_drift_initial", "length_drift", "link_error_initial",
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
     "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
+    "method_choice", "n_jacobians", "n_factorizations",  # (schema.METHOD_ATTRS: a body's method)
     "min_tension", "t_compression",  # (files written before sigma_min existed have none)
+    "start_rest",  # (problems with a body only)
 )
 
 
@@ -282,6 +284,10 @@ def _add_problem(problem, data_vars: dict, coords: dict, attrs: dict) -> None:
     attrs["gravity"] = float(problem.gravity)
     attrs["pin_motion"] = problem.pin.kind
     attrs["start"] = str(problem.start.get("kind", ""))
+    if getattr(problem, "body", None) is not None:  # (new names: the shape the line was released from)
+        kind = str(problem.start.get("kind", ""))
+        attrs["start_rest"] = str(problem.start.get("rest", "catenary" if kind in ("catenary", "supports") else
+                                                    "as given"))
 
 
 def check_writable(path, *, overwrite: bool = False, name: str = "output", need_bytes: float = 0.0) -> str:

@@ -99,6 +99,25 @@ def _resolve_problem(chi, N, chords, initial, problem, method):
     return None, problem.N, problem.chords or DEFAULT_CHORDS, None, problem
 
 
+def _choose(method: str, problem, tol, t_end) -> tuple[str, str]:
+    """The method a run takes and why (:func:`snapping.simulate.stiffness.choose`: ``fast``
+    on a problem with bending is dop853 or rodas4; '' for every other run, which keeps its
+    method), after the cost check of an explicit method named on a stiff problem
+    (:func:`snapping.simulate.stiffness.check_cost`)."""
+    if problem is None or getattr(problem, "body", None) is None:
+        return method, ""
+    from . import stiffness
+
+    if M.resolve(method) != "dop853":
+        return method, ""
+    choice = ""
+    if method == "fast":
+        method, choice = stiffness.choose(problem, tol=1e-6 if tol is None else V.positive("tol", tol), t_end=t_end)
+    if M.resolve(method) == "dop853":
+        stiffness.check_cost(problem, "dop853", t_end=t_end)
+    return method, choice
+
+
 def default_tol(method: str) -> float:
     """The stepper tolerance a run of ``method`` takes when none is given: the method's
     ``DEFAULT_TOL`` (Euler-Richardson: the paper's 1e-8; ``fast``/dop853: chosen by
@@ -212,10 +231,15 @@ def run(
         Stepper tolerance (default: the method's ``DEFAULT_TOL``, :func:`default_tol`:
         Euler-Richardson the paper's eps_tol 1e-8; fast/dop853 1e-6, whose peaks agree
         with tol 1e-11 to 3e-8, measured by ``benchmarks/bench_default_tol.py``).
-    method : {"fast", "dop853", "euler-richardson", "euler-richardson-fixed"}
-        ``fast`` (default): the project's best exact method (now ``dop853``, link
-        angles); ``euler-richardson``: the paper's adaptive scheme (reference);
-        ``euler-richardson-fixed``: the same step with fixed dt = dt0.
+    method : {"fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed"}
+        ``fast`` (default): the project's best exact method (``dop853``, link angles; for
+        a problem with a body whose damped bending waves make dop853 stiff, ``rodas4``:
+        :mod:`snapping.simulate.stiffness`, the reason in the attribute ``method_choice``);
+        ``rodas4``/``stiff``: linearly implicit, L-stable, for problems with a body;
+        ``euler-richardson``: the paper's adaptive scheme (reference);
+        ``euler-richardson-fixed``: the same step with fixed dt = dt0. An explicit method
+        on a problem whose bending stiffness needs more than ~1e6 steps warns
+        (:class:`snapping.simulate.stiffness.CostWarning`), more than 1e9 is refused.
     dt0 : float, optional
         Initial (fixed-mode: constant) time step.
     t_end : float, optional
@@ -298,6 +322,7 @@ def run(
     """
     chi, N, chords, initial, problem = _resolve_problem(chi, N, chords, initial, problem, method)
     chi, N = _validate_start(chi, N, method, chords, initial, problem)
+    method, choice = _choose(method, problem, tol, t_end)
     opts = RunOptions(tol=default_tol(method) if tol is None else tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections)
@@ -309,6 +334,8 @@ def run(
     if output is not None:
         output = check_writable(output, overwrite=overwrite, need_bytes=need["file_bytes"])
     inputs, eng = method_.setup(chi, N, method, opts, chords=chords, initial=initial, problem=problem)
+    if choice:
+        inputs["method_choice"] = choice
     return _drive(eng, inputs, output=output, progress=progress, checkpoint_every=checkpoint_every,
                   wall_before=0.0, overwrite=overwrite)
 
@@ -336,6 +363,7 @@ def check_inputs(chi=None, N=None, **options) -> dict:
     chi, N, chords, initial, problem = _resolve_problem(chi, N, kw["chords"], kw["initial"], kw["problem"],
                                                         kw["method"])
     chi, N = _validate_start(chi, N, kw["method"], chords, initial, problem)
+    kw["method"], _ = _choose(kw["method"], problem, kw["tol"], kw["t_end"])
     if kw["tol"] is None:
         kw["tol"] = default_tol(kw["method"])
     opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])

@@ -208,7 +208,7 @@ def memory_need(N: int, *, chi: float | None = None, tol: float = 1e-8, method: 
     t_end = None if t_end is None else V.positive("t_end", t_end)
     t_end_max = V.positive("t_end_max", t_end_max)
     record_thin = V.real("record_thin", record_thin)
-    angle_form = method in ("dop853", "fast")
+    angle_form = method in ("dop853", "fast", "rodas4", "stiff")
     try:  # in floats: an extreme input makes an astronomical (not an overflowing) count, refused by the guard
         if method == "euler-richardson-fixed" and dt0:
             steps_f = (t_end if t_end else t_end_max) / dt0 * (1.0 - 1e-8)

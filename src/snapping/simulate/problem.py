@@ -70,6 +70,14 @@ def _node_values(name: str, v, n: int) -> None:
                                    f"numbers (one per node)")
 
 
+def _gravity(gravity) -> float:
+    g = V.real("gravity", gravity)
+    if not 0.0 <= g <= GRAVITY_MAX:
+        raise V.SnappingInputError(f"gravity={g!r} is out of range: must lie in [0, {GRAVITY_MAX:g}] (units of "
+                                   f"g, along +e2, y downward)")
+    return abs(g)  # (-0.0 is 0)
+
+
 def _check_links(links) -> None:
     if not isinstance(links, Links):
         raise V.SnappingInputError(f"links={links!r} is not a snapping.simulate.Links (use Links.uniform, "
@@ -115,7 +123,8 @@ class Problem:
     def is_paper(self) -> bool:
         """The paper's problem: its chain from the catenary, at rest, fixed pin, g = 1."""
         return bool(self.links.is_paper and self.start.get("kind") == "catenary" and self.pin.is_fixed
-                    and self.gravity == 1.0 and not self.start.get("velocities") and self.body is None)
+                    and self.gravity == 1.0 and not self.start.get("velocities") and self.body is None
+                    and self.start.get("rest", "catenary") == "catenary")
 
     @property
     def is_uniform_fixed(self) -> bool:
@@ -125,11 +134,19 @@ class Problem:
     # -- constructors
     @classmethod
     def catenary(cls, chi: float, N: int | None = None, *, chords: str = "exact", links: Links | None = None,
-                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None) -> "Problem":
+                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None,
+                 start: str | None = None) -> "Problem":
         """The paper's start: the level catenary of end separation ``chi``, at rest. With the
         paper's links (default: ``Links.uniform(N)``) the nodes are those of
         :func:`snapping.simulate.initial_state` (``chords`` as there); other links are placed
-        on the same curve with chords exactly ``h_j`` (walking from the held end)."""
+        on the same curve with chords exactly ``h_j`` (walking from the held end).
+
+        ``start``: the shape the line is released from, held at both ends at rest before:
+        ``"catenary"`` (the nodes above), or ``"equilibrium"``: the discrete static equilibrium
+        of this chain and body held at the held end and at the catenary's free-end node
+        (the heavy elastica when the body bends; :mod:`snapping.simulate.equilibrium`).
+        Default (None): ``"equilibrium"`` when the body has bending stiffness, else the
+        catenary (then bit for bit as without the option)."""
         from .chain import initial_state
 
         if links is None:
@@ -164,15 +181,18 @@ class Problem:
                 xs, ys = estimates.catenary_shape(s, chi)
                 x, y = L * np.asarray(xs, dtype=float), L * np.asarray(ys, dtype=float)
                 x[-1] = y[-1] = 0.0
-        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "catenary", "chi": chi, "chords": chords},
-                         chi=chi, chords=chords, body=body)
+        x, y, desc, body = _at_rest(links, x, y, body, gravity, start,
+                                    {"kind": "catenary", "chi": chi, "chords": chords})
+        return cls._make(links, x, y, None, None, pin, gravity, desc, chi=chi, chords=chords, body=body)
 
     @classmethod
     def supports(cls, dx: float, dy: float, N: int | None = None, *, links: Links | None = None,
-                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None) -> "Problem":
+                 pin: PinMotion | None = None, gravity: float = 1.0, body: Body | None = None,
+                 start: str | None = None) -> "Problem":
         """The catenary hanging between the held end (origin) and a second support at
         ``(dx, dy)`` (``dy > 0``: lower, y grows downward), released at rest from there;
-        nodes at chords exactly ``h_j``."""
+        nodes at chords exactly ``h_j``. ``start``: as for :meth:`catenary` (the equilibrium
+        held at the origin and at the catenary's free-end node)."""
         from . import shapes
 
         links = links if links is not None else Links.uniform(_links_count("N", N))
@@ -181,7 +201,8 @@ class Problem:
         dy = V.real("dy", dy)
         curve = shapes.catenary_between(dx, dy, links.length)
         x, y = shapes.place_on_curve(curve, links.h)
-        return cls._make(links, x, y, None, None, pin, gravity, {"kind": "supports", "dx": dx, "dy": dy}, body=body)
+        x, y, desc, body = _at_rest(links, x, y, body, gravity, start, {"kind": "supports", "dx": dx, "dy": dy})
+        return cls._make(links, x, y, None, None, pin, gravity, desc, body=body)
 
     @classmethod
     def curve(cls, curve, N: int | None = None, *, links: Links | None = None, vx=None, vy=None,
@@ -249,11 +270,7 @@ class Problem:
         pin = PinMotion() if pin is None else pin
         if not isinstance(pin, PinMotion):
             raise V.SnappingInputError(f"pin={type(pin).__name__} is not a PinMotion")
-        g = V.real("gravity", gravity)
-        if not 0.0 <= g <= GRAVITY_MAX:
-            raise V.SnappingInputError(f"gravity={g!r} is out of range: must lie in [0, {GRAVITY_MAX:g}] (units of "
-                                       f"g, along +e2, y downward)")
-        g = abs(g)  # (-0.0 is 0)
+        g = _gravity(gravity)
         x = np.array(x, dtype=float)
         y = np.array(y, dtype=float)
         N = links.N
@@ -288,8 +305,21 @@ class Problem:
             start = {**start, "velocities": True}
         return cls(links, x, y, vx, vy, pin, g, start, chi, chords, None if body is None else body.resolved(x, y))
 
-    def with_body(self, body: Body | None) -> "Problem":
-        """This problem with another body (validated; None or an inactive body: none)."""
+    def with_body(self, body: Body | None, start: str | None = None) -> "Problem":
+        """This problem with another body (validated; None or an inactive body: none). A
+        catenary or supports start is built again for the body, with ``start`` as there (by
+        default the equilibrium when the body bends, else the catenary); any other start
+        keeps its nodes (``start`` must then be None)."""
+        kind = self.start.get("kind")
+        kw = {"links": self.links, "pin": self.pin, "gravity": self.gravity, "body": body, "start": start}
+        if kind == "catenary":
+            return Problem.catenary(self.chi, chords=self.chords, **kw)
+        if kind == "supports":
+            return Problem.supports(self.start["dx"], self.start["dy"], **kw)
+        if start is not None:
+            _rest_shape(start)
+            raise V.SnappingInputError(f"start={start!r} applies to the catenary and supports starts; this problem "
+                                       f"starts from its {kind!r} nodes as given")
         return Problem._make(self.links, self.x, self.y, self.vx if self.start.get("velocities") else None,
                              self.vy if self.start.get("velocities") else None, self.pin, self.gravity,
                              dict(self.start), chi=self.chi, chords=self.chords, body=body)
@@ -345,6 +375,50 @@ class Problem:
 
     def describe_json(self) -> str:
         return json.dumps(self.describe(), sort_keys=True)
+
+
+# ---------------------------------------------------------------------------------- the rest shape
+#: the shapes a catenary or supports start is released from (the line held at both ends, at rest)
+REST_SHAPES = ("catenary", "equilibrium")
+
+
+def _rest_shape(start) -> None:
+    if start is not None and not (isinstance(start, str) and start in REST_SHAPES):
+        raise V.SnappingInputError(f"start={start!r} is not one of {REST_SHAPES} (the shape the line hangs in, held "
+                                   f"at both ends at rest, before its free end is released; default: the "
+                                   f"equilibrium when the body bends)")
+
+
+def _at_rest(links, x, y, body, gravity, start, desc):
+    """The start's nodes, description and body for ``start`` (None: the equilibrium when the
+    body has bending stiffness, else the catenary's nodes as given). With the equilibrium, a
+    body's ``clamp="start"`` holds the direction of the hinged equilibrium's held link (which
+    is then the clamped equilibrium too: no moment at the clamp), and the description records ``rest`` (the residual is below
+    :data:`snapping.simulate.equilibrium.EQUILIBRIUM_TOL`, else an error)."""
+    _rest_shape(start)
+    bends = False
+    if isinstance(body, Body):
+        _check_links(links)
+        body.check(links.h)
+        bends = body.active and bool(np.any(body.node_values("bending", links.h) != 0.0))
+    shape = start if start is not None else ("equilibrium" if bends else "catenary")
+    if shape == "catenary":
+        return x, y, ({**desc, "rest": "catenary"} if bends else desc), body
+    from .equilibrium import hanging_equilibrium
+
+    g = _gravity(gravity)
+    solve = body if isinstance(body, Body) and body.active else None
+    if solve is not None and isinstance(solve.clamp, str):  # "start": the clamp holds the rest shape's direction,
+        solve = solve.hinged()  # where the hinged equilibrium puts no moment on it (resolved on these nodes)
+    eq = hanging_equilibrium(links, solve, x, y, gravity=g)
+    from . import shapes
+
+    try:
+        shapes.check_curve(eq.x, eq.y, name="start='equilibrium'")
+    except V.SnappingInputError as exc:
+        raise V.SnappingInputError(f"{exc} (the line's rest shape with this bending is not a valid start; use "
+                                   f"start='catenary')") from None
+    return eq.x, eq.y, {**desc, "rest": "equilibrium"}, body
 
 
 # ---------------------------------------------------------------------------------- from options

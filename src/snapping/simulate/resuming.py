@@ -194,6 +194,8 @@ def resume(path, *, output=None, progress: bool | None = False,
         out = check_writable(out, overwrite=True if own else overwrite, need_bytes=need["file_bytes"])
         inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
                                                    initial=kw.get("initial"), problem=kw.get("problem"))
+        if "method_choice" in ds.attrs:  # (why method='fast' chose it: kept as the run recorded it)
+            inputs["method_choice"] = str(ds.attrs["method_choice"])
         fresh = np.array(eng.records(), dtype=float, copy=True)  # the start the stored inputs describe
         try:
             eng.restore(ds)

@@ -251,6 +251,15 @@ def accepted(err) -> bool:
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas, mdl):
+    """:func:`after_attempt_with` for DOP853 (its error exponent -1/8, growth at most 10x,
+    12 evaluations per attempted step)."""
+    return after_attempt_with(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas, mdl,
+                              ERR_EXPONENT, MAX_FACTOR, float(NS))
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def after_attempt_with(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk, meas, mdl,
+                       expo, max_factor, nrhs):
     """Everything after the stages of an attempted step of size h into slot ``ns``
     (``y1`` the new state, c, s, sig its trigonometry and tension; any strides):
     rejection and step-size control, or acceptance with the diagnostics, the record,
@@ -259,8 +268,11 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     :func:`advance_rk` and the ensemble loop (:mod:`snapping.simulate.ensemble`).
     For a general chain (``meas`` of length ``general.NMEAS_G``) the energy bound applies
     to the balance ``E - W`` (W: the work done by the held end) and the record carries the
-    held end's position, velocity and work (``rec`` of width ``general.NREC_G``)."""
-    ctl[Q_NRHS] += float(NS)
+    held end's position, velocity and work (``rec`` of width ``general.NREC_G``).
+    The method's step-size rule: ``h_new = h max(MIN_FACTOR, SAFETY err^expo)`` after a
+    rejection, ``h min(max_factor, SAFETY err^expo)`` after an acceptance (``expo = -1/(q +
+    1)``, q the order of the error estimate); ``nrhs`` evaluations are counted per attempt."""
+    ctl[Q_NRHS] += nrhs
     dtmin = ctl[Q_DTMIN]
     if not (err - err == 0.0):  # NaN/inf in the stages: reject, shrink hard
         ctl[Q_H] = MIN_FACTOR * h
@@ -273,7 +285,7 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
             return K.RET_FAIL_REJECT
         return GO_REJECTED
     if err > 1.0:
-        ctl[Q_H] = h * max(MIN_FACTOR, SAFETY * err ** ERR_EXPONENT)
+        ctl[Q_H] = h * max(MIN_FACTOR, SAFETY * err ** expo)
         ctl[Q_NREJ] += 1.0
         ctl[Q_REJECTED] = 1.0
         ctl[Q_CONSREJ] += 1.0
@@ -286,9 +298,9 @@ def after_attempt(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0, ctl
     # (PI control, Gustafsson / Hairer's DOP853: beta = ctl[Q_BETA]; 0 is the I controller)
     beta = ctl[Q_BETA]
     if err == 0.0:
-        fac = MAX_FACTOR
+        fac = max_factor
     else:
-        fac = min(MAX_FACTOR, SAFETY * err ** (ERR_EXPONENT + 0.2 * beta) * ctl[Q_ERROLD] ** beta)
+        fac = min(max_factor, SAFETY * err ** (expo + 0.2 * beta) * ctl[Q_ERROLD] ** beta)
     ctl[Q_ERROLD] = max(err, 1e-4)
     if ctl[Q_REJECTED] != 0.0:
         fac = min(1.0, fac)

@@ -34,12 +34,13 @@ Each step also costs a Jacobian (20 complex evaluations of the compiled rows) an
 banded LU, and the step loop is Python: per evaluation the method is 5-50x slower in
 wall time than dop853's compiled loop (N = 1000, beta = 1e-2: 66 s against 86 s).
 
-Integration status: :func:`solve` runs a problem to ``t_end`` (or to the snap by the
-driver's rule ``v_max < stop_fraction * peak``) and returns the peaks, step and
-evaluation counts, the final state and per-step records (time, v_max, a_max,
-sigma_max, energy, W, D). It is *not* a method of :func:`snapping.simulate.run` yet:
-no Engine (checkpoints, snapshots, Dataset records, progress), see the module's tests and
-``benchmarks/bench_stiff.py``.
+Integration status: this module is the Python reference of the method (:func:`solve`:
+peaks, counts, records; the rms error norm). The method of :func:`snapping.simulate.run`
+is ``method="rodas4"`` (alias ``"stiff"``; :mod:`snapping.simulate.methods.rodas4`), its
+step loop compiled (:mod:`snapping.simulate.rosenbrock`, the max norm of DOP853, tested
+step for step against :class:`_Stepper`), with records, peaks on the continuous
+extension, the stop rules, snapshots, checkpoints and resume; ``method="fast"`` chooses
+it where the explicit stability limit would cost more (:mod:`snapping.simulate.stiffness`).
 """
 
 from __future__ import annotations

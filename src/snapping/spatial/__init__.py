@@ -4,7 +4,10 @@
   cosines between neighbouring links), the compiled right-hand side and diagnostics;
 * :mod:`snapping.spatial.solve3d`: compiled DOP853 stepping with dense-output peaks, to the snap;
 * :mod:`snapping.spatial.starts3d`: :class:`Problem3D`, planar starts in space and the
-  out-of-plane perturbations only 3D has.
+  out-of-plane perturbations only 3D has;
+* :mod:`snapping.spatial.dataset3d`: the run Dataset of a 3D run (the planar names, and
+  ``z``, ``vz``, ``z_amp``, ... of ``snapping.schema.SPATIAL_VARS``);
+* :mod:`snapping.spatial.figures3d`: the out-of-plane amplitude against eps, the chain in space.
 
 It imports from :mod:`snapping.simulate` (links, the catenary, the DOP853 tableau); the
 planar simulator does not import it.

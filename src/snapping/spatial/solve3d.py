@@ -393,10 +393,26 @@ class Stepper3D:
                     self.peak_meas = self.meas_at(float(res.x))
                     self.peak_state = (float(res.x), self.state_at(float(res.x)))
 
-    def loop(self) -> int:
+    def take_snapshots(self) -> None:
+        """The requested snapshots at or before the current time (dense output of the last
+        step, projected onto the unit links; ``snapshot_times`` sorted)."""
+        pend = self.snapshot_times
+        while pend and pend[0] <= self.t:
+            ts = pend.pop(0)
+            y = self.state_at(ts)
+            C.project(self.N, y)
+            self.snapshots.append((ts, "requested", y))
+        # times to come: back to Python after every accepted step (its dense output); same steps
+        self.ctl[Q_CALLMAX] = 1.0 if pend else self.callmax
+
+    def loop(self, snapshot_times=()) -> int:
         par, h, invm = self.mdl
         w = self.w
         self.peak_meas, self.peak_state = self.meas0.copy(), (0.0, self.Y1[0].copy())
+        self.snapshot_times = sorted(float(t) for t in snapshot_times if t > 0.0)
+        self.snapshots = [(0.0, "requested", self.Y1[0].copy())] if 0.0 in snapshot_times else []
+        self.callmax = float(self.ctl[Q_CALLMAX])
+        self.take_snapshots()
         while True:
             while self.breaks and self.breaks[0] <= self.t:
                 self.breaks.pop(0)
@@ -404,6 +420,8 @@ class Stepper3D:
             code = advance3d(self.N, self.Y0, self.Y1, self.KK, self.TS, self.HS, self.DOK, self.ytmp, w.T, w.cp,
                              w.dp, self.ctl, self.rec, self.pk, self.meas, self.snode, par, h, invm)
             self.drain()
+            if code < RET_FAIL_NAN and self.snapshot_times:
+                self.take_snapshots()
             if self.ctl[Q_REFINE] != 0.0:
                 self.refine()
             if code in (RET_REFINE, RET_RECORD_FULL, RET_CALL_LIMIT, RET_BREAK):
@@ -415,7 +433,8 @@ class Stepper3D:
 
 
 def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: float = 10.0,
-          stop_fraction: float = 0.5, reeval: bool = False, max_link_error: float = 1e-6) -> dict:
+          stop_fraction: float = 0.5, reeval: bool = False, max_link_error: float = 1e-6,
+          snapshot_times=()) -> dict:
     """Run a :class:`snapping.spatial.starts3d.Problem3D` to the snap (or to ``t_end``).
 
     Returns a dict: the peaks ``v_peak, a_peak, sigma_peak`` and their times ``t_snap_*``
@@ -425,7 +444,9 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     drifts of the energy balance ``E - W`` and (fixed end) of the angular momentum along
     gravity, the largest link error ``| |e_j| - 1 |`` at the end of an accepted step before
     its projection (what the projection removes; after it, links are unit to round-off), ``record`` (one row an accepted step, columns
-    :data:`RECORD_NAMES`) and ``state`` (the final state ``[e, u, W]``).
+    :data:`RECORD_NAMES`) and ``state`` (the final state ``[e, u, W]``), ``snapshots``: a list of
+    ``(t, "requested", state)`` at the ``snapshot_times`` reached (dense output, projected;
+    the steps are unchanged; :mod:`snapping.spatial.dataset3d` makes the run Dataset).
     """
     from .._validate import SnappingInputError
 
@@ -439,7 +460,7 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
                    reeval=reeval, max_link_error=max_link_error)
     _warm()
     t0 = time.perf_counter()
-    code = st.loop()
+    code = st.loop(snapshot_times)
     wall = time.perf_counter() - t0
     rec = st.records()
     col = {name: rec[:, i] for i, name in enumerate(RECORD_NAMES)}
@@ -459,7 +480,7 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
                 "angular_momentum_drift": float(np.max(np.abs(col["angular_momentum_g"]
                                                               - col["angular_momentum_g"][0]))),
                 "link_error_max": float(col["link_error"].max()), "record": rec, "state": st.current_state(),
-                "peak_state": st.peak_state})
+                "peak_state": st.peak_state, "snapshots": st.snapshots})
     return out
 
 

@@ -17,22 +17,25 @@ from __future__ import annotations
 from types import ModuleType
 
 from ... import _validate as V
-from . import dop853, euler_richardson
+from . import dop853, euler_richardson, rodas4
 
 __all__ = ["METHODS", "NAMES", "ALIASES", "method", "resolve"]
 
 #: method name -> module. ``euler-richardson``: the paper's adaptive scheme (reference);
 #: ``euler-richardson-fixed``: the same step at a fixed dt = dt0 (order studies);
 #: ``dop853``: the chain in link angles (links exact to round-off), compiled Dormand-Prince
-#: 8(5,3) with dense output, every :class:`snapping.simulate.problem.Problem`.
+#: 8(5,3) with dense output, every :class:`snapping.simulate.problem.Problem`; ``rodas4``: the
+#: stiff method (linearly implicit, L-stable, banded O(N) stage solves) for problems with a body.
 METHODS: dict[str, ModuleType] = {
     "euler-richardson": euler_richardson,
     "euler-richardson-fixed": euler_richardson,
     "dop853": dop853,
+    "rodas4": rodas4,
 }
 #: names that stand for another: ``fast`` is always the project's best exact method (the
 #: default of :func:`snapping.simulate.run`, ``snapping simulate`` and ``snapping sweep``)
-ALIASES = {"fast": "dop853"}
+#: ``stiff`` names the stiff method
+ALIASES = {"fast": "dop853", "stiff": "rodas4"}
 #: every name :func:`snapping.simulate.run` takes
 NAMES = (*METHODS, *ALIASES)
 

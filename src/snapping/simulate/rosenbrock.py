@@ -1,0 +1,403 @@
+"""The compiled RODAS4 step loop of the stiff method (``method="rodas4"``, alias ``"stiff"``).
+
+The method and the banded stage solves are those of :mod:`snapping.simulate.stiff` (the
+Python reference, :func:`snapping.simulate.stiff.solve`) and
+:mod:`snapping.simulate.stiff_system` (the rows, their complex-step derivatives, the
+stage matrix in LAPACK band storage): here they are one numba loop (:func:`advance_rodas`)
+that shares the bookkeeping of every accepted step with DOP853
+(:func:`snapping.simulate.rk.after_attempt_with`: records, peaks, invariants, the stop
+rules), so the two methods differ only in how a step is taken.
+
+A step (Hairer and Wanner, *Solving ODEs II*, sec. VI.4, ``rodas.f``): the Jacobian at the
+step's start (:func:`jacobian_at`, once per accepted step: 20 complex evaluations of the
+compiled rows), the banded stage matrix of bandwidth 5 factored by Gaussian elimination
+with partial pivoting (:func:`band_lu`, O(N)), six stages (five new evaluations), the error
+estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``),
+the new state, and on acceptance one evaluation there (the next step's ``f``). The
+continuous extension of order 3 (``rodas.f``'s CONTRO: ``y(t0 + s h) = (1 - s) y0 + s (y1 +
+(1 - s)(c2 + s c3))`` with ``c2, c3`` fixed combinations of ``U_1 .. U_5``) gives the state
+between steps at no cost (:func:`dense_eval`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from . import forced as FR
+from . import general as G
+from . import models as MD
+from . import rk as R
+from .stiff import RODAS4
+from .stiff_system import _EPS_CS as EPS_CS
+from .stiff_system import KL, KU, NCOL, _rows
+
+__all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
+           "NSTG",
+           "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3"]
+
+GAMMA = RODAS4["gamma"]
+C_NODE = np.array(RODAS4["c"])
+D_TIME = np.array(RODAS4["d"])
+A_ST = np.zeros((6, 6))
+C_ST = np.zeros((6, 6))
+for _i in range(6):
+    for _j, _v in enumerate(RODAS4["a"][_i]):
+        A_ST[_i, _j] = _v
+    for _j, _v in enumerate(RODAS4["C"][_i]):
+        C_ST[_i, _j] = _v
+#: the dense output's weights of U_1 .. U_5 (rodas.f, METH = 1: D21 .. D25, D31 .. D35)
+D2 = np.array([10.12623508344586, -7.487995877610167, -34.80091861555747, -7.992771707568823, 1.025137723295662])
+D3 = np.array([-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872])
+#: the step-size rule of an error estimate of order 3 (rodas.f: at most 6x larger)
+ERR_EXPONENT = -0.25
+MAX_FACTOR = 6.0
+#: rows of a step slot's stage array: f at the start, U_1 .. U_6, f at the end
+NSTG = 8
+S_F0, S_F1 = 0, 7
+#: the engine's counters (``cnt``): Jacobians, factorisations, evaluations of the W/D rows'
+#: differences and of f_t (in n_rhs too), singular stage matrices
+(CN_JAC, CN_LU, CN_EXTRA, CN_SING) = range(4)
+NCNT = 4
+#: the flags of ``rp``: clamped, bending, W/D have dynamics, their rows by differences, autonomous
+(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
+
+
+#: width of a row of the factored stage matrix: lower band, upper band and the fill-in
+WROW = 2 * KL + KU + 1
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def band_lu(A, n, kl, ku, piv):
+    """LU with partial pivoting of the n x n band matrix stored by rows: ``A[i, j]`` at
+    ``R[i, j - i + kl]`` (width ``2 kl + ku + 1``: the last kl columns are room for the
+    fill-in and zero on entry). On return the multipliers are below the diagonal, U above
+    (upper bandwidth kl + ku), ``piv[k]`` the row swapped with row k (LAPACK's ``dgbtrf``,
+    laid out so that the row operations run on contiguous memory). Returns 0, or k + 1 when
+    the k-th pivot is zero or not finite."""
+    R = A
+    m = kl + ku
+    for k in range(n):
+        ilast = min(n - 1, k + kl)
+        p = k
+        vmax = abs(R[k, kl])
+        for i in range(k + 1, ilast + 1):
+            v = abs(R[i, k - i + kl])
+            if v > vmax:
+                vmax = v
+                p = i
+        piv[k] = p
+        if vmax == 0.0 or not (vmax - vmax == 0.0):
+            return k + 1
+        w = min(n - 1, k + m) - k + 1  # columns k .. k + w - 1
+        if p != k:
+            op = k - p + kl
+            for d in range(w):
+                tmp = R[k, kl + d]
+                R[k, kl + d] = R[p, op + d]
+                R[p, op + d] = tmp
+        inv = 1.0 / R[k, kl]
+        for i in range(k + 1, ilast + 1):
+            oi = k - i + kl
+            l = R[i, oi] * inv
+            R[i, oi] = l
+            if l != 0.0:
+                for d in range(1, w):
+                    R[i, oi + d] -= l * R[k, kl + d]
+    return 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def band_solve(A, n, kl, ku, piv, b):
+    """Solve ``A x = b`` in place with the factors of :func:`band_lu`."""
+    R = A
+    m = kl + ku
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+        bk = b[k]
+        for i in range(k + 1, min(n - 1, k + kl) + 1):
+            b[i] -= R[i, k - i + kl] * bk
+    for k in range(n - 1, -1, -1):
+        acc = b[k]
+        for d in range(1, min(n - 1, k + m) - k + 1):
+            acc -= R[k, kl + d] * b[k + d]
+        b[k] = acc / R[k, kl]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def matvec(N, Dv, x, out):
+    """``out += (dR/d var) x`` from the coloured columns ``Dv`` (:func:`stiff_system._matvec`
+    column by column: link l's column, colour l mod 5, touches the rows of links l - 2 .. l + 2;
+    no integer division in the loop)."""
+    k = 0
+    for l in range(N):
+        xl = x[l]
+        i0 = max(0, 2 * l - 4)
+        i1 = min(2 * N, 2 * l + 6)
+        for i in range(i0, i1):
+            out[i] += Dv[k, i] * xl
+        k += 1
+        if k == NCOL:
+            k = 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def assemble(N, D, gh, A):
+    """The stage matrix (:func:`stiff_system._assemble`) stored by rows for :func:`band_lu`:
+    row i, column j at ``A[i, j - i + KL]``; the rest of A zeroed."""
+    for i in range(A.shape[0]):
+        for d in range(A.shape[1]):
+            A[i, d] = 0.0
+    gh2 = gh * gh
+    k = 0
+    for lk in range(N):  # (column by column, as matvec)
+        for i in range(max(0, 2 * lk - 4), min(2 * N, 2 * lk + 6)):
+            A[i, 2 * lk - i + KL] = D[2, k, i] + gh2 * D[0, k, i] + gh * D[1, k, i]
+            A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
+        k += 1
+        if k == NCOL:
+            k = 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
+    """The coloured banded derivatives of the rows (:meth:`stiff_system.Residual.jacobian`)
+    at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``:
+    ``dR/dtheta`` and ``dR/domega`` by complex steps (10 complex evaluations of the compiled
+    rows), ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the
+    node forces depend on neither)."""
+    par, h, invm, invh, snode, tab = mdl
+    phi = 0.0
+    phid = 0.0
+    if rp[RP_CLAMP] != 0.0:
+        phi, phid = FR.clamp_angle(t, par, tab)
+    _, _, _, _, pax, pay = G.pin_kinematics(t, par, tab)
+    payg = pay - par[G.P_G]
+    invm_next = barr[3, :N]
+    M = np.zeros(N + 1, dtype=np.complex128)
+    FX = np.zeros(N + 1, dtype=np.complex128)
+    FY = np.zeros(N + 1, dtype=np.complex128)
+    out = np.zeros(2 * N, dtype=np.complex128)
+    x = np.zeros((4, N), dtype=np.complex128)
+    for i in range(N):
+        x[0, i] = y[i]
+        x[1, i] = y[N + i]
+        x[2, i] = f[N + i]
+        x[3, i] = sig[i]
+    C0 = np.cos(y[:N])
+    S0 = np.sin(y[:N])
+    Cd0 = np.cos(y[1:N] - y[:N - 1])
+    Sd0 = np.sin(y[1:N] - y[:N - 1])
+    clamped = rp[RP_CLAMP] != 0.0
+    hasbend = rp[RP_BEND] != 0.0
+    for v in range(2):
+        for k in range(NCOL):
+            for j in range(k, N, NCOL):
+                x[v, j] += 1j * EPS_CS
+            _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, barr[0], barr[1], barr[2], clamped, hasbend,
+                  phi, phid, pax, payg, M, FX, FY, out, C0, S0, Cd0, Sd0)
+            for i in range(2 * N):
+                Dj[v, k, i] = out[i].imag / EPS_CS
+            for j in range(k, N, NCOL):
+                x[v, j] -= 1j * EPS_CS
+    for v in range(2, 4):
+        for k in range(NCOL):
+            for i in range(2 * N):
+                Dj[v, k, i] = 0.0
+    k = 0
+    for j in range(N):  # link j has colour k = j mod 5
+        Dj[2, k, 2 * j] = h[j]  # angle row: h_j a_j
+        Dj[3, k, 2 * j + 1] = -(invm[j] + invm_next[j])  # tension row: its own tension
+        k += 1
+        if k == NCOL:
+            k = 0
+    for j in range(N - 1):  # row j against T_{j+1} (colour of j + 1), row j + 1 against T_j (colour of j)
+        kn = (j + 1) % NCOL
+        kj = j % NCOL
+        Dj[3, kn, 2 * j] = -Sd0[j] * invm[j + 1]
+        Dj[3, kn, 2 * j + 1] = Cd0[j] * invm[j + 1]
+        Dj[3, kj, 2 * j + 2] = Sd0[j] * invm[j + 1]
+        Dj[3, kj, 2 * j + 3] = Cd0[j] * invm[j + 1]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
+    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`)."""
+    for i in range(N):
+        tmp[i] = b[i] + gh * b[N + i]
+    for i in range(2 * N):
+        rhs[i] = 0.0
+    matvec(N, Dj[0], tmp, rhs)
+    matvec(N, Dj[1], b[N:2 * N], rhs)
+    for i in range(2 * N):
+        rhs[i] *= gh
+    band_solve(ab, 2 * N, KL, KU, piv, rhs)
+    for j in range(N):
+        uom = gh * (b[N + j] - rhs[2 * j])
+        U[N + j] = uom
+        U[j] = gh * (b[j] + uom)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s, S, cp, dp, sig, tol, mdl, barr, rp,
+               cnt):
+    """One RODAS4 step of size h from (t, y0) with ``St[S_F0] = f(t, y0)``, the Jacobian
+    ``Dj`` there and (non-autonomous problems) ``ft`` the time derivative of f: the stages
+    ``U_1 .. U_6`` into ``St[1:7]``, the new state into ``y1``. Returns the scaled error in
+    the max norm (NaN or inf: a failed step), and the number of evaluations it made."""
+    n = y0.shape[0]
+    n2 = 2 * N
+    gh = GAMMA * h
+    nev = 0
+    assemble(N, Dj, gh, ab)
+    cnt[CN_LU] += 1.0
+    if band_lu(ab, n2, KL, KU, piv) != 0:
+        cnt[CN_SING] += 1.0
+        return np.inf, nev
+    f0 = St[S_F0]
+    par, hh, invm, invh, snode, tab = mdl
+    El = barr[2]
+    for st in range(6):
+        U = St[1 + st]
+        if st == 0:
+            for i in range(n):
+                btmp[i] = f0[i]
+        else:
+            for i in range(n):
+                acc = y0[i]
+                for j in range(st):
+                    acc += A_ST[st, j] * St[1 + j, i]
+                ytmp[i] = acc
+            MD.model_rhs(N, t + C_NODE[st] * h, ytmp, btmp, c, s, S, cp, dp, sig, mdl)
+            nev += 1
+            for i in range(n):
+                acc = btmp[i]
+                for j in range(st):
+                    acc += (C_ST[st, j] / h) * St[1 + j, i]
+                btmp[i] = acc
+        if rp[RP_AUTO] == 0.0 and D_TIME[st] != 0.0:
+            dh = D_TIME[st] * h
+            for i in range(n):
+                btmp[i] += dh * ft[i]
+        _stage_solve(N, Dj, gh, ab, piv, btmp, U, rhs, tmp)
+        bw = btmp[n2]
+        bd = btmp[n2 + 1]
+        if rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0:  # dD'/domega U_omega, exact
+            acc = 0.0
+            for j in range(1, N):
+                acc += El[j] * (y0[N + j] - y0[N + j - 1]) * (U[N + j] - U[N + j - 1])
+            bd += 2.0 * acc
+            if rp[RP_CLAMP] != 0.0:
+                _, phid = FR.clamp_angle(t, par, tab)
+                bd -= 2.0 * El[N] * (phid - y0[n2 - 1]) * U[n2 - 1]
+        elif rp[RP_QUAD] != 0.0:  # by one forward difference along U_x
+            nu = 0.0
+            ny = 0.0
+            for i in range(n2):
+                nu += U[i] * U[i]
+                ny += y0[i] * y0[i]
+            nu = math.sqrt(nu / n2)
+            if nu > 0.0:
+                dl = 1e-7 * (1.0 + math.sqrt(ny / n2)) / nu
+                for i in range(n):
+                    ytmp[i] = y0[i] + dl * U[i] if i < n2 else y0[i]
+                MD.model_rhs(N, t, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+                nev += 1
+                cnt[CN_EXTRA] += 1.0
+                bw += (tmp[n2] - f0[n2]) / dl
+                bd += (tmp[n2 + 1] - f0[n2 + 1]) / dl
+        U[n2] = gh * bw
+        U[n2 + 1] = gh * bd
+    err = 0.0
+    for i in range(n):
+        acc = y0[i]
+        for j in range(5):
+            acc += A_ST[5, j] * St[1 + j, i]
+        y1[i] = acc + St[6, i]
+    for i in range(n):
+        sc = tol * (1.0 + max(abs(y0[i]), abs(y1[i])))
+        e = abs(St[6, i]) / sc
+        if not (e - e == 0.0):
+            return np.inf, nev
+        if e > err:
+            err = e
+    return err, nev
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def dense_eval(x, y0, y1, St, out):
+    """The continuous extension of order 3 at the fraction x in [0, 1] of a step."""
+    n = y0.shape[0]
+    for i in range(n):
+        c2 = 0.0
+        c3 = 0.0
+        for j in range(5):
+            c2 += D2[j] * St[1 + j, i]
+            c3 += D3[j] * St[1 + j, i]
+        out[i] = y0[i] * (1.0 - x) + x * (y1[i] + (1.0 - x) * (c2 + x * c3))
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def time_derivative(N, t, y, f0, ft, ytmp, c, s, S, cp, dp, sig, mdl):
+    """``ft = (f(t + dt, y) - f0)/dt``, dt = 1e-7 max(1, |t|) (a moving held end or clamp)."""
+    dt = 1e-7 * max(1.0, abs(t))
+    MD.model_rhs(N, t + dt, y, ft, c, s, S, cp, dp, sig, mdl)
+    for i in range(y.shape[0]):
+        ft[i] = (ft[i] - f0[i]) / dt
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def advance_rodas(N, Y0, Y1, KK, TS, HS, DOK, ytmp, c, s, S, cp, dp, sig, Z, rinv0, ctl, rec, pk, meas, mdl,
+                  Dj, ab, piv, btmp, rhs, tmp, ft, barr, rp, cnt):
+    """Advance the chain with RODAS4 until something needs Python (the return codes and
+    the two step slots of :func:`snapping.simulate.rk.advance_rk`; ``KK[slot]`` holds f at
+    the step's start, its stages ``U_1 .. U_6`` and f at its end). ``Dj`` is the Jacobian
+    at the current state (taken after every accepted step, and again at the right limit
+    of a breakpoint of the held end's motion)."""
+    n = Y0.shape[1]
+    tol = ctl[R.Q_TOL]
+    ctl[R.Q_NCALL] = 0.0
+    while True:
+        sl = int(ctl[R.Q_SLOT])
+        ns = 1 - sl
+        h, last = R.step_size(ctl)
+        y0 = Y0[ns]
+        ycur = Y1[sl]
+        for i in range(n):
+            y0[i] = ycur[i]
+        t = ctl[R.Q_T]
+        extra = 0.0
+        if t == ctl[R.Q_LASTBRK]:
+            # a step from a breakpoint of the held end's motion: f and J just after it
+            t = np.nextafter(t, np.inf)
+            MD.model_rhs(N, t, y0, KK[ns, S_F0], c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            jacobian_at(N, t, y0, KK[ns, S_F0], sig, Dj, mdl, barr, rp)
+            cnt[CN_JAC] += 1.0
+        else:
+            for i in range(n):
+                KK[ns, S_F0, i] = KK[sl, S_F1, i]
+        if rp[RP_AUTO] == 0.0:
+            time_derivative(N, t, y0, KK[ns, S_F0], ft, ytmp, c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            cnt[CN_EXTRA] += 1.0
+        err, nev = rodas_step(N, t, h, y0, Y1[ns], KK[ns], ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s, S, cp, dp,
+                              sig, tol, mdl, barr, rp, cnt)
+        extra += float(nev)
+        if R.accepted(err):
+            tn = ctl[R.Q_TEND] if last else ctl[R.Q_T] + h
+            # f at the new state (the next step's first stage; c, s, sig then belong to it)
+            MD.model_rhs(N, tn, Y1[ns], KK[ns, S_F1], c, s, S, cp, dp, sig, mdl)
+            extra += 1.0
+            jacobian_at(N, tn, Y1[ns], KK[ns, S_F1], sig, Dj, mdl, barr, rp)
+            cnt[CN_JAC] += 1.0
+        code = R.after_attempt_with(N, err, h, last, ns, Y1[ns], TS, HS, DOK, c, s, sig, Z, rinv0, ctl, rec, pk,
+                                    meas, mdl, ERR_EXPONENT, MAX_FACTOR, extra)
+        if code >= 0:
+            return code
