@@ -77,6 +77,7 @@ def test_stretching_twin_and_a_linear_strain_table_give_the_same_run(tmp_path, c
     (["--ea", "100"], "--ea is in SI: it needs --length"),
     (SI + ["--ea", "100", "--stretching", "3"], "exactly one of --ea"),
     (["--stretching", "10", "--bending", "0.01"], "not built for the extensible line"),
+    (["--stretching", "10", "--dims", "3"], "is planar"),
     (SI + ["--strain-table", "TABLE"], "strains must increase"),
     (SI + ["--strain-table", "NOTCSV"], "is not two comma-separated numbers"),
 ])
