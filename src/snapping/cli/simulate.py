@@ -62,6 +62,11 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
+            "the extensible, tension-only line (links go slack; Radau on the banded Jacobian):\n"
+            "  snapping simulate --chi 0.25 --N 60 --stretching 30 --grid-damping 1  # c = 30 sqrt(gL)\n"
+            "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --ea 900 --damping 2  # SI: N, N s\n"
+            "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --strain-table rope.csv -o run.nc\n"
+            "\n"
             "in space (snapping.spatial; --dims 3, implied by --perturb and --whirl):\n"
             "  snapping simulate --dims 3 --chi 0.25 --N 200 -o run3d.nc   # a planar start, run in 3D\n"
             "  snapping simulate --chi 0.25 --N 200 --perturb 1e-4          # out-of-plane kick sin(pi s/L)\n"
@@ -118,6 +123,9 @@ def _add_simulate(sub) -> None:
     from ._body import add_body_options
 
     add_body_options(p)
+    from ._elastic import add_elastic_options
+
+    add_elastic_options(p)
     p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
@@ -155,6 +163,9 @@ def _cmd_simulate(args) -> int:
         _times(times)  # a bad time is named first
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} without -o RUN.nc: the snapshots are "
                                  f"profiles kept only in the run file; add -o RUN.nc (or leave out --snapshot-times)")
+    from ._elastic import elastic_from_args
+
+    elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
     from .simulate3d import cmd_simulate3d, wants_3d
 
     if wants_3d(args):  # the chain in space (snapping.spatial)
@@ -172,9 +183,12 @@ def _cmd_simulate(args) -> int:
         from ._body import attach_body, body_from_args, line_links
 
         problem = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=args.shape,
-                               tip_mass=args.tip_mass, taper=taper, lumping=args.lumping,
+                               tip_mass=args.tip_mass, taper=taper,
+                               lumping=args.lumping or ("shared" if elastic is not None else None),
                                pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
+        if elastic is not None:
+            return _simulate_elastic(args, problem, elastic, times, scales)
         body = body_from_args(args)
         if body is not None or args.start is not None:  # bending, drag, a clamp: a general problem (simulate.body)
             problem = attach_body(problem, body, args)
@@ -258,6 +272,36 @@ def _cmd_simulate(args) -> int:
         _print_dimensionless(numbers)
     if failed is not None:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _simulate_elastic(args, problem, elastic, times, scales) -> int:
+    """The extensible line's run (snapping.simulate.elastic): its summary, -o its Dataset."""
+    from .. import units
+    from ._elastic import run_elastic
+
+    summary, ds = run_elastic(args, problem, elastic, times)
+    if args.output:
+        summary["output"] = args.output
+    numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass)
+    if numbers is not None and "stretching" not in numbers:  # (--stretching or --strain-table: the run's c)
+        from .. import dimensionless
+
+        numbers = {k: (summary["wave_speed"] if k == "stretching" else numbers.get(k)) for k in dimensionless.NUMBERS
+                   if k in numbers or k == "stretching"}
+    if args.json:
+        print_json(_with_si(summary, scales, lambda: {"values": units.values_to_si(summary, scales),
+                                                      **({"dimensionless_numbers": numbers} if numbers else {})}))
+    else:
+        rows = [(k, f"{v:.10g}" if isinstance(v, float) else v, None) for k, v in summary.items()
+                if k not in ("problem", "elastic")]
+        rows.append(("elastic", summary["elastic"], "EA and damping in M g, M g sqrt(L/g)"))
+        print_table(rows, title=f"snapping simulate (extensible line): N={args.N}, {_problem_title(summary)}")
+        _print_si(scales, units.si_rows(summary, scales) if scales else [])
+        _print_dimensionless(numbers)
+    if summary["status"] != "completed":
+        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}", file=sys.stderr)
         return 1
     return 0
 

@@ -3,7 +3,8 @@
 * :mod:`~snapping.simulate.elastic_model`: what the line is made of (:class:`Elastic`) and the
   line itself (:class:`ElasticLine`: the problem's links as springs, the starts, the statics);
 * :mod:`~snapping.simulate.elastic_kernels`: the compiled forces, banded Jacobian, measures;
-* :mod:`~snapping.simulate.elastic_solve`: the stepping (:func:`solve`) and the run Dataset.
+* :mod:`~snapping.simulate.elastic_solve`: the stepping (:func:`solve`) and the run Dataset;
+* :mod:`~snapping.simulate.elastic_loads`: snap loads in SI (:func:`climbing_fall`).
 
 Example
 -------
@@ -15,7 +16,9 @@ Example
 'completed'
 """
 
+from .elastic_loads import EN892_LIMIT, climbing_fall, massless_peak_force
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_solve import METHODS, ElasticRun, solve
 
-__all__ = ["Elastic", "ElasticLine", "ElasticRun", "solve", "STARTS", "METHODS"]
+__all__ = ["Elastic", "ElasticLine", "ElasticRun", "solve", "STARTS", "METHODS", "climbing_fall", "massless_peak_force",
+           "EN892_LIMIT"]

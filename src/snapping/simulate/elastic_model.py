@@ -57,10 +57,15 @@ class Elastic:
     curve for every link (strains increasing from 0, tensions non-decreasing from 0,
     interpolated linearly, extended with the last slope; a first point other than (0, 0) is
     joined to (0, 0)); ``damping``: Kelvin-Voigt c (a number or one per link, >= 0), the
-    tension ``+ c de/dt`` while taut (the total never below 0).
+    tension ``+ c de/dt`` while taut (the total never below 0); ``grid_damping``: zeta >= 0, a
+    further Kelvin-Voigt damping ``zeta h_j sqrt(EA_j lambda_j)`` per link, the damping ratio
+    zeta for the line's shortest longitudinal mode (nodes moving against their neighbours,
+    omega = 2 c/h) and about ``zeta omega/omega_max`` for a mode of frequency omega (the long
+    waves: zeta pi h/(4 L) for the slowest), a numerical damping of the grid-scale ringing
+    that the release excites (see the elastic guide: it takes most of the cost away).
 
     >>> Elastic(ea=100.0).describe()
-    {'ea': 100.0, 'damping': 0.0, 'table': None}
+    {'ea': 100.0, 'damping': 0.0, 'table': None, 'grid_damping': 0.0}
     >>> Elastic(ea=-1.0)
     Traceback (most recent call last):
     ...
@@ -70,6 +75,7 @@ class Elastic:
     ea: object = None
     damping: object = 0.0
     table: tuple | None = None
+    grid_damping: float = 0.0
 
     def __post_init__(self):
         if (self.ea is None) == (self.table is None):
@@ -97,9 +103,13 @@ class Elastic:
         object.__setattr__(self, "damping", abs(float(d)) if d.ndim == 0 else d.copy())
         if self.table is not None:
             object.__setattr__(self, "table", _check_table(self.table))
+        z = V.real("grid_damping", self.grid_damping)
+        if not (np.isfinite(z) and z >= 0.0):
+            raise V.SnappingInputError(f"grid_damping={z!r} is out of range: the damping ratio must be finite and >= 0")
+        object.__setattr__(self, "grid_damping", float(z))
 
     @classmethod
-    def from_wave_speed(cls, c: float, *, lam: float = 1.0, damping=0.0) -> "Elastic":
+    def from_wave_speed(cls, c: float, *, lam: float = 1.0, damping=0.0, grid_damping: float = 0.0) -> "Elastic":
         """EA = lambda c^2 for the wave speed ``c`` (units of sqrt(g L)) on a line of mass per
         length ``lam`` (units of M/L; 1 for the uniform unit chain).
 
@@ -108,14 +118,15 @@ class Elastic:
         """
         c = V.positive("c", c)
         lam = V.positive("lam", lam)
-        return cls(ea=lam * c * c, damping=damping)
+        return cls(ea=lam * c * c, damping=damping, grid_damping=grid_damping)
 
     def describe(self) -> dict:
         def j(v):
             return v if np.ndim(v) == 0 else np.asarray(v).tolist()
 
         tab = None if self.table is None else [self.table[0].tolist(), self.table[1].tolist()]
-        return {"ea": None if self.ea is None else j(self.ea), "damping": j(self.damping), "table": tab}
+        return {"ea": None if self.ea is None else j(self.ea), "damping": j(self.damping), "table": tab,
+                "grid_damping": self.grid_damping}
 
 
 def _check_table(table) -> tuple:
@@ -197,6 +208,9 @@ class ElasticLine:
         else:
             self.tabe = self.tabt = self.tabw = np.zeros(0)
             self.ea = per_link("ea", elastic.ea)
+        if elastic.grid_damping > 0.0:
+            self.damp = self.damp + elastic.grid_damping * self.h * np.sqrt(self.ea * self.lam)
+        self._invm = 1.0 / self.m
         self._work = tuple(np.zeros(N) for _ in range(4))
 
     @property
@@ -206,6 +220,11 @@ class ElasticLine:
 
     # -- the state
     def pin_state(self, t: float) -> np.ndarray:
+        if self.pin.kind == "fixed":  # (a fixed end: computed once; its kinematics cost a quarter of a run)
+            if getattr(self, "_pin0", None) is None:
+                x, y, vx, vy, _, _ = self.pin.kinematics(0.0)
+                self._pin0 = np.array([x, y, vx, vy])
+            return self._pin0
         x, y, vx, vy, _, _ = self.pin.kinematics(float(t))
         return np.array([x, y, vx, vy])
 
@@ -239,7 +258,7 @@ class ElasticLine:
     # -- the compiled model
     def rhs(self, t: float, z: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         dz = np.empty_like(z) if out is None else out
-        EK.rhs(self.N, z, self.pin_state(t), self.h, 1.0 / self.m, self.ea, self.damp, self.tabe, self.tabt, self.g,
+        EK.rhs(self.N, z, self.pin_state(t), self.h, self._invm, self.ea, self.damp, self.tabe, self.tabt, self.g,
                dz, *self._work)
         return dz
 
@@ -264,7 +283,7 @@ class ElasticLine:
         """The Jacobian of :meth:`rhs` (analytic, banded: 7 sub- and super-diagonals), sparse."""
         indices, indptr, order = self._pattern()
         B = self._blocks
-        EK.jac_blocks(self.N, z, self.pin_state(t), self.h, 1.0 / self.m, self.ea, self.damp, self.tabe, self.tabt,
+        EK.jac_blocks(self.N, z, self.pin_state(t), self.h, self._invm, self.ea, self.damp, self.tabe, self.tabt,
                       B, *self._work)
         n = 4 * self.N + 2
         return sp.csc_matrix((B.ravel()[order], indices, indptr), shape=(n, n))

@@ -1,0 +1,166 @@
+"""Command-line options of the extensible, tension-only line (:mod:`snapping.simulate.elastic`)
+for ``snapping simulate``: in SI with --length/--mass (--ea N, --damping N s, --strain-table
+CSV of strain and tension in N) or nondimensional (--stretching C = c/sqrt(gL),
+--axial-damping in M g sqrt(L/g)). Every check is made before any work; a bad value is one
+line naming the option (exit 2)."""
+
+from __future__ import annotations
+
+import math
+
+#: the dests of the elastic options (any of them given: the elastic model)
+ELASTIC_DESTS = ("ea", "stretching", "axial_damping_si", "axial_damping", "grid_damping", "strain_table")
+#: simulate options the elastic model does not take (dest: why)
+NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
+               "record_thin": "--record-thin thins the rigid-link record",
+               "dt0": "--dt0 sets the rigid-link methods' first step",
+               "max_link_error": "--max-link-error checks rigid links", "chords": "--chords",
+               "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections",
+               "start": "--start (the bending line's start; the extensible line starts at its stretched equilibrium)"}
+
+
+def add_elastic_options(p) -> None:
+    g = p.add_argument_group(
+        "the extensible line (tension-only links: snapping.simulate.elastic; any of these runs it, with scipy's "
+        "Radau on the banded Jacobian, or --method dop853; released from its stretched equilibrium)",
+        "SI with --length METERS --mass KG [--g]; or nondimensional: EA in M g, c = sqrt(EA/lambda) in sqrt(g L)")
+    g.add_argument("--ea", type=float, default=None, metavar="N", help="axial stiffness EA in N (SI)")
+    g.add_argument("--stretching", type=float, default=None, metavar="C",
+                   help="axial stiffness as the wave speed c/sqrt(g L) of the uniform line (EA = c^2 M g)")
+    g.add_argument("--damping", dest="axial_damping_si", type=float, default=None, metavar="N_S",
+                   help="Kelvin-Voigt axial damping, N s (tension + damping x strain rate while taut; SI)")
+    g.add_argument("--axial-damping", dest="axial_damping", type=float, default=None, metavar="ETA",
+                   help="Kelvin-Voigt axial damping in units of M g sqrt(L/g)")
+    g.add_argument("--grid-damping", dest="grid_damping", type=float, default=None, metavar="ZETA",
+                   help="damping ratio of the shortest longitudinal mode (added Kelvin-Voigt damping; ~1 damps "
+                        "the release's grid-scale ringing, the long waves by about ZETA pi/(4N))")
+    g.add_argument("--strain-table", default=None, metavar="CSV",
+                   help="tension-strain curve: rows strain,tension (tension in N with --length/--mass, else in "
+                        "M g), strains increasing from 0; replaces --ea")
+
+
+def _given(args) -> list[str]:
+    return [d for d in ELASTIC_DESTS if getattr(args, d, None) is not None]
+
+
+def is_elastic(args) -> bool:
+    return bool(_given(args))
+
+
+def _finite_positive(opt: str, v: float, what: str) -> float:
+    from .._validate import SnappingInputError
+
+    if not (math.isfinite(v) and v > 0.0):
+        raise SnappingInputError(f"{opt}={v!r} is out of range: {what} must be finite and > 0")
+    return v
+
+
+def _read_table(path: str):
+    from .._validate import SnappingInputError
+
+    try:
+        with open(path, encoding="utf-8") as fh:
+            text = fh.read()
+    except OSError as exc:
+        raise SnappingInputError(f"--strain-table={path!r} cannot be read: {exc.strerror or exc}") from None
+    e, t = [], []
+    for k, line in enumerate(text.splitlines(), 1):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        parts = [q.strip() for q in s.split(",")]
+        try:
+            a, b = (float(q) for q in parts)
+        except ValueError:
+            if not e and k == 1 or not e and all(not _isnum(q) for q in parts):
+                continue  # a header line
+            raise SnappingInputError(f"--strain-table={path!r} line {k}: {s[:40]!r} is not two comma-separated "
+                                     f"numbers (strain,tension)") from None
+        e.append(a)
+        t.append(b)
+    if len(e) < 1:
+        raise SnappingInputError(f"--strain-table={path!r} has no rows strain,tension (CSV)")
+    return e, t
+
+
+def _isnum(q: str) -> bool:
+    try:
+        float(q)
+        return True
+    except ValueError:
+        return False
+
+
+def elastic_from_args(args, scales):
+    """The :class:`~snapping.simulate.elastic.Elastic` of the options (None when none is given),
+    after checking every one (SnappingInputError naming the option)."""
+    from .._validate import SnappingInputError
+    from ..simulate.elastic import Elastic
+
+    given = _given(args)
+    if not given:
+        return None
+    if args.method in ("euler-richardson", "euler-richardson-fixed"):
+        opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
+        raise SnappingInputError(f"{opt} (the extensible line) with --method {args.method}: the paper's method steps "
+                                 f"rigid links only; use --method fast (Radau) or dop853")
+    for dest, why in NOT_ELASTIC.items():
+        if dest in getattr(args, "_explicit", ()) and getattr(args, dest, None) not in (None, False):
+            raise SnappingInputError(f"{why} cannot be given with the extensible line (--ea/--stretching/...)")
+    from ._body import body_from_args
+    from .simulate3d import wants_3d
+
+    if wants_3d(args):
+        raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
+                                 "--perturb or --whirl")
+    if body_from_args(args) is not None:
+        raise SnappingInputError("bending, drag and wind are not built for the extensible line yet: give --ea/"
+                                 "--stretching without body options")
+    n_stiff = sum(getattr(args, d) is not None for d in ("ea", "stretching", "strain_table"))
+    if n_stiff != 1:
+        raise SnappingInputError("give exactly one of --ea, --stretching and --strain-table (the axial stiffness)")
+    if args.axial_damping is not None and args.axial_damping_si is not None:
+        raise SnappingInputError("give --damping (N s) or --axial-damping (nondimensional), not both")
+    need_si = [o for d, o in (("ea", "--ea"), ("axial_damping_si", "--damping")) if getattr(args, d) is not None]
+    if need_si and scales is None:
+        raise SnappingInputError(f"{need_si[0]} is in SI: it needs --length METERS and --mass KG (or use "
+                                 f"{'--stretching' if need_si[0] == '--ea' else '--axial-damping'})")
+    force = 1.0 if scales is None else scales.mass * scales.g
+    damping = 0.0
+    if args.axial_damping_si is not None or args.axial_damping is not None:
+        opt, v = (("--damping", args.axial_damping_si) if args.axial_damping_si is not None
+                  else ("--axial-damping", args.axial_damping))
+        if not (math.isfinite(v) and v >= 0.0):
+            raise SnappingInputError(f"{opt}={v!r} is out of range: the damping must be finite and >= 0")
+        damping = v / (force * scales.time) if opt == "--damping" else v
+    zeta = 0.0 if args.grid_damping is None else args.grid_damping
+    if not (math.isfinite(zeta) and zeta >= 0.0):
+        raise SnappingInputError(f"--grid-damping={zeta!r} is out of range: the damping ratio must be finite and >= 0")
+    if args.ea is not None:
+        ea = _finite_positive("--ea", args.ea, "the axial stiffness EA (N)")
+        return Elastic(ea=ea / force, damping=damping, grid_damping=zeta)
+    if args.stretching is not None:
+        c = _finite_positive("--stretching", args.stretching, "the wave speed c/sqrt(g L)")
+        return Elastic.from_wave_speed(c, damping=damping, grid_damping=zeta)
+    e, t = _read_table(args.strain_table)
+    try:
+        return Elastic(table=(e, [v / force for v in t]), damping=damping, grid_damping=zeta)
+    except SnappingInputError as exc:
+        raise SnappingInputError(f"--strain-table={args.strain_table!r}: {exc}") from None
+
+
+def run_elastic(args, problem, elastic, times):
+    """Solve, write -o, and return (summary, dataset)."""
+    from .. import _files
+    from ..simulate.elastic import solve
+
+    out = None
+    if args.output is not None:
+        out = _files.check_output(args.output, overwrite=args.overwrite)
+    r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
+              method="dop853" if args.method == "dop853" else "radau", stop_fraction=args.stop_fraction,
+              snapshot_times=times)
+    if out is not None:
+        ds = r.dataset
+        _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
+    return r.summary(), r.dataset
