@@ -9,7 +9,7 @@ Pure functions on arrays, then on a study (:func:`snapping.regimes.regimes`):
 * :func:`crossover` finds the first number where a ratio to the ideal falls below
   ``level`` (0.9: 10% below), interpolated linearly in (log number, log ratio), with an
   interval from the ratios' error bars.
-* :func:`analyze` applies both to each chi of a study, fits the crossover against chi,
+* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%) of each chi of a study, fits the crossover against chi,
   and :func:`report` prints it; :func:`regime_map` draws chi against the number, colour
   the peak over the ideal's, with the 0.9 contour.
 
@@ -30,7 +30,7 @@ import numpy as np
 
 from . import _validate as V
 
-__all__ = ["power_law", "crossover", "analyze", "report", "regime_map", "LEVEL"]
+__all__ = ["power_law", "crossover", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR"]
 
 #: the crossover: the peak 10% below the ideal's
 LEVEL = 0.9
@@ -170,19 +170,41 @@ def crossover(numbers, ratio, ratio_err=None, *, level: float = LEVEL) -> dict:
             "statement": f"crossover at {c:.3g}" + (f" (interval {lo:.3g}..{hi:.3g})" if e is not None else "")}
 
 
-def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1) -> dict:
-    """Per chi of a study: the power law of the peak against the number and the crossover;
-    and the crossover against chi (a power law where three chi or more cross)."""
+#: a cell is resolved when its extrapolation converged with an error bar at most this fraction of its value
+MAX_REL_ERROR = 0.05
+
+
+def resolved(value, error, order, max_rel_error: float = MAX_REL_ERROR) -> np.ndarray:
+    """Which cells are resolved: an observed order (the levels converge) and a relative error
+    bar <= ``max_rel_error``. The others are left out of fits and crossovers, and named."""
+    v, e, o = (np.asarray(a, dtype=float) for a in (value, error, order))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.isfinite(o) & np.isfinite(v) & (np.abs(e) <= max_rel_error * np.abs(v))
+
+
+def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_error: float = MAX_REL_ERROR) -> dict:
+    """Per chi of a study: the power law of the peak against the number and the crossover,
+    on the resolved cells (:func:`resolved`); and the crossover against chi."""
     if quantity not in ds or f"{quantity}_ratio" not in ds:
         raise V.SnappingInputError(f"quantity={quantity!r} is not in the study")
     nums = ds.number.values
     rows = {}
     for chi in ds.chi.values:
         c = ds.sel(chi=chi)
-        fit = power_law(nums, c[quantity].values, c[f"{quantity}_error"].values, slope_tol=slope_tol)
-        cross = crossover(nums, c[f"{quantity}_ratio"].values, c[f"{quantity}_ratio_error"].values)
+        ok = resolved(c[quantity].values, c[f"{quantity}_error"].values, c[f"{quantity}_order"].values, max_rel_error)
+        ideal_ok = abs(float(c[f"{quantity}_ideal_error"])) <= max_rel_error * abs(float(c[f"{quantity}_ideal"]))
+        fit = power_law(nums[ok], c[quantity].values[ok], c[f"{quantity}_error"].values[ok], slope_tol=slope_tol)
+        cross = crossover(nums[ok], c[f"{quantity}_ratio"].values[ok], c[f"{quantity}_ratio_error"].values[ok])
+        if not ideal_ok:
+            cross = {**cross, "number": float("nan"), "bracketed": False,
+                     "statement": "no crossover: the ideal's limit is not resolved (error bar > "
+                                  f"{max_rel_error:.0%})"}
+        bad = [format(n, "g") for n in nums[~ok]]
+        if bad:
+            note = f" [unresolved, left out: {', '.join(bad)}]"
+            fit["statement"] += note
         rows[float(chi)] = {"fit": fit, "crossover": cross, "ideal": float(c[f"{quantity}_ideal"]),
-                            "ideal_error": float(c[f"{quantity}_ideal_error"])}
+                            "ideal_error": float(c[f"{quantity}_ideal_error"]), "unresolved": bad}
     pts = [(chi, r["crossover"]["number"]) for chi, r in rows.items() if r["crossover"]["bracketed"]]
     law = {"statement": f"crossover against chi: {len(pts)} chi with a bracketed crossover (a law needs 2 or more)"}
     if len(pts) >= 2:
