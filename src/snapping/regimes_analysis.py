@@ -9,7 +9,8 @@ Pure functions on arrays, then on a study (:func:`snapping.regimes.regimes`):
 * :func:`crossover` finds the first number where a ratio to the ideal falls below
   ``level`` (0.9: 10% below), interpolated linearly in (log number, log ratio), with an
   interval from the ratios' error bars.
-* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%) of each chi of a study, fits the crossover against chi,
+* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%) of each chi of a study
+  (the power law to the capped cells alone, ratio < 0.9), fits the crossover against chi,
   and :func:`report` prints it; :func:`regime_map` draws chi against the number, colour
   the peak over the ideal's, with the 0.9 contour.
 
@@ -183,8 +184,9 @@ def resolved(value, error, order, max_rel_error: float = MAX_REL_ERROR) -> np.nd
 
 
 def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_error: float = MAX_REL_ERROR) -> dict:
-    """Per chi of a study: the power law of the peak against the number and the crossover,
-    on the resolved cells (:func:`resolved`); and the crossover against chi."""
+    """Per chi of a study: the power law of the peak against the number in the capped regime
+    (resolved cells whose ratio to the ideal is below :data:`LEVEL`) and the crossover (on
+    the resolved cells, :func:`resolved`); and the crossover against chi."""
     if quantity not in ds or f"{quantity}_ratio" not in ds:
         raise V.SnappingInputError(f"quantity={quantity!r} is not in the study")
     nums = ds.number.values
@@ -193,7 +195,10 @@ def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_err
         c = ds.sel(chi=chi)
         ok = resolved(c[quantity].values, c[f"{quantity}_error"].values, c[f"{quantity}_order"].values, max_rel_error)
         ideal_ok = abs(float(c[f"{quantity}_ideal_error"])) <= max_rel_error * abs(float(c[f"{quantity}_ideal"]))
-        fit = power_law(nums[ok], c[quantity].values[ok], c[f"{quantity}_error"].values[ok], slope_tol=slope_tol)
+        capped = ok & (c[f"{quantity}_ratio"].values < LEVEL)  # the law of the cap: past the crossover only
+        fit = power_law(nums[capped], c[quantity].values[capped], c[f"{quantity}_error"].values[capped],
+                        slope_tol=slope_tol)
+        fit["statement"] = f"capped regime (ratio < {LEVEL:g}, {int(capped.sum())} resolved cells): " + fit["statement"]
         cross = crossover(nums[ok], c[f"{quantity}_ratio"].values[ok], c[f"{quantity}_ratio_error"].values[ok])
         if not ideal_ok:
             cross = {**cross, "number": float("nan"), "bracketed": False,
@@ -214,7 +219,7 @@ def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_err
             law = {"exponent": p, "exponent_err": float("nan"), "prefactor": nx[0] / cx[0] ** p,
                    "statement": f"crossover ~ chi^{p:.3f} (two chi: no uncertainty)"}
         else:
-            f = power_law(cx, nx, slope_tol=math.inf)
+            f = power_law(cx, nx, slope_tol=1e300)  # (one law through every chi)
             law = {**f, "statement": f"crossover ~ {f['prefactor']:.3g} chi^{f['exponent']:.3f} +- "
                                      f"{f['exponent_err']:.2g}"}
     return {"quantity": quantity, "mechanism": ds.attrs["mechanism"], "number_name": ds.attrs["number_name"],
