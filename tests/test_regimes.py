@@ -207,3 +207,13 @@ def test_cli_bad_input_exits_2(tmp_path):
 def test_unresolved_cells_are_left_out():
     ok = A.resolved([10.0, 10.0, 10.0, 10.0], [0.1, 0.6, 0.1, float("nan")], [1.5, 1.5, float("nan"), 1.5])
     assert ok.tolist() == [True, False, False, False]  # 6% error bar; no order; no error bar
+
+
+def test_dask_scheduler_gives_the_local_result():
+    distributed = pytest.importorskip("dask.distributed")
+    kw = dict(levels=2, first=-3, progress=False)
+    with distributed.Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as client:
+        remote = R.regimes("drag", [CHI], [1e-3], scheduler=client, **kw)
+    local = R.regimes("drag", [CHI], [1e-3], **kw)
+    assert remote.attrs["status"] == "complete"
+    np.testing.assert_array_equal(remote.v_peak_level.values, local.v_peak_level.values)
