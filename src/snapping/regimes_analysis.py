@@ -271,6 +271,8 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
                 ax.annotate(f"{r[i, j]:.2f}", (n, chi), ha="center", va="center", fontsize=7, color="k",
                             bbox={"boxstyle": "round", "fc": "w", "alpha": 0.6, "lw": 0})
     ax.set_xscale("log")
+    if nums.size >= 2:  # the edge cells whole (half a log step beyond the first and last numbers)
+        ax.set_xlim(nums[0] / math.sqrt(nums[1] / nums[0]), nums[-1] * math.sqrt(nums[-1] / nums[-2]))
     ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
     ax.set_ylabel("chi")
     ax.set_title(f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})")
