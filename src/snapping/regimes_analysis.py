@@ -260,7 +260,17 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
     r = ds[f"{quantity}_ratio"].values
     nums, chis = ds.number.values, ds.chi.values
     fig, ax = plt.subplots(figsize=(6, 4))
-    mesh = ax.pcolormesh(nums, chis, r, shading="nearest", cmap="viridis", vmin=0.0, vmax=max(1.0, np.nanmax(r)))
+    def edges(v, log):  # cell edges halfway between the values (in log for the numbers)
+        u = np.log(v) if log else np.asarray(v, float)
+        if u.size == 1:
+            e = np.array([u[0] - 0.5, u[0] + 0.5]) if log else np.array([u[0] * 0.9, u[0] * 1.1])
+        else:
+            mid = 0.5 * (u[1:] + u[:-1])
+            e = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+        return np.exp(e) if log else e
+
+    mesh = ax.pcolormesh(edges(nums, True), edges(chis, False), r, shading="flat", cmap="viridis", vmin=0.0,
+                         vmax=max(1.0, np.nanmax(r)))
     fig.colorbar(mesh, ax=ax, label=f"{quantity} / ideal")
     if r.shape[0] >= 2 and r.shape[1] >= 2 and np.nanmin(r) < LEVEL < np.nanmax(r):
         cs = ax.contour(nums, chis, r, levels=[LEVEL], colors="w")
@@ -271,8 +281,6 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
                 ax.annotate(f"{r[i, j]:.2f}", (n, chi), ha="center", va="center", fontsize=7, color="k",
                             bbox={"boxstyle": "round", "fc": "w", "alpha": 0.6, "lw": 0})
     ax.set_xscale("log")
-    if nums.size >= 2:  # the edge cells whole (half a log step beyond the first and last numbers)
-        ax.set_xlim(nums[0] / math.sqrt(nums[1] / nums[0]), nums[-1] * math.sqrt(nums[-1] / nums[-2]))
     ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
     ax.set_ylabel("chi")
     ax.set_title(f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})")
