@@ -8,7 +8,7 @@ Bad input (a :class:`ValueError` from the library, or an argparse error) prints
 one line on stderr and exits with status 2, without a traceback.
 
 The subcommands live in one module per group: ``estimate`` (ideal, estimate,
-design), ``simulate``, ``sweep`` (sweep, converge) and ``analysis`` (fit,
+design), ``simulate``, ``sweep`` (sweep, converge), ``regimes`` and ``analysis`` (fit,
 reproduce, plot, animate); ``_common`` holds what they share (printing, the SI
 options). This module holds the parser, :func:`main` and the error handling.
 """
@@ -22,6 +22,7 @@ from ._common import PLOT_BYTES, _formatter, print_json, print_table
 from .analysis import _add_animate, _add_fit, _add_plot, _add_reproduce
 from .estimate import _add_design, _add_estimate, _add_ideal
 from .simulate import _add_simulate
+from .regimes import _add_regimes
 from .sweep import _add_converge, _add_sweep
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_FAILED", "PLOT_BYTES", "build_parser", "main", "print_json", "print_table"]
@@ -31,7 +32,7 @@ EXIT_FAILED = 1  # a numerical failure or an I/O fault (e.g. a full disk)
 
 #: the subcommands' ``_add_<name>`` functions, in the order of the help
 _SUBCOMMANDS = (_add_ideal, _add_estimate, _add_design, _add_simulate, _add_sweep, _add_fit, _add_converge,
-                _add_reproduce, _add_plot, _add_animate)
+                _add_regimes, _add_reproduce, _add_plot, _add_animate)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,0 +1,87 @@
+"""The subcommand ``regimes``: a mechanism's number against chi, continuum-extrapolated peaks,
+power laws, crossovers and the regime map (:mod:`snapping.regimes`, :mod:`snapping.regimes_analysis`)."""
+
+from __future__ import annotations
+
+from ._common import PLOT_BYTES, _floats, _formatter, print_json
+
+
+def _add_regimes(sub) -> None:
+    from ..regimes import ACCURACY, MECHANISMS
+
+    p = sub.add_parser(
+        "regimes",
+        help="what caps the snap: a mechanism's number x chi, converged peaks against the ideal's, regime map",
+        formatter_class=_formatter,
+        description=(
+            "For every chi and number, refine the chain level by level (fold-graded; uniform\n"
+            "with bending) and extrapolate the peaks to the continuum, beside the ideal chain's\n"
+            "limit (number 0). Prints each peak's ratio to the ideal, the power law of the peak\n"
+            "against the number where its local slope is constant, and the crossover number where\n"
+            "the peak falls 10% below the ideal's. The study file (-o) is rewritten after every\n"
+            "run and reused by a rerun of the same study (another study's file is refused).\n"
+            "Numbers: bending beta = B/(lambda g L^3); drag 0.5 rho C d L/lambda; end-mass\n"
+            "M_end/(lambda L) (snapping.dimensionless). Nondimensional units."
+        ),
+        epilog=(
+            "examples:\n"
+            "  snapping regimes --mechanism end-mass --chi 0.25 --numbers 1e-3,1e-2 -o em.nc   # ~1 min\n"
+            "  snapping regimes --mechanism bending --chi 0.1,0.25 --numbers 1e-6,1e-4,1e-2 -o bend.nc --workers 2\n"
+            "  snapping regimes --mechanism drag --chi 0.1,0.25 --numbers 0.01,0.1,1,10 -o drag.nc --plot drag.png\n"
+            "  snapping regimes --load drag.nc --plot drag.png           # the map of a finished study"
+        ),
+    )
+    p.add_argument("--mechanism", choices=sorted(MECHANISMS), default=None, help="the mechanism scanned")
+    p.add_argument("--chi", type=_floats, default=None, help="comma-separated end separations in (0, 1)")
+    p.add_argument("--numbers", type=_floats, default=None, help="comma-separated values of the mechanism's number")
+    p.add_argument("--accuracy", choices=sorted(ACCURACY), default="coarse",
+                   help="levels preset (default coarse: 3 levels; medium: 4 levels, ~1e-3 in the ideal's peaks)")
+    p.add_argument("--levels", type=int, default=None, help="override the preset's refinement levels")
+    p.add_argument("--first", type=int, default=None, help="override the preset's first fold-graded level")
+    p.add_argument("--n0", type=int, default=None, help="override the preset's links of the first uniform level")
+    p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+    p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    p.add_argument("-o", "--output", default=None, metavar="FILE", help="the study file (netCDF), resumable")
+    p.add_argument("--load", default=None, metavar="FILE", help="report (and --plot) a study file, running nothing")
+    p.add_argument("--plot", default=None, metavar="PATH", help="draw the regime map (.png, .pdf, .svg)")
+    p.add_argument("--quantity", default="v_peak", choices=["v_peak", "a_peak", "sigma_peak", "kappa_peak"],
+                   help="the peak of the map (default v_peak)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true", help="print the analysis as one JSON object")
+    p.set_defaults(func=_cmd_regimes)
+
+
+def _cmd_regimes(args) -> int:
+    from .. import regimes as R
+    from .. import regimes_analysis as A
+    from .._files import check_output, figure_format
+    from .._validate import SnappingInputError
+
+    if args.plot is not None:
+        figure_format(args.plot, name="--plot")
+        check_output(args.plot, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)
+    if args.load is not None:
+        if args.mechanism or args.chi or args.numbers:
+            raise SnappingInputError("--load reads a finished study: give no --mechanism, --chi or --numbers")
+        ds = R.load_study(args.load)
+    else:
+        missing = [o for o, v in (("--mechanism", args.mechanism), ("--chi", args.chi), ("--numbers", args.numbers))
+                   if v is None]
+        if missing:
+            raise SnappingInputError(f"regimes needs {', '.join(missing)} (or --load FILE)")
+        ds = R.regimes(args.mechanism, args.chi, args.numbers, accuracy=args.accuracy, levels=args.levels,
+                       first=args.first, n0=args.n0, workers=args.workers, scheduler=args.scheduler,
+                       out=args.output, progress=not args.no_progress)
+    if args.json:
+        out = {q: A.analyze(ds, q) for q in ("v_peak", "a_peak", "sigma_peak")}
+        print_json({"study": {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items()},
+                    "analysis": out})
+    else:
+        print("\n".join(A.report(ds)))
+    if args.plot is not None:
+        import matplotlib.pyplot as plt
+
+        plt.close(A.regime_map(ds, args.plot, quantity=args.quantity))
+        print(f"regime map: {args.plot}")
+    return 0

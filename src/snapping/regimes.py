@@ -1,0 +1,395 @@
+"""Regime studies: what caps the snap of a real body (issue 24, item 2).
+
+:func:`regimes` scans one mechanism's nondimensional number (:mod:`snapping.dimensionless`)
+against the end separation chi. Every cell (chi, number) is a continuum study like
+:func:`snapping.continuum.converge`: the same problem at ``levels`` resolutions, each
+peak (speed, acceleration, tension, curvature, snapping time) extrapolated to the
+continuum (:func:`snapping.continuum.extrapolate`: observed order, Richardson limit, error
+bar). Beside the cells, the ideal chain's continuum limit at each chi (number = 0,
+fold-following graded chains: the limit the paper quotes) and each peak's ratio to it.
+
+Mechanisms (:data:`MECHANISMS`) and their resolutions:
+
+* ``bending``: ``Body(bending=beta)``; uniform chains of ``n0 / ratio**k`` links (a bending
+  wave's explicit step cannot afford the fold-following grading's smallest links). A fold
+  thinner than the finest link (small beta) is not resolved: the error bars say so, and
+  the cell does not reach the ideal limit as beta -> 0.
+* ``drag`` (normal number d, tangential ``d * pi C_t / C_n`` with the default coefficients
+  of :mod:`snapping.units`), ``drag-normal``, ``drag-tangential``: ``Body(drag_...)``;
+  fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
+* ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``);
+  fold-following graded chains.
+* ``stretching`` (the elastic model) is not scanned yet: it is too slow for a scan; the
+  hook is :data:`MECHANISMS` (add an entry whose ``problem`` builds the elastic problem).
+
+The work is one task per (cell, level) run, on the sweep's workers: local processes
+(:func:`snapping._workers.run_all`) or a Dask cluster (``scheduler``). The study file
+``out`` is rewritten (atomically) after every run: an interrupted study keeps what is
+done, and a rerun computes only the runs missing. A file at ``out`` that holds another
+study (other mechanism, grid or accuracy) is refused, never overwritten.
+
+Example
+-------
+>>> ds = regimes("end-mass", [0.5], [1e-3], progress=False)  # doctest: +SKIP
+>>> float(ds.v_peak_ratio.sel(chi=0.5, number=1e-3))  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+
+import numpy as np
+import xarray as xr
+
+from . import _validate as V
+from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
+
+__all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem"]
+
+#: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
+MECHANISMS = {
+    "bending": ("beta", "uniform", "bending stiffness B/(lambda g L^3)"),
+    "drag": ("drag_normal", "fold", "air drag: normal number d, tangential d*pi*C_t/C_n (default coefficients)"),
+    "drag-normal": ("drag_normal", "fold", "normal (cross-flow) air drag alone"),
+    "drag-tangential": ("drag_tangential", "fold", "tangential air drag (skin friction) alone"),
+    "end-mass": ("end_mass", "fold", "a point mass M_end/(lambda L) at the free end"),
+}
+
+#: accuracy presets: levels, first level, links of level 0 of uniform chains (n0), tolerance. Measured
+#: (ideal chain, `benchmarks`-free check in the guide): coarse gives 34.1 +- 2.0 at chi = 0.1 and
+#: 11.33 +- 0.13 at chi = 0.25 (fold-graded 493-1857 and 193-639 links), medium 32.98 +- 0.10 and
+#: 11.282 +- 0.004 (947-7328 and 341-2436 links); the paper's limits are 32.97 and 11.28
+ACCURACY = {
+    "coarse": {"levels": 3, "first": -2, "n0": 50, "tol": 1e-7},
+    "medium": {"levels": 4, "first": -1, "n0": 50, "tol": 1e-7},
+    "fine": {"levels": 4, "first": 0, "n0": 100, "tol": 1e-7},
+}
+
+#: the largest number a cell takes (every mechanism's number is a ratio to the chain's scales)
+NUMBER_MAX = 1e4
+
+
+def _drag_ratio() -> float:
+    from . import units
+
+    return math.pi * units.CD_TANGENTIAL / units.CD_NORMAL
+
+
+def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping: str = "shared"):
+    """The problem of one run: the catenary of separation ``chi`` with the mechanism at
+    ``number`` (0 or ``mechanism=None``: the ideal chain, fold-graded) at the resolution
+    ``level`` (``n_links``: a uniform chain; else the fold-following grading)."""
+    from .simulate import Body, Links, Problem, grading
+
+    if "n_links" in level:
+        h = np.full(int(level["n_links"]), 1.0 / int(level["n_links"]))
+    else:
+        h = grading.fold_following(chi, frac=level["frac"], h_min=level["h_min"], h_max=level["h_max"])
+    body, tip = None, 0.0
+    if mechanism == "bending" and number > 0:
+        body = Body(bending=number)
+    elif mechanism == "drag" and number > 0:
+        body = Body(drag_normal=number, drag_tangential=number * _drag_ratio())
+    elif mechanism == "drag-normal" and number > 0:
+        body = Body(drag_normal=number)
+    elif mechanism == "drag-tangential" and number > 0:
+        body = Body(drag_tangential=number)
+    elif mechanism == "end-mass":
+        tip = float(number)
+    return Problem.catenary(chi, links=Links.graded(h, lumping=lumping, tip_mass=tip), chords="exact", body=body)
+
+
+def _run_task(chi, mechanism, number, level, tol):
+    """Worker: one run of one cell at one level; its peaks and cost (no file: the study keeps them)."""
+    from .simulate import run
+
+    problem = cell_problem(chi, mechanism, number, level)
+    cpu = time.process_time()
+    ds = run(problem, method="fast", tol=tol, progress=False).dataset
+    a = ds.attrs
+    if a.get("status") != "completed":
+        raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
+                           f"{a.get('stop_reason', '')}")
+    row = {q: float(a[q]) for q in QUANTITIES}
+    row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
+    return row
+
+
+def _levels(grading: str, acc: dict, ratio: float) -> list[dict]:
+    if grading == "uniform":
+        return _uniform_levels(acc["levels"], ratio, acc["n0"], 0)
+    return level_parameters(acc["levels"], ratio, first=acc["first"])
+
+
+def _numbers(numbers) -> list[float]:
+    if isinstance(numbers, (int, float)):
+        numbers = [numbers]
+    if isinstance(numbers, (str, bytes, dict)) or not hasattr(numbers, "__iter__"):
+        raise V.SnappingInputError(f"numbers={numbers!r} is not a list of values")
+    out = []
+    for x in numbers:
+        v = V.real("numbers", x)
+        if not (math.isfinite(v) and 0.0 < v <= NUMBER_MAX):
+            raise V.SnappingInputError(f"numbers: {v!r} is out of range: each must lie in (0, {NUMBER_MAX:g}] "
+                                       f"(the ideal, number 0, is computed anyway)")
+        out.append(v)
+    if not out or len(set(out)) != len(out):
+        raise V.SnappingInputError(f"numbers={list(numbers)!r}: give one or more distinct values")
+    return sorted(out)
+
+
+def _study_key(mechanism, chis, numbers, acc, ratio) -> str:
+    return json.dumps({"mechanism": mechanism, "chi": chis, "number": numbers, "ratio": ratio, **acc},
+                      sort_keys=True)
+
+
+def load_study(path) -> xr.Dataset:
+    """A regime study's file (:func:`regimes`), loaded into memory."""
+    p = V.file_path("path", path)
+    if not os.path.isfile(p):
+        raise V.SnappingInputError(f"path={p!r} does not exist")
+    try:
+        with xr.open_dataset(p) as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as exc:
+        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF file ({exc})") from None
+    if "regimes_study" not in ds.attrs:
+        raise V.SnappingInputError(f"path={p!r} is not a regime study (snapping regimes)")
+    return ds
+
+
+def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
+    nc, nn, nl = len(chis), len(numbers), len(levels)
+    data = {}
+    for q in QUANTITIES + ("n_rhs", "cpu_time"):
+        data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
+        data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
+    data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
+    data["n_links_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
+    data["resolution"] = ("level", np.array([p["frac"] for p in levels]),
+                          {"long_name": "resolution of a cell's level: link length (uniform) or fold fraction"})
+    data["resolution_ideal"] = ("level", np.array([p["frac"] for p in ideal_levels]),
+                                {"long_name": "fold fraction of the ideal chain's levels (fold-following)"})
+    name, grading, what = MECHANISMS[mechanism]
+    attrs = {"title": "snapping: regime study (peaks against a mechanism's number, continuum-extrapolated)",
+             "regimes_study": key, "mechanism": mechanism, "number_name": name, "mechanism_description": what,
+             "grading": grading, "ratio": ratio, "status": "partial", **{k: acc[k] for k in acc}}
+    if mechanism == "drag":
+        attrs["drag_tangential_ratio"] = _drag_ratio()
+    return xr.Dataset(data, coords={"chi": ("chi", np.array(chis, float)), "number": ("number", np.array(numbers)),
+                                    "level": ("level", np.arange(nl))}, attrs=attrs)
+
+
+def _finish(ds: xr.Dataset) -> xr.Dataset:
+    """The limits, error bars, orders and ratios of every cell whose levels are all done."""
+    nc, nn = ds.sizes["chi"], ds.sizes["number"]
+    for q in QUANTITIES:
+        lim, err, order = (np.full((nc, nn), np.nan) for _ in range(3))
+        ilim, ierr = np.full(nc, np.nan), np.full(nc, np.nan)
+        for i in range(nc):
+            row = ds[f"{q}_ideal_level"].values[i]
+            if np.all(np.isfinite(row)):
+                e = extrapolate(ds.resolution_ideal.values, row)
+                ilim[i], ierr[i] = e["limit"], e["error"]
+            for j in range(nn):
+                row = ds[f"{q}_level"].values[i, j]
+                if np.all(np.isfinite(row)):
+                    e = extrapolate(ds.resolution.values, row)
+                    lim[i, j], err[i, j], order[i, j] = e["limit"], e["error"], e["order"]
+        ds[q] = (("chi", "number"), lim, {"long_name": f"continuum limit of {q}"})
+        ds[f"{q}_error"] = (("chi", "number"), err, {"long_name": f"error bar of {q}"})
+        ds[f"{q}_order"] = (("chi", "number"), order, {"long_name": f"observed order of convergence of {q}"})
+        ds[f"{q}_ideal"] = ("chi", ilim, {"long_name": f"ideal chain's continuum limit of {q} (number 0)"})
+        ds[f"{q}_ideal_error"] = ("chi", ierr)
+        r = lim / ilim[:, None]
+        ds[f"{q}_ratio"] = (("chi", "number"), r, {"long_name": f"{q} / the ideal's"})
+        ds[f"{q}_ratio_error"] = (("chi", "number"),
+                                  np.abs(r) * np.hypot(err / lim, (ierr / ilim)[:, None]))
+    done = np.isfinite(ds["v_peak_level"].values).all() and np.isfinite(ds["v_peak_ideal_level"].values).all()
+    ds.attrs["status"] = "complete" if done else "partial"
+    return ds
+
+
+def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
+            first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
+            workers: int = 1, scheduler=None, out=None, progress: bool = True) -> xr.Dataset:
+    """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
+
+    Parameters
+    ----------
+    mechanism : str
+        One of :data:`MECHANISMS`.
+    chis : sequence of float
+        End separations, each in (0, 1).
+    numbers : sequence of float
+        The mechanism's number (:mod:`snapping.dimensionless`), each > 0 (the ideal, 0, is
+        always computed, fold-graded).
+    accuracy : str
+        A preset of :data:`ACCURACY` (``coarse``: 3 fold-graded levels, 193-639 links at chi = 0.25; uniform 50-200).
+    levels, first, n0, tol
+        Override the preset: refinement levels, the first fold-graded level (as
+        :func:`snapping.continuum.level_parameters`), links of the first uniform level, the
+        fast method's tolerance.
+    ratio : float
+        Resolution ratio from one level to the next.
+    workers : int
+        Local worker processes (the sweep's, :mod:`snapping._workers`).
+    scheduler : str or dask.distributed.Client, optional
+        Run on this Dask cluster instead.
+    out : path, optional
+        The study file (netCDF), rewritten after each run; reused when it holds this study.
+    progress : bool
+        A progress bar (runs done).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions chi, number, level: ``{q}_level`` (each run's peak), ``{q}`` (limit),
+        ``{q}_error``, ``{q}_order``, ``{q}_ideal`` (+ ``_error``, per chi), ``{q}_ratio``
+        (+ ``_error``) for q in :data:`snapping.continuum.QUANTITIES`.
+
+    Raises
+    ------
+    SnappingInputError
+        Bad input, or ``out`` holding another study or another program's file, before any run.
+    """
+    from tqdm.auto import tqdm
+
+    from .estimates import check_chi
+
+    if mechanism not in MECHANISMS:
+        raise V.SnappingInputError(f"mechanism={mechanism!r} is not one of {sorted(MECHANISMS)} (stretching: the "
+                                   f"elastic model is not scanned yet)")
+    if not isinstance(accuracy, str) or accuracy not in ACCURACY:
+        raise V.SnappingInputError(f"accuracy={accuracy!r} is not one of {sorted(ACCURACY)}")
+    acc = dict(ACCURACY[accuracy])
+    for k, v in (("levels", levels), ("first", first), ("n0", n0), ("tol", tol)):
+        if v is not None:
+            acc[k] = v
+    acc["levels"] = V.integer("levels", acc["levels"], 2, 12)
+    acc["first"] = V.integer("first", acc["first"], -20, 20)
+    acc["n0"] = V.integer("n0", acc["n0"], 2, 10**6)
+    acc["tol"] = V.open_interval("tol", acc["tol"], 0.0, 1e-2)
+    ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
+    workers = V.integer("workers", workers, 1)
+    if isinstance(chis, (int, float)):
+        chis = [chis]
+    chis = sorted(check_chi(c) for c in chis)
+    if not chis or len(set(chis)) != len(chis):
+        raise V.SnappingInputError(f"chis={chis!r}: give one or more distinct values")
+    numbers = _numbers(numbers)
+    grading = MECHANISMS[mechanism][1]
+    levels_p = _levels(grading, acc, ratio)
+    ideal_p = _levels("fold", acc, ratio)
+    key = _study_key(mechanism, chis, numbers, acc, ratio)
+    ds = _empty(mechanism, chis, numbers, levels_p, ideal_p, key, acc, ratio)
+    lock = None
+    if out is not None:
+        from ._files import check_output, locked
+
+        out = V.file_path("out", out)
+        if os.path.lexists(out):
+            check_output(out, name="out", overwrite=True)  # a regular file
+            try:
+                old = load_study(out)
+            except V.SnappingInputError:
+                raise V.SnappingInputError(f"out={out!r} exists and is not a regime study: it is not replaced "
+                                           f"(give another path)") from None
+            if old.attrs["regimes_study"] != key:
+                raise V.SnappingInputError(f"out={out!r} holds another study ({old.attrs['regimes_study']}); "
+                                           f"this one is {key}: give another path (it is not replaced)")
+            ds = old
+        lock = locked(out, name="out")
+    # the runs still to do: (chi index, number index or None for the ideal, level index)
+    todo = []
+    for i, chi in enumerate(chis):
+        for k in range(len(levels_p)):
+            if not np.isfinite(ds["v_peak_ideal_level"].values[i, k]):
+                todo.append((i, None, k))
+            for j in range(len(numbers)):
+                if not np.isfinite(ds["v_peak_level"].values[i, j, k]):
+                    todo.append((i, j, k))
+    todo.sort(key=lambda t: (t[2], t[0], -1 if t[1] is None else t[1]))  # coarse levels first
+    calls = {}
+    for t in todo:
+        i, j, k = t
+        if j is None:
+            calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
+        else:
+            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"])
+    for args in calls.values():  # every run's problem is checked before any starts
+        cell_problem(*args[:4])
+
+    bar = tqdm(total=len(ds.chi) * (len(numbers) + 1) * len(levels_p), initial=0, desc=f"regimes {mechanism}",
+               unit="run", disable=not progress)
+    bar.update(bar.total - len(todo))
+    failures = []
+
+    def save():
+        if out is not None:
+            from .sweep_files import atomic_to_netcdf
+
+            atomic_to_netcdf(_finish(ds.copy()), out)
+
+    def collect(t, result):
+        try:
+            row = result()
+        except Exception as exc:  # noqa: BLE001 - reported after the other runs
+            failures.append(f"{calls[t][1] or 'ideal'} chi={calls[t][0]:g} number={calls[t][2]:g} level {t[2]}: "
+                            f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
+            bar.update(1)
+            return
+        i, j, k = t
+        for q, v in row.items():
+            name = f"{q}_ideal_level" if j is None else f"{q}_level"
+            if j is None:
+                ds[name].values[i, k] = v
+            else:
+                ds[name].values[i, j, k] = v
+        save()
+        bar.update(1)
+
+    import contextlib
+
+    with lock if lock is not None else contextlib.nullcontext():
+        try:
+            if scheduler is not None and todo:
+                from dask.distributed import as_completed as dask_completed
+
+                from .sweep_run import _client_for
+
+                client, owned = _client_for(scheduler)
+                futures = {}
+                try:
+                    futures = {client.submit(_run_task, *calls[t], pure=False): t for t in todo}
+                    for fut in dask_completed(futures):
+                        collect(futures[fut], fut.result)
+                except BaseException:
+                    client.cancel(list(futures))
+                    raise
+                finally:
+                    if owned:
+                        client.close()
+            elif workers > 1 and len(todo) > 1:
+                from . import _workers
+
+                order = list(todo)
+                _workers.run_all(min(workers, len(todo)), _run_task, [calls[t] for t in order],
+                                 lambda args, res: collect(order[[calls[t] for t in order].index(args)], res))
+            else:
+                for t in todo:
+                    collect(t, lambda t=t: _run_task(*calls[t]))
+        finally:
+            bar.close()
+        ds = _finish(ds)
+        if out is not None:
+            from .sweep_files import atomic_to_netcdf
+
+            atomic_to_netcdf(ds, out)
+    if failures:
+        raise RuntimeError(f"{len(failures)} run(s) of the study failed (the others are kept"
+                           + (f" in {out}" if out else "") + "): " + "; ".join(failures[:5]))
+    return ds

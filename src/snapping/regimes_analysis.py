@@ -1,0 +1,292 @@
+"""What a regime study finds (issue 24, item 3): power laws, crossovers, the regime map.
+
+Pure functions on arrays, then on a study (:func:`snapping.regimes.regimes`):
+
+* :func:`power_law` fits ``y = A x^p`` on the longest run of points whose local log-log
+  slopes agree within ``slope_tol`` (three points or more), with the exponent's
+  uncertainty; where no such run exists it says so plainly (``constant`` False) and fits
+  nothing.
+* :func:`crossover` finds the first number where a ratio to the ideal falls below
+  ``level`` (0.9: 10% below), interpolated linearly in (log number, log ratio), with an
+  interval from the ratios' error bars.
+* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%) of each chi of a study
+  (the power law to the capped cells alone, ratio < 0.9), fits the crossover against chi,
+  and :func:`report` prints it; :func:`regime_map` draws chi against the number, colour
+  the peak over the ideal's, with the 0.9 contour.
+
+>>> import numpy as np
+>>> x = np.array([1e-4, 1e-3, 1e-2, 1e-1])
+>>> f = power_law(x, 2.0 * x**-0.5)
+>>> round(f["exponent"], 12), round(f["prefactor"], 12), f["constant"]
+(-0.5, 2.0, True)
+>>> round(crossover([1e-4, 1e-2], [1.0, 0.81])["number"], 12)
+0.001
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _validate as V
+
+__all__ = ["power_law", "crossover", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR"]
+
+#: the crossover: the peak 10% below the ideal's
+LEVEL = 0.9
+
+
+def _xy(x, y, yerr=None):
+    x = np.asarray(V.float_array("x", x), dtype=float).ravel()
+    y = np.asarray(V.float_array("y", y), dtype=float).ravel()
+    if x.size != y.size:
+        raise V.SnappingInputError(f"x and y must have one length; got {x.size} and {y.size}")
+    e = None if yerr is None else np.asarray(V.float_array("yerr", yerr), dtype=float).ravel()
+    if e is not None and e.size != x.size:
+        raise V.SnappingInputError(f"yerr must have the length of x ({x.size}); got {e.size}")
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    if e is not None:
+        ok &= np.isfinite(e)
+    order = np.argsort(x[ok])
+    return x[ok][order], y[ok][order], (None if e is None else e[ok][order])
+
+
+def power_law(x, y, yerr=None, *, slope_tol: float = 0.1, min_points: int = 3) -> dict:
+    """Fit ``y = A x^p`` where the local log-log slope is constant.
+
+    Parameters
+    ----------
+    x, y : array_like
+        Positive samples (others are dropped); ``x`` need not be sorted.
+    yerr : array_like, optional
+        Error bars of ``y`` (weights 1/(yerr/y)^2 in log; None: equal weights).
+    slope_tol : float
+        Largest spread (max - min) of the local slopes ``d log y / d log x`` between
+        neighbours over the fitted points.
+    min_points : int
+        Fewest points of a power law (>= 2).
+
+    Returns
+    -------
+    dict
+        ``constant`` (bool: a run of ``min_points`` points or more with constant slope was
+        found), ``exponent``, ``exponent_err`` (least-squares standard error -- from the
+        error bars, or the scatter when larger -- and half the slopes' spread, in
+        quadrature), ``prefactor`` (A), ``x_lo``, ``x_hi``, ``n_points``, ``slopes``
+        (all local slopes), ``statement`` (one sentence).
+    """
+    tol = V.real("slope_tol", slope_tol)
+    if not (math.isfinite(tol) and tol > 0):
+        raise V.SnappingInputError(f"slope_tol={slope_tol!r} is out of range: must be finite and > 0")
+    min_points = V.integer("min_points", min_points, 2)
+    x, y, e = _xy(x, y, yerr)
+    nan = float("nan")
+    out = {"constant": False, "exponent": nan, "exponent_err": nan, "prefactor": nan, "x_lo": nan, "x_hi": nan,
+           "n_points": 0, "slopes": []}
+    if x.size < 2:
+        out["statement"] = f"no power law: {x.size} usable point(s)"
+        return out
+    X, Y = np.log(x), np.log(y)
+    s = np.diff(Y) / np.diff(X)
+    out["slopes"] = s.tolist()
+    best = None  # (points, last index, first index): the longest run, at the largest x on ties
+    for i in range(s.size):
+        for j in range(i, s.size):
+            run = s[i:j + 1]
+            if run.max() - run.min() > tol:
+                break
+            n = j - i + 2
+            if n >= min_points and (best is None or (n, j) >= (best[0], best[1])):
+                best = (n, j, i)
+    if best is None:
+        out["statement"] = (f"no power law: the local slopes vary from {s.min():.3g} to {s.max():.3g} over "
+                            f"{x[0]:.3g}..{x[-1]:.3g} (no {min_points} neighbours within {tol:g})")
+        return out
+    n, j, i = best
+    sl = slice(i, j + 2)
+    Xf, Yf = X[sl], Y[sl]
+    w = np.ones_like(Xf) if e is None else 1.0 / np.maximum((e[sl] / y[sl]) ** 2, 1e-300)
+    W = w.sum()
+    xm, ym = (w @ Xf) / W, (w @ Yf) / W
+    sxx = w @ (Xf - xm) ** 2
+    p = float((w @ ((Xf - xm) * (Yf - ym))) / sxx)
+    a = float(ym - p * xm)
+    res = Yf - (a + p * Xf)
+    stat = math.sqrt(float(w @ res**2) / max(n - 2, 1) / sxx) if n > 2 else 0.0
+    if e is not None:
+        stat = max(stat, math.sqrt(1.0 / sxx))
+    spread = float(s[i:j + 1].max() - s[i:j + 1].min())
+    err = math.hypot(stat, 0.5 * spread)
+    out.update({"constant": True, "exponent": p, "exponent_err": err, "prefactor": math.exp(a),
+                "x_lo": float(x[i]), "x_hi": float(x[j + 1]), "n_points": n,
+                "statement": f"power law exponent {p:.3f} +- {err:.2g} over {x[i]:.3g}..{x[j + 1]:.3g} "
+                             f"({n} points)"})
+    return out
+
+
+def _cross(x, r, level):
+    """First crossing of ``level`` from above by ``r`` (x ascending): the number, or a side."""
+    above = r >= level
+    if not above[0]:
+        return "below"
+    k = np.flatnonzero(~above)
+    if k.size == 0:
+        return "above"
+    k = int(k[0])
+    x1, x2, r1, r2 = x[k - 1], x[k], r[k - 1], r[k]
+    f = (math.log(level) - math.log(r1)) / (math.log(r2) - math.log(r1))
+    return math.exp(math.log(x1) + f * (math.log(x2) - math.log(x1)))
+
+
+def crossover(numbers, ratio, ratio_err=None, *, level: float = LEVEL) -> dict:
+    """The number where ``ratio`` (peak / the ideal's) first falls below ``level``, scanning
+    the numbers upward, interpolated linearly in (log number, log ratio).
+
+    Returns
+    -------
+    dict
+        ``number`` (nan when not bracketed), ``lo`` and ``hi`` (the crossover of
+        ``ratio + err`` and ``ratio - err``: its interval; nan when not bracketed),
+        ``bracketed`` (bool), ``statement``.
+    """
+    lev = V.real("level", level)
+    if not (0.0 < lev < 1.0 or lev > 1.0):
+        raise V.SnappingInputError(f"level={level!r} is out of range: must be > 0 and not 1")
+    x, r, e = _xy(numbers, ratio, ratio_err)
+    nan = float("nan")
+    if x.size == 0:
+        return {"number": nan, "lo": nan, "hi": nan, "bracketed": False, "statement": "no finite ratios"}
+    c = _cross(x, r, lev)
+    if isinstance(c, str):
+        side = (f"above {x[-1]:.3g}: the ratio stays >= {lev:g} up to the largest number" if c == "above" else
+                f"below {x[0]:.3g}: the ratio is already < {lev:g} at the smallest number")
+        return {"number": nan, "lo": nan, "hi": nan, "bracketed": False, "statement": f"crossover {side}"}
+    lo = hi = nan
+    if e is not None:
+        a, b = _cross(x, r - e, lev), _cross(x, r + e, lev)
+        lo = a if not isinstance(a, str) else (x[0] if a == "below" else nan)
+        hi = b if not isinstance(b, str) else (x[-1] if b == "above" else nan)
+    return {"number": c, "lo": lo, "hi": hi, "bracketed": True,
+            "statement": f"crossover at {c:.3g}" + (f" (interval {lo:.3g}..{hi:.3g})" if e is not None else "")}
+
+
+#: a cell is resolved when its extrapolation converged with an error bar at most this fraction of its value
+MAX_REL_ERROR = 0.05
+
+
+def resolved(value, error, order, max_rel_error: float = MAX_REL_ERROR) -> np.ndarray:
+    """Which cells are resolved: an observed order (the levels converge) and a relative error
+    bar <= ``max_rel_error``. The others are left out of fits and crossovers, and named."""
+    v, e, o = (np.asarray(a, dtype=float) for a in (value, error, order))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.isfinite(o) & np.isfinite(v) & (np.abs(e) <= max_rel_error * np.abs(v))
+
+
+def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_error: float = MAX_REL_ERROR) -> dict:
+    """Per chi of a study: the power law of the peak against the number in the capped regime
+    (resolved cells whose ratio to the ideal is below :data:`LEVEL`) and the crossover (on
+    the resolved cells, :func:`resolved`); and the crossover against chi."""
+    if quantity not in ds or f"{quantity}_ratio" not in ds:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not in the study")
+    nums = ds.number.values
+    rows = {}
+    for chi in ds.chi.values:
+        c = ds.sel(chi=chi)
+        ok = resolved(c[quantity].values, c[f"{quantity}_error"].values, c[f"{quantity}_order"].values, max_rel_error)
+        ideal_ok = abs(float(c[f"{quantity}_ideal_error"])) <= max_rel_error * abs(float(c[f"{quantity}_ideal"]))
+        capped = ok & (c[f"{quantity}_ratio"].values < LEVEL)  # the law of the cap: past the crossover only
+        fit = power_law(nums[capped], c[quantity].values[capped], c[f"{quantity}_error"].values[capped],
+                        slope_tol=slope_tol)
+        fit["statement"] = f"capped regime (ratio < {LEVEL:g}, {int(capped.sum())} resolved cells): " + fit["statement"]
+        cross = crossover(nums[ok], c[f"{quantity}_ratio"].values[ok], c[f"{quantity}_ratio_error"].values[ok])
+        if not ideal_ok:
+            cross = {**cross, "number": float("nan"), "bracketed": False,
+                     "statement": "no crossover: the ideal's limit is not resolved (error bar > "
+                                  f"{max_rel_error:.0%})"}
+        bad = [format(n, "g") for n in nums[~ok]]
+        if bad:
+            note = f" [unresolved, left out: {', '.join(bad)}]"
+            fit["statement"] += note
+        rows[float(chi)] = {"fit": fit, "crossover": cross, "ideal": float(c[f"{quantity}_ideal"]),
+                            "ideal_error": float(c[f"{quantity}_ideal_error"]), "unresolved": bad}
+    pts = [(chi, r["crossover"]["number"]) for chi, r in rows.items() if r["crossover"]["bracketed"]]
+    law = {"statement": f"crossover against chi: {len(pts)} chi with a bracketed crossover (a law needs 2 or more)"}
+    if len(pts) >= 2:
+        cx, nx = np.array(pts).T
+        if len(pts) == 2:
+            p = math.log(nx[1] / nx[0]) / math.log(cx[1] / cx[0])
+            law = {"exponent": p, "exponent_err": float("nan"), "prefactor": nx[0] / cx[0] ** p,
+                   "statement": f"crossover ~ chi^{p:.3f} (two chi: no uncertainty)"}
+        else:
+            f = power_law(cx, nx, slope_tol=1e300)  # (one law through every chi)
+            law = {**f, "statement": f"crossover ~ {f['prefactor']:.3g} chi^{f['exponent']:.3f} +- "
+                                     f"{f['exponent_err']:.2g}"}
+    return {"quantity": quantity, "mechanism": ds.attrs["mechanism"], "number_name": ds.attrs["number_name"],
+            "chi": rows, "crossover_law": law}
+
+
+def report(ds, quantities=("v_peak", "a_peak", "sigma_peak")) -> list[str]:
+    """Text lines: each cell's limit and ratio, then each chi's power law and crossover."""
+    name = ds.attrs["number_name"]
+    lines = [f"regime study: {ds.attrs['mechanism']} ({ds.attrs['mechanism_description']}), number {name}; "
+             f"{ds.attrs['grading']} levels x{ds.sizes['level']}, status {ds.attrs['status']}"]
+    for q in quantities:
+        lines.append(f"{q}: limit +- error (ratio to the ideal)")
+        lines.append(f"{'chi':>6} {'ideal':>18} " + " ".join(f"{name + '=' + format(n, 'g'):>28}"
+                                                           for n in ds.number.values))
+        for chi in ds.chi.values:
+            c = ds.sel(chi=chi)
+            cells = [f"{float(c[q][j]):.5g} +- {float(c[q + '_error'][j]):.2g} ({float(c[q + '_ratio'][j]):.3f})"
+                     for j in range(ds.sizes["number"])]
+            lines.append(f"{chi:6.3g} {float(c[q + '_ideal']):9.5g} +- {float(c[q + '_ideal_error']):5.2g} "
+                         + " ".join(f"{x:>28}" for x in cells))
+        a = analyze(ds, q)
+        for chi, r in a["chi"].items():
+            lines.append(f"  chi={chi:g}: {r['fit']['statement']}; {r['crossover']['statement']}")
+        lines.append(f"  {a['crossover_law']['statement']}")
+    return lines
+
+
+def regime_map(ds, path=None, quantity: str = "v_peak"):
+    """The regime map: chi against the number (log), colour = peak / the ideal's, the 0.9
+    contour where the grid has 2 x 2 cells or more. Saved to ``path`` when given."""
+    import matplotlib
+
+    if path is not None:
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    r = ds[f"{quantity}_ratio"].values
+    nums, chis = ds.number.values, ds.chi.values
+    fig, ax = plt.subplots(figsize=(6, 4))
+    def edges(v, log):  # cell edges halfway between the values (in log for the numbers)
+        u = np.log(v) if log else np.asarray(v, float)
+        if u.size == 1:
+            e = np.array([u[0] - 0.5, u[0] + 0.5]) if log else np.array([u[0] * 0.9, u[0] * 1.1])
+        else:
+            mid = 0.5 * (u[1:] + u[:-1])
+            e = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+        return np.exp(e) if log else e
+
+    mesh = ax.pcolormesh(edges(nums, True), edges(chis, False), r, shading="flat", cmap="viridis", vmin=0.0,
+                         vmax=max(1.0, np.nanmax(r)))
+    fig.colorbar(mesh, ax=ax, label=f"{quantity} / ideal")
+    if r.shape[0] >= 2 and r.shape[1] >= 2 and np.nanmin(r) < LEVEL < np.nanmax(r):
+        cs = ax.contour(nums, chis, r, levels=[LEVEL], colors="w")
+        ax.clabel(cs, fmt={LEVEL: f"{LEVEL:g}"})
+    for i, chi in enumerate(chis):
+        for j, n in enumerate(nums):
+            if np.isfinite(r[i, j]):
+                ax.annotate(f"{r[i, j]:.2f}", (n, chi), ha="center", va="center", fontsize=7, color="k",
+                            bbox={"boxstyle": "round", "fc": "w", "alpha": 0.6, "lw": 0})
+    ax.set_xscale("log")
+    ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
+    ax.set_ylabel("chi")
+    ax.set_title(f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})")
+    fig.tight_layout()
+    if path is not None:
+        from ._files import save_figure
+
+        save_figure(fig, path)
+    return fig
