@@ -31,8 +31,14 @@ from . import general as G
 from . import models as MD
 from . import rk as R
 from .stiff import RODAS4
-from .stiff_system import _EPS_CS as EPS_CS
-from .stiff_system import KL, KU, NCOL, _rows
+from . import stiff_system as SS
+
+#: the stage matrix's bandwidths and the colours, written out here: numba bakes module
+#: constants into this module's cached machine code, which is keyed on this file alone
+#: (a change in stiff_system must change this file too, or the import fails)
+KL, KU, NCOL = 5, 4, 5
+if (KL, KU, NCOL) != (SS.KL, SS.KU, SS.NCOL):  # pragma: no cover - a guard for editors
+    raise ImportError("rosenbrock's KL, KU, NCOL differ from stiff_system's: update both")
 
 __all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
            "NSTG",
@@ -69,6 +75,99 @@ NCNT = 4
 WROW = 2 * KL + KU + 1
 
 
+#: the fill-in bandwidth of the stage matrix's U
+MBW = KL + KU
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _band_lu_stage(R, n, piv):
+    """:func:`band_lu` for the stage matrix's bandwidths (``KL``, ``KU``: compile-time
+    constants, so the loops of the rows away from the end have fixed lengths; the same
+    operations in the same order, so the same factors)."""
+    for k in range(n):
+        if k + MBW >= n:  # the last rows: the general loop
+            ilast = min(n - 1, k + KL)
+            p = k
+            vmax = abs(R[k, KL])
+            for i in range(k + 1, ilast + 1):
+                v = abs(R[i, k - i + KL])
+                if v > vmax:
+                    vmax = v
+                    p = i
+            piv[k] = p
+            if vmax == 0.0 or not (vmax - vmax == 0.0):
+                return k + 1
+            w = n - k
+            if p != k:
+                op = k - p + KL
+                for d in range(w):
+                    tmp = R[k, KL + d]
+                    R[k, KL + d] = R[p, op + d]
+                    R[p, op + d] = tmp
+            inv = 1.0 / R[k, KL]
+            for i in range(k + 1, ilast + 1):
+                oi = k - i + KL
+                l = R[i, oi] * inv
+                R[i, oi] = l
+                for d in range(1, w):
+                    R[i, oi + d] -= l * R[k, KL + d]
+            continue
+        p = k
+        vmax = abs(R[k, KL])
+        for q in range(1, KL + 1):
+            v = abs(R[k + q, KL - q])
+            if v > vmax:
+                vmax = v
+                p = k + q
+        piv[k] = p
+        if vmax == 0.0 or not (vmax - vmax == 0.0):
+            return k + 1
+        if p != k:
+            op = k - p + KL
+            for d in range(MBW + 1):
+                tmp = R[k, KL + d]
+                R[k, KL + d] = R[p, op + d]
+                R[p, op + d] = tmp
+        inv = 1.0 / R[k, KL]
+        for q in range(1, KL + 1):
+            i = k + q
+            oi = KL - q
+            l = R[i, oi] * inv
+            R[i, oi] = l
+            for d in range(1, MBW + 1):
+                R[i, oi + d] -= l * R[k, KL + d]
+    return 0
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _band_solve_stage(R, n, piv, b):
+    """:func:`band_solve` for the stage matrix's bandwidths (fixed-length loops)."""
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+        bk = b[k]
+        if k + KL < n:
+            for q in range(1, KL + 1):
+                b[k + q] -= R[k + q, KL - q] * bk
+        else:
+            for i in range(k + 1, n):
+                b[i] -= R[i, k - i + KL] * bk
+    # back substitution by columns: x_k, then its products out of the rows above (ten
+    # independent updates, where the row form is a chain of ten dependent subtractions)
+    for k in range(n - 1, -1, -1):
+        xk = b[k] / R[k, KL]
+        b[k] = xk
+        if k >= MBW:
+            for d in range(1, MBW + 1):
+                b[k - d] -= R[k - d, KL + d] * xk
+        else:
+            for d in range(1, k + 1):
+                b[k - d] -= R[k - d, KL + d] * xk
+
+
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def band_lu(A, n, kl, ku, piv):
     """LU with partial pivoting of the n x n band matrix stored by rows: ``A[i, j]`` at
@@ -77,6 +176,8 @@ def band_lu(A, n, kl, ku, piv):
     (upper bandwidth kl + ku), ``piv[k]`` the row swapped with row k (LAPACK's ``dgbtrf``,
     laid out so that the row operations run on contiguous memory). Returns 0, or k + 1 when
     the k-th pivot is zero or not finite."""
+    if kl == KL and ku == KU:
+        return _band_lu_stage(A, n, piv)
     R = A
     m = kl + ku
     for k in range(n):
@@ -112,6 +213,9 @@ def band_lu(A, n, kl, ku, piv):
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def band_solve(A, n, kl, ku, piv, b):
     """Solve ``A x = b`` in place with the factors of :func:`band_lu`."""
+    if kl == KL and ku == KU:
+        _band_solve_stage(A, n, piv, b)
+        return
     R = A
     m = kl + ku
     for k in range(n):
@@ -138,10 +242,15 @@ def matvec(N, Dv, x, out):
     k = 0
     for l in range(N):
         xl = x[l]
-        i0 = max(0, 2 * l - 4)
-        i1 = min(2 * N, 2 * l + 6)
-        for i in range(i0, i1):
-            out[i] += Dv[k, i] * xl
+        if 2 <= l and l + 3 <= N:  # (all ten rows: a fixed-length loop)
+            i0 = 2 * l - 4
+            for d in range(10):
+                out[i0 + d] += Dv[k, i0 + d] * xl
+        else:
+            i0 = max(0, 2 * l - 4)
+            i1 = min(2 * N, 2 * l + 6)
+            for i in range(i0, i1):
+                out[i] += Dv[k, i] * xl
         k += 1
         if k == NCOL:
             k = 0
@@ -166,12 +275,68 @@ def assemble(N, D, gh, A):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _rows_tangent(N, var, d, om, T, h, invm, invm_next, invh, Bl, El, clamped, hasbend, C0, S0, Cd0, Sd0, fq, afx,
+                  afy, dM, dFX, dFY, out):
+    """The derivative of the rows (:func:`stiff_system._rows`) at fixed a and T along the
+    direction ``d`` of the angles (``var`` 0) or of the angular velocities (``var`` 1), by
+    the chain rule in real arithmetic (forward mode: what the complex step of ``_rows``
+    computes in its imaginary parts), from the base point's ``fq`` (the bending moments'
+    differences over the link lengths) and ``afx, afy`` (the node forces' accelerations)."""
+    th_dir = var == 0
+    for i in range(N + 1):
+        dM[i] = 0.0
+        dFX[i] = 0.0
+        dFY[i] = 0.0
+    if hasbend:
+        cf = Bl if th_dir else El
+        for i in range(1, N):
+            dM[i] = cf[i] * (d[i] - d[i - 1])
+        if clamped:
+            dM[N] = -cf[N] * d[N - 1]
+        for j in range(N):
+            dfq = (dM[j + 1] - dM[j]) * invh[j]
+            if th_dir:
+                gx = -(C0[j] * d[j] * fq[j] + S0[j] * dfq)
+                gy = -S0[j] * d[j] * fq[j] + C0[j] * dfq
+            else:
+                gx = -S0[j] * dfq
+                gy = C0[j] * dfq
+            dFX[j + 1] += gx
+            dFY[j + 1] += gy
+            dFX[j] -= gx
+            dFY[j] -= gy
+    for j in range(N):
+        cj = C0[j]
+        sj = S0[j]
+        dafx = dFX[j + 1] * invm_next[j] - dFX[j] * invm[j]
+        dafy = dFY[j + 1] * invm_next[j] - dFY[j] * invm[j]
+        if th_dir:
+            dj = d[j]
+            drt = dafx * cj - afx[j] * sj * dj + dafy * sj + afy[j] * cj * dj
+            dra = -(cj * dafy - sj * dj * afy[j] - sj * dafx - cj * dj * afx[j])
+            if j < N - 1:
+                e = (d[j + 1] - dj) * invm[j + 1] * T[j + 1]
+                drt -= Sd0[j] * e
+                dra -= Cd0[j] * e
+            if j > 0:
+                e = (dj - d[j - 1]) * invm[j] * T[j - 1]
+                drt -= Sd0[j - 1] * e
+                dra += Cd0[j - 1] * e
+        else:
+            drt = 2.0 * h[j] * om[j] * d[j] + dafx * cj + dafy * sj
+            dra = -(cj * dafy - sj * dafx)
+        out[2 * j] = dra
+        out[2 * j + 1] = drt
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
     """The coloured banded derivatives of the rows (:meth:`stiff_system.Residual.jacobian`)
     at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``:
-    ``dR/dtheta`` and ``dR/domega`` by complex steps (10 complex evaluations of the compiled
-    rows), ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the
-    node forces depend on neither)."""
+    ``dR/dtheta`` and ``dR/domega`` along the five colours of each (:func:`_rows_tangent`:
+    the chain rule in real arithmetic, equal to the complex steps of ``_rows`` to rounding),
+    ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the node
+    forces depend on neither)."""
     par, h, invm, invh, snode, tab = mdl
     phi = 0.0
     phid = 0.0
@@ -180,32 +345,55 @@ def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
     _, _, _, _, pax, pay = G.pin_kinematics(t, par, tab)
     payg = pay - par[G.P_G]
     invm_next = barr[3, :N]
-    M = np.zeros(N + 1, dtype=np.complex128)
-    FX = np.zeros(N + 1, dtype=np.complex128)
-    FY = np.zeros(N + 1, dtype=np.complex128)
-    out = np.zeros(2 * N, dtype=np.complex128)
-    x = np.zeros((4, N), dtype=np.complex128)
-    for i in range(N):
-        x[0, i] = y[i]
-        x[1, i] = y[N + i]
-        x[2, i] = f[N + i]
-        x[3, i] = sig[i]
-    C0 = np.cos(y[:N])
-    S0 = np.sin(y[:N])
+    Bl = barr[0]
+    K0L = barr[1]
+    El = barr[2]
+    th = y[:N]
+    om = y[N:2 * N]
+    C0 = np.cos(th)
+    S0 = np.sin(th)
     Cd0 = np.cos(y[1:N] - y[:N - 1])
     Sd0 = np.sin(y[1:N] - y[:N - 1])
     clamped = rp[RP_CLAMP] != 0.0
     hasbend = rp[RP_BEND] != 0.0
+    # the base point: bending moments, node forces and their accelerations (as _rows)
+    Mb = np.zeros(N + 1)
+    FX = np.zeros(N + 1)
+    FY = np.zeros(N + 1)
+    fq = np.zeros(N)
+    if hasbend:
+        for i in range(1, N):
+            Mb[i] = Bl[i] * ((th[i] - th[i - 1]) - K0L[i]) + El[i] * (om[i] - om[i - 1])
+        if clamped:
+            Mb[N] = Bl[N] * ((phi - th[N - 1]) - K0L[N]) + El[N] * (phid - om[N - 1])
+        for j in range(N):
+            fq[j] = (Mb[j + 1] - Mb[j]) * invh[j]
+            FX[j + 1] += -S0[j] * fq[j]
+            FY[j + 1] += C0[j] * fq[j]
+            FX[j] -= -S0[j] * fq[j]
+            FY[j] -= C0[j] * fq[j]
+    afx = np.empty(N)
+    afy = np.empty(N)
+    for j in range(N):
+        afx[j] = FX[j + 1] * invm_next[j] - FX[j] * invm[j]
+        afy[j] = FY[j + 1] * invm_next[j] - FY[j] * invm[j]
+    afx[N - 1] += pax
+    afy[N - 1] += payg
+    dM = np.empty(N + 1)
+    dFX = np.empty(N + 1)
+    dFY = np.empty(N + 1)
+    d = np.zeros(N)
+    out = np.empty(2 * N)
     for v in range(2):
         for k in range(NCOL):
             for j in range(k, N, NCOL):
-                x[v, j] += 1j * EPS_CS
-            _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, barr[0], barr[1], barr[2], clamped, hasbend,
-                  phi, phid, pax, payg, M, FX, FY, out, C0, S0, Cd0, Sd0)
+                d[j] = 1.0
+            _rows_tangent(N, v, d, om, sig, h, invm, invm_next, invh, Bl, El, clamped, hasbend, C0, S0, Cd0, Sd0, fq,
+                          afx, afy, dM, dFX, dFY, out)
             for i in range(2 * N):
-                Dj[v, k, i] = out[i].imag / EPS_CS
+                Dj[v, k, i] = out[i]
             for j in range(k, N, NCOL):
-                x[v, j] -= 1j * EPS_CS
+                d[j] = 0.0
     for v in range(2, 4):
         for k in range(NCOL):
             for i in range(2 * N):
