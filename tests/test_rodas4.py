@@ -29,7 +29,8 @@ def test_band_lu_solves_a_banded_system_that_needs_pivoting(kl, ku):
         for j in range(max(0, i - kl), min(n, i + ku + 1)):
             A[i, j] = rng.normal()
     A[np.arange(n), np.arange(n)] *= 1e-3  # small diagonal: partial pivoting must swap rows
-    ab = np.zeros((n, 2 * kl + ku + 1))  # (stored by rows: A[i, j] at ab[i, j - i + kl])
+    w = RB.WROW if (kl, ku) == (RB.KL, RB.KU) else 2 * kl + ku + 1  # (+1: the reciprocal pivots)
+    ab = np.zeros((n, w))  # (stored by rows: A[i, j] at ab[i, j - i + kl])
     for i in range(n):
         for j in range(max(0, i - kl), min(n, i + ku + 1)):
             ab[i, j - i + kl] = A[i, j]

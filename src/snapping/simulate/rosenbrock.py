@@ -71,8 +71,10 @@ NCNT = 4
 (RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
 
 
-#: width of a row of the factored stage matrix: lower band, upper band and the fill-in
-WROW = 2 * KL + KU + 1
+#: width of a row of the factored stage matrix: lower band, upper band, the fill-in and
+#: (column ``IDIAG``) the reciprocal of the pivot, for the solves' multiplications
+WROW = 2 * KL + KU + 2
+IDIAG = 2 * KL + KU + 1
 
 
 #: the fill-in bandwidth of the stage matrix's U
@@ -83,7 +85,8 @@ MBW = KL + KU
 def _band_lu_stage(R, n, piv):
     """:func:`band_lu` for the stage matrix's bandwidths (``KL``, ``KU``: compile-time
     constants, so the loops of the rows away from the end have fixed lengths; the same
-    operations in the same order, so the same factors)."""
+    operations in the same order, so the same factors), rows of width :data:`WROW`: the
+    reciprocal pivots go to column ``IDIAG``."""
     for k in range(n):
         if k + MBW >= n:  # the last rows: the general loop
             ilast = min(n - 1, k + KL)
@@ -105,6 +108,7 @@ def _band_lu_stage(R, n, piv):
                     R[k, KL + d] = R[p, op + d]
                     R[p, op + d] = tmp
             inv = 1.0 / R[k, KL]
+            R[k, IDIAG] = inv
             for i in range(k + 1, ilast + 1):
                 oi = k - i + KL
                 l = R[i, oi] * inv
@@ -129,6 +133,7 @@ def _band_lu_stage(R, n, piv):
                 R[k, KL + d] = R[p, op + d]
                 R[p, op + d] = tmp
         inv = 1.0 / R[k, KL]
+        R[k, IDIAG] = inv
         for q in range(1, KL + 1):
             i = k + q
             oi = KL - q
@@ -158,7 +163,7 @@ def _band_solve_stage(R, n, piv, b):
     # back substitution by columns: x_k, then its products out of the rows above (ten
     # independent updates, where the row form is a chain of ten dependent subtractions)
     for k in range(n - 1, -1, -1):
-        xk = b[k] / R[k, KL]
+        xk = b[k] * R[k, IDIAG]
         b[k] = xk
         if k >= MBW:
             for d in range(1, MBW + 1):
@@ -175,7 +180,8 @@ def band_lu(A, n, kl, ku, piv):
     fill-in and zero on entry). On return the multipliers are below the diagonal, U above
     (upper bandwidth kl + ku), ``piv[k]`` the row swapped with row k (LAPACK's ``dgbtrf``,
     laid out so that the row operations run on contiguous memory). Returns 0, or k + 1 when
-    the k-th pivot is zero or not finite."""
+    the k-th pivot is zero or not finite. With the stage matrix's ``KL, KU`` the rows need
+    :data:`WROW` columns (one more: the reciprocal pivots)."""
     if kl == KL and ku == KU:
         return _band_lu_stage(A, n, piv)
     R = A
@@ -449,6 +455,7 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
         cnt[CN_SING] += 1.0
         return np.inf, nev
     f0 = St[S_F0]
+    ch = np.empty(6)
     par, hh, invm, invh, snode, tab = mdl
     El = barr[2]
     for st in range(6):
@@ -464,10 +471,12 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
                 ytmp[i] = acc
             MD.model_rhs(N, t + C_NODE[st] * h, ytmp, btmp, c, s, S, cp, dp, sig, mdl)
             nev += 1
+            for j in range(st):  # (the divisions once per stage, not per component)
+                ch[j] = C_ST[st, j] / h
             for i in range(n):
                 acc = btmp[i]
                 for j in range(st):
-                    acc += (C_ST[st, j] / h) * St[1 + j, i]
+                    acc += ch[j] * St[1 + j, i]
                 btmp[i] = acc
         if rp[RP_AUTO] == 0.0 and D_TIME[st] != 0.0:
             dh = D_TIME[st] * h
