@@ -9,9 +9,13 @@ that shares the bookkeeping of every accepted step with DOP853
 rules), so the two methods differ only in how a step is taken.
 
 A step (Hairer and Wanner, *Solving ODEs II*, sec. VI.4, ``rodas.f``): the Jacobian at the
-step's start (:func:`jacobian_at`, once per accepted step: 20 complex evaluations of the
-compiled rows), the banded stage matrix of bandwidth 5 factored by Gaussian elimination
-with partial pivoting (:func:`band_lu`, O(N)), six stages (five new evaluations), the error
+step's start (:func:`jacobian_at`, once per accepted step: ten real forward-mode
+derivatives of the compiled rows, one per colour and variable, equal to the complex steps
+of :mod:`snapping.simulate.stiff_system` to rounding), the banded stage matrix of lower
+bandwidth 5 and upper 4 factored by Gaussian elimination with partial pivoting
+(:func:`band_lu`, O(N); loops of fixed length, the reciprocal pivots kept for the
+solves), six stages (five new evaluations; a stage's solve is one fused pass for its right
+side and one forward and one column-wise back substitution), the error
 estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``),
 the new state, and on acceptance one evaluation there (the next step's ``f``). The
 continuous extension of order 3 (``rodas.f``'s CONTRO: ``y(t0 + s h) = (1 - s) y0 + s (y1 +
@@ -148,11 +152,11 @@ def _band_lu_stage(R, n, piv):
 def _band_solve_stage(R, n, piv, b):
     """:func:`band_solve` for the stage matrix's bandwidths (fixed-length loops)."""
     for k in range(n):
-        p = piv[k]
-        if p != k:
+        pk = piv[k]
+        if pk != k:
             tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
+            b[k] = b[pk]
+            b[pk] = tmp
         bk = b[k]
         if k + KL < n:
             for q in range(1, KL + 1):
@@ -241,28 +245,6 @@ def band_solve(A, n, kl, ku, piv, b):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def matvec(N, Dv, x, out):
-    """``out += (dR/d var) x`` from the coloured columns ``Dv`` (:func:`stiff_system._matvec`
-    column by column: link l's column, colour l mod 5, touches the rows of links l - 2 .. l + 2;
-    no integer division in the loop)."""
-    k = 0
-    for l in range(N):
-        xl = x[l]
-        if 2 <= l and l + 3 <= N:  # (all ten rows: a fixed-length loop)
-            i0 = 2 * l - 4
-            for d in range(10):
-                out[i0 + d] += Dv[k, i0 + d] * xl
-        else:
-            i0 = max(0, 2 * l - 4)
-            i1 = min(2 * N, 2 * l + 6)
-            for i in range(i0, i1):
-                out[i] += Dv[k, i] * xl
-        k += 1
-        if k == NCOL:
-            k = 0
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def assemble(N, D, gh, A):
     """The stage matrix (:func:`stiff_system._assemble`) stored by rows for :func:`band_lu`:
     row i, column j at ``A[i, j - i + KL]``; the rest of A zeroed."""
@@ -271,7 +253,7 @@ def assemble(N, D, gh, A):
             A[i, d] = 0.0
     gh2 = gh * gh
     k = 0
-    for lk in range(N):  # (column by column, as matvec)
+    for lk in range(N):  # (column by column, as _stage_solve)
         for i in range(max(0, 2 * lk - 4), min(2 * N, 2 * lk + 6)):
             A[i, 2 * lk - i + KL] = D[2, k, i] + gh2 * D[0, k, i] + gh * D[1, k, i]
             A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
@@ -422,16 +404,28 @@ def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
-    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`)."""
-    for i in range(N):
-        tmp[i] = b[i] + gh * b[N + i]
+    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`):
+    the right side ``gh [R_theta (b_theta + gh b_omega) + R_omega b_omega]`` in one pass over
+    the links (the two coloured products with the columns of ``Dj``, fused), then the banded solve."""
     for i in range(2 * N):
         rhs[i] = 0.0
-    matvec(N, Dj[0], tmp, rhs)
-    matvec(N, Dj[1], b[N:2 * N], rhs)
-    for i in range(2 * N):
-        rhs[i] *= gh
-    band_solve(ab, 2 * N, KL, KU, piv, rhs)
+    D0 = Dj[0]
+    D1 = Dj[1]
+    k = 0
+    for l in range(N):
+        zl = gh * b[N + l]
+        xl = gh * (b[l] + zl)
+        if 2 <= l and l + 3 <= N:
+            i0 = 2 * l - 4
+            for d in range(10):
+                rhs[i0 + d] += D0[k, i0 + d] * xl + D1[k, i0 + d] * zl
+        else:
+            for i in range(max(0, 2 * l - 4), min(2 * N, 2 * l + 6)):
+                rhs[i] += D0[k, i] * xl + D1[k, i] * zl
+        k += 1
+        if k == NCOL:
+            k = 0
+    _band_solve_stage(ab, 2 * N, piv, rhs)
     for j in range(N):
         uom = gh * (b[N + j] - rhs[2 * j])
         U[N + j] = uom
