@@ -2,7 +2,7 @@
 
 The method and the banded stage solves are those of :mod:`snapping.simulate.stiff` (the
 Python reference, :func:`snapping.simulate.stiff.solve`) and
-:mod:`snapping.simulate.stiff_system` (the rows, their complex-step derivatives, the
+:mod:`snapping.simulate.stiff_system` (the rows, their derivatives, the
 stage matrix in LAPACK band storage): here they are one numba loop (:func:`advance_rodas`)
 that shares the bookkeeping of every accepted step with DOP853
 (:func:`snapping.simulate.rk.after_attempt_with`: records, peaks, invariants, the stop
