@@ -11,8 +11,8 @@ times on a shared machine are noisy: the load is printed).
 
 Counts. dop853: ``n_rhs`` (12 per attempted step, peak location included). rodas4:
 ``n_rhs`` (5 per attempted step, 1 per accepted step, the W/D rows' differences and f_t
-where there are any, peak location: every real evaluation), ``jac`` Jacobians (each 20
-complex-step evaluations of the compiled rows, not in ``n_rhs``), ``lu`` banded
+where there are any, peak location: every real evaluation), ``jac`` Jacobians (each ten
+real forward-mode derivatives of the compiled rows, not in ``n_rhs``), ``lu`` banded
 factorisations; ``us/step`` its wall time per step and ``us/rhs`` dop853's per evaluation.
 
 Bending damping (Kelvin-Voigt) ``eta = zeta sqrt(beta)/(2 N^2)``: damping ratio about zeta

@@ -19,15 +19,18 @@ from snapping.simulate.methods import rodas4 as RO
 from test_checkpoint import _StopAt, assert_same_run
 
 
-def test_band_lu_solves_a_banded_system_that_needs_pivoting():
+@pytest.mark.parametrize("kl, ku", [(5, 5), (RB.KL, RB.KU)])
+def test_band_lu_solves_a_banded_system_that_needs_pivoting(kl, ku):
+    """The general loops (5, 5) and those of the stage matrix's bandwidths (constants)."""
     rng = np.random.default_rng(3)
-    n, kl, ku = 40, 5, 5
+    n = 40
     A = np.zeros((n, n))
     for i in range(n):
         for j in range(max(0, i - kl), min(n, i + ku + 1)):
             A[i, j] = rng.normal()
     A[np.arange(n), np.arange(n)] *= 1e-3  # small diagonal: partial pivoting must swap rows
-    ab = np.zeros((n, 2 * kl + ku + 1))  # (stored by rows: A[i, j] at ab[i, j - i + kl])
+    w = RB.WROW if (kl, ku) == (RB.KL, RB.KU) else 2 * kl + ku + 1  # (+1: the reciprocal pivots)
+    ab = np.zeros((n, w))  # (stored by rows: A[i, j] at ab[i, j - i + kl])
     for i in range(n):
         for j in range(max(0, i - kl), min(n, i + ku + 1)):
             ab[i, j - i + kl] = A[i, j]

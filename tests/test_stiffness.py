@@ -72,7 +72,7 @@ def test_dop853_steps_sit_at_the_stability_limit_when_the_waves_are_damped():
 
 @pytest.mark.parametrize("zeta,expect", [(2.0, "dop853"), (10.0, "rodas4")])
 def test_fast_chooses_the_cheaper_method_on_either_side_of_the_threshold(zeta, expect):
-    """N = 300, beta = 1e-2: damping ratio 2 (RODAS4 fewer steps, but each ~5 DOP853 steps of
+    """N = 300, beta = 1e-2: damping ratio 2 (RODAS4 fewer steps, but each ~2.5 DOP853 steps of
     time) is dop853's, 10 (~25x fewer) rodas4's; both methods run to t = 0.2 and the
     chosen one costs less, its steps priced at stiffness.RODAS4_PRICE (measured apart:
     benchmarks/bench_stiff_costs.py)."""

@@ -150,7 +150,7 @@ PROBLEM_ATTRS: dict[str, str] = {
 METHOD_ATTRS: dict[str, str] = {
     "method_choice": ("why method='fast' ran this method ('method' names it): the shortest bending wave's "
                       "frequency and damping ratio, and the explicit method's estimated steps"),
-    "n_jacobians": "Jacobians of the stiff method (rodas4; each 20 complex-step evaluations of the rows)",
+    "n_jacobians": "Jacobians of the stiff method (rodas4; each ten forward-mode derivatives of the rows)",
     "n_factorizations": "banded LU factorisations of the stiff method's stage matrix (rodas4)",
 }
 

@@ -2,16 +2,20 @@
 
 The method and the banded stage solves are those of :mod:`snapping.simulate.stiff` (the
 Python reference, :func:`snapping.simulate.stiff.solve`) and
-:mod:`snapping.simulate.stiff_system` (the rows, their complex-step derivatives, the
+:mod:`snapping.simulate.stiff_system` (the rows, their derivatives, the
 stage matrix in LAPACK band storage): here they are one numba loop (:func:`advance_rodas`)
 that shares the bookkeeping of every accepted step with DOP853
 (:func:`snapping.simulate.rk.after_attempt_with`: records, peaks, invariants, the stop
 rules), so the two methods differ only in how a step is taken.
 
 A step (Hairer and Wanner, *Solving ODEs II*, sec. VI.4, ``rodas.f``): the Jacobian at the
-step's start (:func:`jacobian_at`, once per accepted step: 20 complex evaluations of the
-compiled rows), the banded stage matrix of bandwidth 5 factored by Gaussian elimination
-with partial pivoting (:func:`band_lu`, O(N)), six stages (five new evaluations), the error
+step's start (:func:`jacobian_at`, once per accepted step: ten real forward-mode
+derivatives of the compiled rows, one per colour and variable, equal to the complex steps
+of :mod:`snapping.simulate.stiff_system` to rounding), the banded stage matrix of lower
+bandwidth 5 and upper 4 factored by Gaussian elimination with partial pivoting
+(:func:`band_lu`, O(N); loops of fixed length, the reciprocal pivots kept for the
+solves), six stages (five new evaluations; a stage's solve is one fused pass for its right
+side and one forward and one column-wise back substitution), the error
 estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``),
 the new state, and on acceptance one evaluation there (the next step's ``f``). The
 continuous extension of order 3 (``rodas.f``'s CONTRO: ``y(t0 + s h) = (1 - s) y0 + s (y1 +
@@ -31,8 +35,16 @@ from . import general as G
 from . import models as MD
 from . import rk as R
 from .stiff import RODAS4
-from .stiff_system import _EPS_CS as EPS_CS
-from .stiff_system import KL, KU, NCOL, _rows
+from . import stiff_system as SS
+
+from .banded import IDIAG, KL, KU, WROW, _band_solve_stage, band_lu, band_solve  # noqa: F401 (re-exported)
+
+#: the colours, written out here: numba bakes module constants into this module's cached
+#: machine code, which is keyed on this file alone (a change in stiff_system must change
+#: this file too, or the import fails)
+NCOL = 5
+if NCOL != SS.NCOL:  # pragma: no cover - a guard for editors
+    raise ImportError("rosenbrock's NCOL differs from stiff_system's: update both")
 
 __all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
            "NSTG",
@@ -65,88 +77,6 @@ NCNT = 4
 (RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
 
 
-#: width of a row of the factored stage matrix: lower band, upper band and the fill-in
-WROW = 2 * KL + KU + 1
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def band_lu(A, n, kl, ku, piv):
-    """LU with partial pivoting of the n x n band matrix stored by rows: ``A[i, j]`` at
-    ``R[i, j - i + kl]`` (width ``2 kl + ku + 1``: the last kl columns are room for the
-    fill-in and zero on entry). On return the multipliers are below the diagonal, U above
-    (upper bandwidth kl + ku), ``piv[k]`` the row swapped with row k (LAPACK's ``dgbtrf``,
-    laid out so that the row operations run on contiguous memory). Returns 0, or k + 1 when
-    the k-th pivot is zero or not finite."""
-    R = A
-    m = kl + ku
-    for k in range(n):
-        ilast = min(n - 1, k + kl)
-        p = k
-        vmax = abs(R[k, kl])
-        for i in range(k + 1, ilast + 1):
-            v = abs(R[i, k - i + kl])
-            if v > vmax:
-                vmax = v
-                p = i
-        piv[k] = p
-        if vmax == 0.0 or not (vmax - vmax == 0.0):
-            return k + 1
-        w = min(n - 1, k + m) - k + 1  # columns k .. k + w - 1
-        if p != k:
-            op = k - p + kl
-            for d in range(w):
-                tmp = R[k, kl + d]
-                R[k, kl + d] = R[p, op + d]
-                R[p, op + d] = tmp
-        inv = 1.0 / R[k, kl]
-        for i in range(k + 1, ilast + 1):
-            oi = k - i + kl
-            l = R[i, oi] * inv
-            R[i, oi] = l
-            if l != 0.0:
-                for d in range(1, w):
-                    R[i, oi + d] -= l * R[k, kl + d]
-    return 0
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def band_solve(A, n, kl, ku, piv, b):
-    """Solve ``A x = b`` in place with the factors of :func:`band_lu`."""
-    R = A
-    m = kl + ku
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
-        bk = b[k]
-        for i in range(k + 1, min(n - 1, k + kl) + 1):
-            b[i] -= R[i, k - i + kl] * bk
-    for k in range(n - 1, -1, -1):
-        acc = b[k]
-        for d in range(1, min(n - 1, k + m) - k + 1):
-            acc -= R[k, kl + d] * b[k + d]
-        b[k] = acc / R[k, kl]
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def matvec(N, Dv, x, out):
-    """``out += (dR/d var) x`` from the coloured columns ``Dv`` (:func:`stiff_system._matvec`
-    column by column: link l's column, colour l mod 5, touches the rows of links l - 2 .. l + 2;
-    no integer division in the loop)."""
-    k = 0
-    for l in range(N):
-        xl = x[l]
-        i0 = max(0, 2 * l - 4)
-        i1 = min(2 * N, 2 * l + 6)
-        for i in range(i0, i1):
-            out[i] += Dv[k, i] * xl
-        k += 1
-        if k == NCOL:
-            k = 0
-
-
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def assemble(N, D, gh, A):
     """The stage matrix (:func:`stiff_system._assemble`) stored by rows for :func:`band_lu`:
@@ -156,7 +86,7 @@ def assemble(N, D, gh, A):
             A[i, d] = 0.0
     gh2 = gh * gh
     k = 0
-    for lk in range(N):  # (column by column, as matvec)
+    for lk in range(N):  # (column by column, as _stage_solve)
         for i in range(max(0, 2 * lk - 4), min(2 * N, 2 * lk + 6)):
             A[i, 2 * lk - i + KL] = D[2, k, i] + gh2 * D[0, k, i] + gh * D[1, k, i]
             A[i, 2 * lk + 1 - i + KL] = D[3, k, i]
@@ -166,12 +96,68 @@ def assemble(N, D, gh, A):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _rows_tangent(N, var, d, om, T, h, invm, invm_next, invh, Bl, El, clamped, hasbend, C0, S0, Cd0, Sd0, fq, afx,
+                  afy, dM, dFX, dFY, out):
+    """The derivative of the rows (:func:`stiff_system._rows`) at fixed a and T along the
+    direction ``d`` of the angles (``var`` 0) or of the angular velocities (``var`` 1), by
+    the chain rule in real arithmetic (forward mode: what the complex step of ``_rows``
+    computes in its imaginary parts), from the base point's ``fq`` (the bending moments'
+    differences over the link lengths) and ``afx, afy`` (the node forces' accelerations)."""
+    th_dir = var == 0
+    for i in range(N + 1):
+        dM[i] = 0.0
+        dFX[i] = 0.0
+        dFY[i] = 0.0
+    if hasbend:
+        cf = Bl if th_dir else El
+        for i in range(1, N):
+            dM[i] = cf[i] * (d[i] - d[i - 1])
+        if clamped:
+            dM[N] = -cf[N] * d[N - 1]
+        for j in range(N):
+            dfq = (dM[j + 1] - dM[j]) * invh[j]
+            if th_dir:
+                gx = -(C0[j] * d[j] * fq[j] + S0[j] * dfq)
+                gy = -S0[j] * d[j] * fq[j] + C0[j] * dfq
+            else:
+                gx = -S0[j] * dfq
+                gy = C0[j] * dfq
+            dFX[j + 1] += gx
+            dFY[j + 1] += gy
+            dFX[j] -= gx
+            dFY[j] -= gy
+    for j in range(N):
+        cj = C0[j]
+        sj = S0[j]
+        dafx = dFX[j + 1] * invm_next[j] - dFX[j] * invm[j]
+        dafy = dFY[j + 1] * invm_next[j] - dFY[j] * invm[j]
+        if th_dir:
+            dj = d[j]
+            drt = dafx * cj - afx[j] * sj * dj + dafy * sj + afy[j] * cj * dj
+            dra = -(cj * dafy - sj * dj * afy[j] - sj * dafx - cj * dj * afx[j])
+            if j < N - 1:
+                e = (d[j + 1] - dj) * invm[j + 1] * T[j + 1]
+                drt -= Sd0[j] * e
+                dra -= Cd0[j] * e
+            if j > 0:
+                e = (dj - d[j - 1]) * invm[j] * T[j - 1]
+                drt -= Sd0[j - 1] * e
+                dra += Cd0[j - 1] * e
+        else:
+            drt = 2.0 * h[j] * om[j] * d[j] + dafx * cj + dafy * sj
+            dra = -(cj * dafy - sj * dafx)
+        out[2 * j] = dra
+        out[2 * j + 1] = drt
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
     """The coloured banded derivatives of the rows (:meth:`stiff_system.Residual.jacobian`)
     at (t, y) with the accelerations ``f[N:2N]`` and tensions ``sig`` of y, into ``Dj``:
-    ``dR/dtheta`` and ``dR/domega`` by complex steps (10 complex evaluations of the compiled
-    rows), ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the
-    node forces depend on neither)."""
+    ``dR/dtheta`` and ``dR/domega`` along the five colours of each (:func:`_rows_tangent`:
+    the chain rule in real arithmetic, equal to the complex steps of ``_rows`` to rounding),
+    ``dR/da`` and ``dR/dT`` in closed form (the rows are linear in a and T, and the node
+    forces depend on neither)."""
     par, h, invm, invh, snode, tab = mdl
     phi = 0.0
     phid = 0.0
@@ -180,32 +166,55 @@ def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
     _, _, _, _, pax, pay = G.pin_kinematics(t, par, tab)
     payg = pay - par[G.P_G]
     invm_next = barr[3, :N]
-    M = np.zeros(N + 1, dtype=np.complex128)
-    FX = np.zeros(N + 1, dtype=np.complex128)
-    FY = np.zeros(N + 1, dtype=np.complex128)
-    out = np.zeros(2 * N, dtype=np.complex128)
-    x = np.zeros((4, N), dtype=np.complex128)
-    for i in range(N):
-        x[0, i] = y[i]
-        x[1, i] = y[N + i]
-        x[2, i] = f[N + i]
-        x[3, i] = sig[i]
-    C0 = np.cos(y[:N])
-    S0 = np.sin(y[:N])
+    Bl = barr[0]
+    K0L = barr[1]
+    El = barr[2]
+    th = y[:N]
+    om = y[N:2 * N]
+    C0 = np.cos(th)
+    S0 = np.sin(th)
     Cd0 = np.cos(y[1:N] - y[:N - 1])
     Sd0 = np.sin(y[1:N] - y[:N - 1])
     clamped = rp[RP_CLAMP] != 0.0
     hasbend = rp[RP_BEND] != 0.0
+    # the base point: bending moments, node forces and their accelerations (as _rows)
+    Mb = np.zeros(N + 1)
+    FX = np.zeros(N + 1)
+    FY = np.zeros(N + 1)
+    fq = np.zeros(N)
+    if hasbend:
+        for i in range(1, N):
+            Mb[i] = Bl[i] * ((th[i] - th[i - 1]) - K0L[i]) + El[i] * (om[i] - om[i - 1])
+        if clamped:
+            Mb[N] = Bl[N] * ((phi - th[N - 1]) - K0L[N]) + El[N] * (phid - om[N - 1])
+        for j in range(N):
+            fq[j] = (Mb[j + 1] - Mb[j]) * invh[j]
+            FX[j + 1] += -S0[j] * fq[j]
+            FY[j + 1] += C0[j] * fq[j]
+            FX[j] -= -S0[j] * fq[j]
+            FY[j] -= C0[j] * fq[j]
+    afx = np.empty(N)
+    afy = np.empty(N)
+    for j in range(N):
+        afx[j] = FX[j + 1] * invm_next[j] - FX[j] * invm[j]
+        afy[j] = FY[j + 1] * invm_next[j] - FY[j] * invm[j]
+    afx[N - 1] += pax
+    afy[N - 1] += payg
+    dM = np.empty(N + 1)
+    dFX = np.empty(N + 1)
+    dFY = np.empty(N + 1)
+    d = np.zeros(N)
+    out = np.empty(2 * N)
     for v in range(2):
         for k in range(NCOL):
             for j in range(k, N, NCOL):
-                x[v, j] += 1j * EPS_CS
-            _rows(N, x[0], x[1], x[2], x[3], h, invm, invm_next, invh, barr[0], barr[1], barr[2], clamped, hasbend,
-                  phi, phid, pax, payg, M, FX, FY, out, C0, S0, Cd0, Sd0)
+                d[j] = 1.0
+            _rows_tangent(N, v, d, om, sig, h, invm, invm_next, invh, Bl, El, clamped, hasbend, C0, S0, Cd0, Sd0, fq,
+                          afx, afy, dM, dFX, dFY, out)
             for i in range(2 * N):
-                Dj[v, k, i] = out[i].imag / EPS_CS
+                Dj[v, k, i] = out[i]
             for j in range(k, N, NCOL):
-                x[v, j] -= 1j * EPS_CS
+                d[j] = 0.0
     for v in range(2, 4):
         for k in range(NCOL):
             for i in range(2 * N):
@@ -228,16 +237,28 @@ def jacobian_at(N, t, y, f, sig, Dj, mdl, barr, rp):
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
-    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`)."""
-    for i in range(N):
-        tmp[i] = b[i] + gh * b[N + i]
+    """The angle part of ``(I/(gamma h) - J) U = b`` (:meth:`stiff_system.StageMatrix.solve`):
+    the right side ``gh [R_theta (b_theta + gh b_omega) + R_omega b_omega]`` in one pass over
+    the links (the two coloured products with the columns of ``Dj``, fused), then the banded solve."""
     for i in range(2 * N):
         rhs[i] = 0.0
-    matvec(N, Dj[0], tmp, rhs)
-    matvec(N, Dj[1], b[N:2 * N], rhs)
-    for i in range(2 * N):
-        rhs[i] *= gh
-    band_solve(ab, 2 * N, KL, KU, piv, rhs)
+    D0 = Dj[0]
+    D1 = Dj[1]
+    k = 0
+    for l in range(N):
+        zl = gh * b[N + l]
+        xl = gh * (b[l] + zl)
+        if 2 <= l and l + 3 <= N:
+            i0 = 2 * l - 4
+            for d in range(10):
+                rhs[i0 + d] += D0[k, i0 + d] * xl + D1[k, i0 + d] * zl
+        else:
+            for i in range(max(0, 2 * l - 4), min(2 * N, 2 * l + 6)):
+                rhs[i] += D0[k, i] * xl + D1[k, i] * zl
+        k += 1
+        if k == NCOL:
+            k = 0
+    _band_solve_stage(ab, 2 * N, piv, rhs)
     for j in range(N):
         uom = gh * (b[N + j] - rhs[2 * j])
         U[N + j] = uom
@@ -261,6 +282,7 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
         cnt[CN_SING] += 1.0
         return np.inf, nev
     f0 = St[S_F0]
+    ch = np.empty(6)
     par, hh, invm, invh, snode, tab = mdl
     El = barr[2]
     for st in range(6):
@@ -276,10 +298,12 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
                 ytmp[i] = acc
             MD.model_rhs(N, t + C_NODE[st] * h, ytmp, btmp, c, s, S, cp, dp, sig, mdl)
             nev += 1
+            for j in range(st):  # (the divisions once per stage, not per component)
+                ch[j] = C_ST[st, j] / h
             for i in range(n):
                 acc = btmp[i]
                 for j in range(st):
-                    acc += (C_ST[st, j] / h) * St[1 + j, i]
+                    acc += ch[j] * St[1 + j, i]
                 btmp[i] = acc
         if rp[RP_AUTO] == 0.0 and D_TIME[st] != 0.0:
             dh = D_TIME[st] * h

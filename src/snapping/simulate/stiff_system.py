@@ -25,8 +25,9 @@ with ``w = M^{-1}[R_theta (b_theta + U_omega)/alpha + R_omega U_omega]`` (``alph
 
     [M + ((gamma h)^2 R_theta + gamma h R_omega) P] w = gamma h [R_theta (b_theta + gamma h b_omega) + R_omega b_omega]
 
-of lower and upper bandwidth 5 (per link: its a and T against the a of links j - 2 .. j + 2
-and the T of links j - 1 .. j + 1): one banded LU per step (LAPACK ``dgbtrf``, O(N)) and
+of lower bandwidth 5 and upper bandwidth 4 (per link: its a and T against the a of links
+j - 2 .. j + 2 and the T of links j - 1 .. j + 1; the tension row 2j + 1 reaches column
+2j - 4, the angle row 2j column 2j + 4): one banded LU per step (LAPACK ``dgbtrf``, O(N)) and
 one banded solve per stage (``dgbtrs``, O(N)). The derivatives ``M``, ``R_theta``,
 ``R_omega`` are exact: complex-step derivatives of a transcription of the rows
 (:meth:`Residual.R` in numpy, ``_rows`` compiled), five colours per variable (columns five
@@ -57,7 +58,7 @@ from . import kernels as K
 
 __all__ = ["Residual", "StageMatrix", "body_model", "dense_ode_jacobian", "KL", "KU", "NCOL"]
 
-KL = KU = 5  # bandwidths of the interleaved stage matrix
+KL, KU = 5, 4  # bandwidths of the interleaved stage matrix (rows of a link: 2j, 2j + 1)
 NCOL = 5  # colours: links 5 apart share no row
 _EPS_CS = 1e-30  # complex-step size
 

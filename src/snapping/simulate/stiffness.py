@@ -32,14 +32,15 @@ The choice (:func:`choose`, what ``method="fast"`` does for a problem with bendi
 damping leaves (damping ratio ``zeta omega_k/omega_max`` for Kelvin-Voigt damping): measured
 ``13500 sqrt(beta) N^0.37 zeta^-0.42`` steps per unit time (:func:`stiff_steps`), e.g.
 N = 1000, zeta = 1: 3.4x (beta 1e-4) and 3.9x (beta 1e-2) fewer steps than DOP853; and a
-step costs ~5 DOP853 steps of time (:data:`RODAS4_PRICE`: 5 evaluations, 6 banded
+step costs ~2.5 DOP853 steps of time (:data:`RODAS4_PRICE`: 6 evaluations, 6 banded
 solves, a factorisation, a Jacobian). Undamped, the release's grid-scale waves
 limit both methods by accuracy and RODAS4 needs 4-8x DOP853's steps. So ``fast`` takes
 RODAS4 when the shortest wave is damped (``zeta >= ZETA_MIN``) and DOP853's estimated steps
 (the larger of the stability limit and the accuracy-limited :func:`accuracy_steps`) exceed
-``CHOICE_RATIO x RODAS4_PRICE`` times RODAS4's; else DOP853, bit for bit as before (with
-the reason in the run's ``method_choice``). At N = 300, beta = 1e-2: zeta 3 stays DOP853
-(4.5x fewer RODAS4 steps: not enough), zeta 10 is RODAS4's (25x). Runs without a body, or
+``CHOICE_RATIO x RODAS4_PRICE`` (3.75) times RODAS4's; else DOP853, bit for bit as before
+(with the reason in the run's ``method_choice``). At N = 300, beta = 1e-2: zeta 2 stays
+DOP853 (an estimated 2.7x fewer RODAS4 steps: not enough), zeta 3, 5 and 10 are RODAS4's
+(5x, 10.6x, 28x); at N = 1000 zeta 1 is RODAS4's (3.9x), at N = 100 only zeta >= ~10. Runs without a body, or
 whose body has no bending, never consult this module.
 """
 
@@ -62,9 +63,11 @@ __all__ = ["R_DOP853", "ZETA_MIN", "CHOICE_RATIO", "RODAS4_PRICE", "WARN_STEPS",
 R_DOP853 = 5.96
 #: damping ratio of the shortest bending wave from which the stiff method is chosen
 ZETA_MIN = 0.5
-#: a RODAS4 step's time in DOP853 steps (measured in CPU time: 3.9, 4.8, 4.6 at N = 100, 300,
-#: 1000, benchmarks/bench_stiff_costs.py: a step ~56 evaluations' time at N = 1000)
-RODAS4_PRICE = 5.0
+#: a RODAS4 step's time in DOP853 steps (CPU time, the least of five timings,
+#: ``python benchmarks/bench_stiff_costs.py 100,300,1000``: 2.35, 2.49, 2.42 at N = 100, 300,
+#: 1000, a step ~31 evaluations' time at N = 1000; whole runs, N = 1000, beta 1e-4, zeta 1,
+#: to t = 0.3: 641 against 256 us of CPU per step, 2.5; was 5 before the step was made cheaper)
+RODAS4_PRICE = 2.5
 #: the stiff method is chosen when it is estimated this much cheaper (a margin for the estimates)
 CHOICE_RATIO = 1.5
 #: estimated explicit steps above which a run of an explicit method warns / is refused

@@ -5,7 +5,8 @@ steps below ~3.5 over the frequency of the shortest bending wave, ``omega_max = 
 sqrt(B/lambda)`` on a chain of N equal links (:mod:`snapping.simulate.stiffness`). RODAS4
 is L-stable: its steps are set by accuracy alone. The compiled loop is
 :func:`snapping.simulate.rosenbrock.advance_rodas` (banded O(N) stage solves,
-complex-step banded Jacobian, :mod:`snapping.simulate.stiff_system`); everything after a
+banded Jacobian by forward-mode derivatives of the rows of
+:mod:`snapping.simulate.stiff_system`); everything after a
 step -- records (``models.model_measure``, the columns of every method), peaks, the stop
 rules (including the moving held end's), invariants -- is DOP853's
 (:func:`snapping.simulate.rk.after_attempt_with`), and so is the engine's interface
@@ -17,7 +18,7 @@ at most 6x larger); peaks located on RODAS4's continuous extension of order 3
 (:func:`snapping.simulate.rosenbrock.dense_eval`, no extra evaluation); ``n_rhs`` counts
 every real evaluation (5 per attempted step, 1 per accepted step, the W/D rows'
 differences and ``f_t`` where there are any, peak location), and the Jacobians
-(``n_jacobians``: 20 complex evaluations of the compiled rows each) and banded
+(``n_jacobians``: ten real forward-mode derivatives of the compiled rows each) and banded
 factorisations (``n_factorizations``) are counted apart.
 
 Only problems with an active body (:class:`snapping.simulate.Body`) are taken: without
