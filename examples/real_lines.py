@@ -2,14 +2,15 @@
 stroke of its handle and a fly line falling from a catenary, with their energy balance.
 
 * **Bullwhip** (:mod:`snapping.lines` ``bullwhip``: a leather cone, lambda ~ d^2, EI ~ d^4,
-  drag, a 1 g cracker with its drag area): released from the catenary of end separation
-  chi = 0.25, its handle clamped (it holds the thong's direction through the bending
-  stiffness) and moved as a cracking stroke: the handle jerked back (``PinMotion.flick``,
+  drag, a 1 g cracker with its drag area): released at rest, held at end separation
+  chi = 0.25 (its static equilibrium), its handle clamped in the catenary's direction (it
+  holds the thong's direction through the bending stiffness) and moved as a cracking stroke: the handle jerked back (``PinMotion.flick``,
   peak 10 g over 0.3 sqrt(L/g) = 0.15 s, the handle moving back by 0.14 L = 35 cm and
   stopping) while it turns by 2 radians (a prescribed clamp angle, smooth, at rest at both
   ends: :func:`stroke`).
 * **Fly line** (``fly-line``: 30 ft of a WF-5 floating line, tapered, with a dry fly's mass and
-  drag): the falling catenary of chi = 0.25 from a still rod tip.
+  drag): released at rest at chi = 0.25 (its static equilibrium, within 1e-3 L of the
+  catenary) from a still rod tip.
 
 Each beside the ideal chain of the same geometry: the same links (the same tapered masses and
 tip mass), the same start and held-end motion, B = 0 and no drag (a hinge: no clamp). The
@@ -26,9 +27,13 @@ Usage::
     python examples/real_lines.py                    # N = 200 (whip and fly line), tol 1e-6, 1e-8, 1e-10
     python examples/real_lines.py --N 100 --quick    # coarse, seconds
     python examples/real_lines.py --whip-levels 100,200,400   # the whip refined (a minute)
+    python examples/real_lines.py --whip-levels 100,200 --method stiff   # the real lines by RODAS4
 
-The whip runs on explicit dop853 (``method="fast"``), whose step the bending waves limit
-(dt ~ h^2 sqrt(lambda/B)): N of 100 to 400 is what it takes in seconds to a minute.
+Each line starts at rest (the default with bending: its static equilibrium, held at both
+ends; the ideal chain's is its catenary). The real lines run by ``--method`` (default
+``fast``: dop853 here, since their shortest bending waves are undamped, its step limited by
+dt ~ h^2 sqrt(lambda/B)); the ideal chains by ``fast`` (dop853). The table says which start
+and method each run took.
 """
 
 from __future__ import annotations
