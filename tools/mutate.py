@@ -58,7 +58,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 LIST = Path(__file__).resolve().parent / "mutations.toml"
-COPY = ("src", "tests", "tools", "benchmarks", "pyproject.toml", "conftest.py", "docs", "README.md", "notebooks")
+COPY = ("src", "tests", "tools", "benchmarks", "pyproject.toml", "conftest.py", "docs", "README.md", "notebooks", "examples")
 FIELDS = {"id", "class", "file", "original", "replacement", "tests"}
 
 
