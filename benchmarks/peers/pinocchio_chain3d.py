@@ -16,12 +16,16 @@ The same discrete chain in both codes:
   (k = 1..N) the link from node N - k + 1 to node N - k, joined to its parent by a
   spherical joint (the first at the held end, fixed in the world), carrying the point mass
   of node N - k at its far end (lever ``h (1, 0, 0)`` in the body's frame) and a rotational
-  inertia ``J = m h^2`` about its own axis only. A point mass has no inertia about the link's
-  axis, which would make the articulated-body inertia singular; the axial inertia fixes
-  that without changing the motion: spherical joints at points on the axis exert no axial
-  torque, the inertia is axisymmetric, so the spin about the link's axis stays what it
-  started at (zero) and a spin-free rigid link moves exactly as the massless link of the
-  point-mass chain. Forward dynamics by the articulated-body algorithm (``pin.aba``, O(N)).
+  inertia ``J = M L^2`` (the chain's mass and length) about its own axis only. A point mass
+  has no inertia about the link's axis, which would make the articulated-body inertia
+  singular; the axial inertia fixes that without changing the motion: spherical joints at
+  points on the axis exert no axial torque, the inertia is axisymmetric, so the spin about
+  the link's axis stays what it started at (zero) and a spin-free rigid link moves exactly
+  as the massless link of the point-mass chain. (A spin inertia of the link's own scale,
+  m h^2, works too but leaves the spin's acceleration at 1e-8 of the others near the root:
+  ill-conditioned.) Forward dynamics by the articulated-body algorithm (``pin.aba``, O(N)
+  operations); but ``model.createData()`` for this tree takes memory growing as N^3 (6.7 GB
+  at N = 200, measured by ``--memory``), so N = 500 (about 100 GB) does not fit here.
   Time stepping: classical RK4 at a fixed step, on the Lie group (Runge-Kutta-Munthe-Kaas:
   in each step the configuration is ``q = integrate(q0, xi)`` with ``xi' = dexp^{-1}_xi(v)``
   per spherical joint, and ``pin.integrate`` makes each stage's and the step's
@@ -41,7 +45,7 @@ Usage::
     python benchmarks/peers/pinocchio_chain3d.py                  # N = 200, 500
     python benchmarks/peers/pinocchio_chain3d.py --quick          # N = 20, seconds
     python benchmarks/peers/pinocchio_chain3d.py --N 200 --dt 4e-5,2e-5,1e-5 --budget 300
-    python benchmarks/peers/pinocchio_chain3d.py --memory 200,500,1000,2000
+    python benchmarks/peers/pinocchio_chain3d.py --memory 25,50,100,200,300
 
 Needs the optional ``peers`` extra (``pip install pin``) for the Pinocchio side; ``--help``
 and the problem setup work without it.
@@ -111,11 +115,12 @@ def build_pinocchio(p):
     R_par = np.eye(3)
     qs, vs = [], []
     omega_par = np.zeros(3)
+    Jspin = float(m.sum() * h.sum() ** 2)  # the chain's own scale: the spin's inertia well conditioned
     for k in range(1, N + 1):
         j = N - k  # the link (and its far node) this body carries
         place = pin.SE3.Identity() if k == 1 else pin.SE3(np.eye(3), h[j + 1] * AXIS)
         jid = model.addJoint(parent, pin.JointModelSpherical(), place, f"joint{k}")
-        J = m[j] * h[j] ** 2
+        J = Jspin
         model.appendBodyToJoint(jid, pin.Inertia(float(m[j]), h[j] * AXIS, np.diag([J, 0.0, 0.0])),
                                 pin.SE3.Identity())
         if k == 1:
@@ -312,23 +317,31 @@ def rss_mib() -> float:
 
 
 def memory(Ns, chi=0.25) -> None:
-    """Resident memory added by Pinocchio's model + data of N bodies, and by 100 ABA calls."""
+    """Resident memory added by Pinocchio's model + data of N bodies (``model.createData()``),
+    and one ABA call's CPU time; the growth exponent between successive N."""
     import pinocchio as pin
 
-    print("Pinocchio's memory (resident set added, MiB) and one ABA call's CPU time:")
-    print(f"  {'N':>6}{'model+data':>12}{'+100 ABA':>10}{'ABA us':>9}{'nv^2 x 8 B':>12}")
+    print("Pinocchio's memory (resident set added by model + data, MiB) and one ABA call's CPU time:")
+    print(f"  {'N':>6}{'model+data':>12}{'exponent':>10}{'ABA us':>9}")
+    prev = None
     for N in Ns:
         p = project_problem(chi, N)
         r0 = rss_mib()
-        model, data, q, v, _ = build_pinocchio(p)
+        try:
+            model, data, q, v, _ = build_pinocchio(p)
+        except MemoryError:
+            print(f"  {N:>6}  MemoryError in model.createData() (this machine: "
+                  f"{os.sysconf('SC_PHYS_PAGES') * os.sysconf('SC_PAGE_SIZE') / 2 ** 30:.0f} GiB)")
+            break
         r1 = rss_mib()
         tau = np.zeros(model.nv)
         c = time.process_time()
         for _ in range(100):
             pin.aba(model, data, q, v, tau)
         c = (time.process_time() - c) / 100
-        r2 = rss_mib()
-        print(f"  {N:>6}{r1 - r0:>12.1f}{r2 - r0:>10.1f}{c * 1e6:>9.0f}{model.nv ** 2 * 8 / 2 ** 20:>12.1f}")
+        ex = f"{math.log((r1 - r0) / prev[1]) / math.log(N / prev[0]):10.2f}" if prev else f"{'':>10}"
+        print(f"  {N:>6}{r1 - r0:>12.1f}{ex}{c * 1e6:>9.0f}")
+        prev = (N, r1 - r0)
         del model, data
     print()
 
@@ -376,6 +389,9 @@ def compare(chi, N, eps, tols, dts, budget, ref_tol=REF_TOL):
             continue
         try:
             r = run_pinocchio(p, dt, budget=budget - spent)
+        except MemoryError:
+            print(f"  (Pinocchio at N = {N}: MemoryError in model.createData(); see --memory)")
+            break
         except (FloatingPointError, TimeoutError) as e:
             print(f"  ({e})")
             spent = budget + 1.0
