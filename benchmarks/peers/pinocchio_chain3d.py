@@ -318,6 +318,26 @@ def rss_mib() -> float:
         return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
 
 
+def projected_data_mib(N: int, chi: float = 0.25, n0: int = 100) -> float:
+    """Pinocchio's model + data memory at N (MiB), projected as N^3 from a measurement at n0
+    (``--memory``: exponent 3.0-3.1 from N = 50 to 200)."""
+    p = project_problem(chi, n0)
+    r0 = rss_mib()
+    model, data, *_ = build_pinocchio(p)
+    r1 = rss_mib()
+    del model, data
+    return max(r1 - r0, 1.0) * (N / n0) ** 3
+
+
+def available_mib() -> float:
+    """Memory available to a new allocation now (MiB, Linux /proc/meminfo)."""
+    with open("/proc/meminfo") as fh:
+        for line in fh:
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) / 1024
+    return math.inf
+
+
 def memory(Ns, chi=0.25) -> None:
     """Resident memory added by Pinocchio's model + data of N bodies (``model.createData()``),
     and one ABA call's CPU time; the growth exponent between successive N."""
@@ -385,6 +405,11 @@ def compare(chi, N, eps, tols, dts, budget, ref_tol=REF_TOL):
     ref = run_project(p, ref_tol)
     rows = [run_project(p, tol) for tol in tols]
     spent = 0.0
+    need, have = projected_data_mib(N, chi), available_mib()
+    if need > 0.7 * have:
+        print(f"  (Pinocchio at N = {N} not run: model.createData() would take about {need / 1024:.0f} GiB (N^3 "
+              f"from N = 100), {have / 1024:.0f} GiB available)")
+        dts = []
     for dt in dts:
         if spent > budget:
             print(f"  (Pinocchio dt = {dt:.3g} skipped: the budget of {budget:g} s is spent)")
