@@ -16,14 +16,17 @@ The same discrete chain in both codes:
   (k = 1..N) the link from node N - k + 1 to node N - k, joined to its parent by a
   spherical joint (the first at the held end, fixed in the world), carrying the point mass
   of node N - k at its far end (lever ``h (1, 0, 0)`` in the body's frame) and a rotational
-  inertia ``J = M L^2`` (the chain's mass and length) about its own axis only. A point mass
-  has no inertia about the link's axis, which would make the articulated-body inertia
-  singular; the axial inertia fixes that without changing the motion: spherical joints at
-  points on the axis exert no axial torque, the inertia is axisymmetric, so the spin about
-  the link's axis stays what it started at (zero) and a spin-free rigid link moves exactly
-  as the massless link of the point-mass chain. (A spin inertia of the link's own scale,
-  m h^2, works too but leaves the spin's acceleration at 1e-8 of the others near the root:
-  ill-conditioned.) Forward dynamics by the articulated-body algorithm (``pin.aba``, O(N)
+  inertia ``J = m h^2`` about its own axis only. A point mass has no inertia about the
+  link's axis, which would make the articulated-body inertia singular; the axial inertia
+  fixes that without changing the motion: spherical joints at points on the axis exert no
+  axial torque, the inertia is axisymmetric, so the spin about the link's axis stays what it
+  started at (zero) and a spin-free rigid link moves exactly as the massless link of the
+  point-mass chain. J must stay at the link's own scale: a Runge-Kutta stage's state carries
+  a spin of the step's size, and its gyroscopic torque J w_s e' acts on the transverse
+  inertia m h^2 (J = M L^2 at N = 200 blows up in the first step at any dt); at J = m h^2
+  the articulated inertias are ill-conditioned (the spin's acceleration comes out at 1e-8 of
+  the others near the root), but the node accelerations agree with the tension solve to
+  1e-9 (tested). Forward dynamics by the articulated-body algorithm (``pin.aba``, O(N)
   operations); but ``model.createData()`` for this tree takes memory growing as N^3 (6.7 GB
   at N = 200, measured by ``--memory``), so N = 500 (about 100 GB) does not fit here.
   Time stepping: classical RK4 at a fixed step, on the Lie group (Runge-Kutta-Munthe-Kaas:
@@ -115,12 +118,11 @@ def build_pinocchio(p):
     R_par = np.eye(3)
     qs, vs = [], []
     omega_par = np.zeros(3)
-    Jspin = float(m.sum() * h.sum() ** 2)  # the chain's own scale: the spin's inertia well conditioned
     for k in range(1, N + 1):
         j = N - k  # the link (and its far node) this body carries
         place = pin.SE3.Identity() if k == 1 else pin.SE3(np.eye(3), h[j + 1] * AXIS)
         jid = model.addJoint(parent, pin.JointModelSpherical(), place, f"joint{k}")
-        J = Jspin
+        J = m[j] * h[j] ** 2  # the link's own scale (see the module's docstring)
         model.appendBodyToJoint(jid, pin.Inertia(float(m[j]), h[j] * AXIS, np.diag([J, 0.0, 0.0])),
                                 pin.SE3.Identity())
         if k == 1:
