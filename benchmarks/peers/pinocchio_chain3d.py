@@ -370,6 +370,36 @@ def memory(Ns, chi=0.25) -> None:
     print()
 
 
+def aba_accuracy(Ns, chi=0.25, step=1e-3) -> None:
+    """Pinocchio's ABA against its own CRBA + a dense solve (``M a = -rnea(q, v, 0)``) and
+    against this project's tension solve, at the kicked catenary moved by ``step`` along its
+    velocity (out of the plane: at the planar start itself ABA is accurate at every N)."""
+    import pinocchio as pin
+    from snapping.spatial import Problem3D
+
+    print(f"Pinocchio's ABA at the start moved by {step:g} along its velocity (max |node acceleration| error):")
+    print(f"  {'N':>6}{'ABA - tension solve':>22}{'CRBA - tension solve':>22}{'|a| max':>10}")
+    for N in Ns:
+        p = project_problem(chi, N)
+        model, data, q, v, frames = build_pinocchio(p)
+        tau = np.zeros(model.nv)
+        q = pin.integrate(model, q, step * v)
+        a_aba = pin.aba(model, data, q, v, tau).copy()
+        M = pin.crba(model, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        a_crba = np.linalg.solve(M, -pin.rnea(model, data, q, v, tau))
+        r = node_positions(model, data, q, frames)
+        pin.forwardKinematics(model, data, q, v)
+        pin.updateFramePlacements(model, data)
+        vel = np.array([pin.getFrameVelocity(model, data, f, pin.LOCAL_WORLD_ALIGNED).linear for f in frames])
+        ref = project_accelerations(Problem3D(p.links, r - r[-1], vel - vel[-1]))
+        e1 = np.abs(node_accelerations(model, data, q, v, a_aba, frames) - ref).max()
+        e2 = np.abs(node_accelerations(model, data, q, v, a_crba, frames) - ref).max()
+        print(f"  {N:>6}{e1:>22.2e}{e2:>22.2e}{np.abs(ref).max():>10.3g}")
+        del model, data
+    print()
+
+
 # ---------------------------------------------------------------- reporting
 def machine():
     try:
@@ -464,6 +494,8 @@ def main(argv=None) -> int:
     ap.add_argument("--budget", type=float, default=900.0, help="CPU seconds for Pinocchio per N (default 900)")
     ap.add_argument("--ref-tol", type=float, default=REF_TOL, help=f"the reference's tolerance (default {REF_TOL:g})")
     ap.add_argument("--memory", default="", help="only Pinocchio's memory and ABA time at these N (e.g. 200,1000)")
+    ap.add_argument("--aba-check", default="", help="only ABA's accuracy against the tension solve at these N "
+                                                     "(e.g. 40,60,80,100,160)")
     ap.add_argument("--quick", action="store_true", help="N = 20, two steps, two tolerances: seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
@@ -476,6 +508,9 @@ def main(argv=None) -> int:
     print(f"uptime: {os.popen('uptime').read().strip()}\n")
     if a.memory:
         memory([int(x) for x in a.memory.split(",")], a.chi)
+        return 0
+    if a.aba_check:
+        aba_accuracy([int(x) for x in a.aba_check.split(",")], a.chi)
         return 0
     Ns, dts, tols = [int(x) for x in a.N.split(",") if x], _floats(a.dt), _floats(a.tols)
     if a.quick:
