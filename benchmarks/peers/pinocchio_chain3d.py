@@ -229,9 +229,30 @@ def hermite_max(t0, t1, s0, s1, d0, d1):
     return best
 
 
-def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, budget: float = math.inf) -> Result:
+def forward_dynamics(model, data, kind: str = "aba"):
+    """``a(q, v)`` of Pinocchio's model: ``"aba"`` (``pin.aba``, O(N)) or ``"crba"`` (the
+    joint-space inertia ``pin.crba`` and the bias ``pin.rnea(q, v, 0)``, a dense Cholesky
+    solve: O(N^3), accurate where ABA is not on this chain)."""
+    import pinocchio as pin
+    from scipy.linalg import cho_factor, cho_solve
+
+    zero = np.zeros(model.nv)
+    if kind == "aba":
+        return lambda q, v: pin.aba(model, data, q, v, zero).copy()
+
+    def crba(q, v):
+        M = pin.crba(model, data, q)  # (upper triangle)
+        b = pin.rnea(model, data, q, v, zero)
+        return cho_solve(cho_factor(M, lower=False, overwrite_a=True, check_finite=False), -b, check_finite=False)
+
+    return crba
+
+
+def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, budget: float = math.inf,
+                  dynamics: str = "aba") -> Result:
     """RK4 (Munthe-Kaas, ``pin.integrate``) at the fixed step dt until the tip speed has fallen
-    below ``stop_fraction`` of its peak (the project's stop rule)."""
+    below ``stop_fraction`` of its peak (the project's stop rule); forward dynamics
+    ``dynamics`` (:func:`forward_dynamics`)."""
     import pinocchio as pin
 
     w = time.process_time()
@@ -239,7 +260,8 @@ def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, 
     N = p.N
     tau = np.zeros(model.nv)
     tip = frames[0]
-    integ, aba = pin.integrate, pin.aba
+    integ = pin.integrate
+    fd = forward_dynamics(model, data, dynamics)
 
     def tip_state(q, v, a):
         pin.forwardKinematics(model, data, q, v, a)
@@ -250,11 +272,11 @@ def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, 
         return s, float(vt @ at) / s if s > 0.0 else 0.0
 
     c = time.process_time()
-    for _ in range(50):
-        aba(model, data, q, v, tau)
-    t_call = (time.process_time() - c) / 50
+    for _ in range(50 if dynamics == "aba" else 3):
+        fd(q, v)
+    t_call = (time.process_time() - c) / (50 if dynamics == "aba" else 3)
     w += time.process_time() - c  # (not part of the run's cost)
-    a = aba(model, data, q, v, tau).copy()
+    a = fd(q, v)
     n_aba = 1
     s, ds = tip_state(q, v, a)
     hist = [(0.0, s, ds, q.copy(), v.copy())]  # the last three samples
@@ -267,20 +289,20 @@ def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, 
         k1x, k1v = v, a
         x2 = h2 * k1x
         v2 = v + h2 * k1v
-        a2 = aba(model, data, integ(model, q, x2), v2, tau).copy()
+        a2 = fd(integ(model, q, x2), v2)
         k2x = dexpinv(x2.reshape(-1, 3), v2.reshape(-1, 3)).ravel()
         x3 = h2 * k2x
         v3 = v + h2 * a2
-        a3 = aba(model, data, integ(model, q, x3), v3, tau).copy()
+        a3 = fd(integ(model, q, x3), v3)
         k3x = dexpinv(x3.reshape(-1, 3), v3.reshape(-1, 3)).ravel()
         x4 = dt * k3x
         v4 = v + dt * a3
-        a4 = aba(model, data, integ(model, q, x4), v4, tau).copy()
+        a4 = fd(integ(model, q, x4), v4)
         k4x = dexpinv(x4.reshape(-1, 3), v4.reshape(-1, 3)).ravel()
         q = integ(model, q, (dt / 6.0) * (k1x + 2.0 * k2x + 2.0 * k3x + k4x))
         v = v + (dt / 6.0) * (k1v + 2.0 * a2 + 2.0 * a3 + a4)
         t = n * dt
-        a = aba(model, data, q, v, tau).copy()
+        a = fd(q, v)
         n_aba += 4
         s, ds = tip_state(q, v, a)
         hist.append((t, s, ds, q.copy(), v.copy()))
@@ -305,7 +327,8 @@ def run_pinocchio(p, dt: float, t_max: float = 3.0, stop_fraction: float = 0.5, 
     zs = [float(np.abs(node_positions(model, data, qq, frames)[:, 2]).max()) for qq in (qa, qb, qc)]
     cz = np.polyfit([ta - tb, 0.0, tc - tb], zs, 2)
     z = float(np.polyval(cz, tp - tb))
-    return Result("Pinocchio", N, f"RK4 dt={dt:.3g}", n_aba, w, vp, tp, z, aba_only=n_aba * t_call)
+    tag = "" if dynamics == "aba" else f" {dynamics}"
+    return Result("Pinocchio", N, f"RK4{tag} dt={dt:.3g}", n_aba, w, vp, tp, z, aba_only=n_aba * t_call)
 
 
 def run_project(p, tol: float) -> Result:
@@ -439,7 +462,7 @@ def matched(rows, level):
     return out
 
 
-def compare(chi, N, eps, tols, dts, budget, ref_tol=REF_TOL):
+def compare(chi, N, eps, tols, dts, budget, ref_tol=REF_TOL, dynamics="aba"):
     p = project_problem(chi, N, eps)
     ref = run_project(p, ref_tol)
     rows = [run_project(p, tol) for tol in tols]
@@ -454,7 +477,7 @@ def compare(chi, N, eps, tols, dts, budget, ref_tol=REF_TOL):
             print(f"  (Pinocchio dt = {dt:.3g} skipped: the budget of {budget:g} s is spent)")
             continue
         try:
-            r = run_pinocchio(p, dt, budget=budget - spent)
+            r = run_pinocchio(p, dt, budget=budget - spent, dynamics=dynamics)
         except MemoryError:
             print(f"  (Pinocchio at N = {N}: MemoryError in model.createData(); see --memory)")
             break
@@ -504,6 +527,8 @@ def main(argv=None) -> int:
     ap.add_argument("--memory", default="", help="only Pinocchio's memory and ABA time at these N (e.g. 200,1000)")
     ap.add_argument("--aba-check", default="", help="only ABA's accuracy against the tension solve at these N "
                                                      "(e.g. 40,60,80,100,160)")
+    ap.add_argument("--dynamics", choices=("aba", "crba"), default="aba",
+                    help="Pinocchio's forward dynamics: aba (O(N); default) or crba (+ dense Cholesky, O(N^3))")
     ap.add_argument("--quick", action="store_true", help="N = 20, two steps, two tolerances: seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
@@ -525,7 +550,7 @@ def main(argv=None) -> int:
         Ns, dts, tols, a.ref_tol = [20], [4e-4, 2e-4], [1e-5, 1e-8], 1e-11
     run_project(project_problem(a.chi, 5, a.eps), 1e-4)  # compile before timing
     for N in Ns:
-        compare(a.chi, N, a.eps, tols, dts, a.budget, a.ref_tol)
+        compare(a.chi, N, a.eps, tols, dts, a.budget, a.ref_tol, a.dynamics)
     print(f"uptime: {os.popen('uptime').read().strip()}")
     return 0
 
