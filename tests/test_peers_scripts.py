@@ -312,3 +312,16 @@ def test_pinocchio_quick_run():
     rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("Pinocchio ")]
     assert len(rows) == 2
     assert all(float(r[-2]) < 1e-8 for r in rows)  # (rel err; the last column is the ABA-only time)
+
+
+@needs_pin
+def test_pinocchio_crba_dynamics_equals_the_tension_solve():
+    """The script's other forward dynamics (CRBA + dense Cholesky) gives the tension solve's node
+    accelerations at a random 3D state of a random chain."""
+    P = _pin_script()
+    p = _random_chain3d(25, 5)
+    model, data, q, v, frames = P.build_pinocchio(p)
+    a = P.forward_dynamics(model, data, "crba")(q, v)
+    acc = P.node_accelerations(model, data, q, v, a, frames)
+    ref = P.project_accelerations(p)
+    assert np.abs(acc - ref).max() < 1e-9 * max(1.0, np.abs(ref).max())
