@@ -153,3 +153,175 @@ def test_quick_run():
     rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("PyElastica ")]
     assert len(rows) == 2
     assert float(rows[-1][-1]) < 1e-2
+
+
+# ---------------------------------------------------------------- Pinocchio on the 3D chain (issue 23)
+PIN_SCRIPT = ROOT / "benchmarks" / "peers" / "pinocchio_chain3d.py"
+HAVE_PIN = importlib.util.find_spec("pinocchio") is not None
+needs_pin = pytest.mark.skipif(not HAVE_PIN, reason="pin (Pinocchio, the 'peers' extra) is not installed")
+
+
+def _pin_script():
+    if "pinocchio_chain3d" in sys.modules:
+        return sys.modules["pinocchio_chain3d"]
+    spec = importlib.util.spec_from_file_location("pinocchio_chain3d", PIN_SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["pinocchio_chain3d"] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_pinocchio_help_without_the_peer():
+    out = subprocess.run([sys.executable, str(PIN_SCRIPT), "--help"], capture_output=True, text=True, env=_env(),
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "--quick" in out.stdout and "--dt" in out.stdout and "--memory" in out.stdout
+
+
+@pytest.mark.parametrize("N", [7, 40])
+def test_pinocchio_project_problem_is_the_kicked_catenary(N):
+    """The project's side: catenary nodes (closed form), consistent masses, the kick eps sin(pi s/L) in z."""
+    P = _pin_script()
+    p = P.project_problem(0.25, N, 1e-2)
+    x, y = _catenary(0.25, N)
+    assert np.abs(p.r[:, 0] - x).max() < 1e-12 and np.abs(p.r[:, 1] - y).max() < 1e-12 and not p.r[:, 2].any()
+    m = np.full(N, 1.0 / N)
+    m[0] = 0.5 / N
+    assert np.abs(p.links.m - m).max() < 1e-15
+    s = 1.0 - np.arange(N + 1) / N  # arclength from the held end
+    assert np.abs(p.v[:, 2] - 1e-2 * np.sin(np.pi * s)).max() < 1e-15 and not p.v[:, :2].any()
+
+
+@needs_pin
+@pytest.mark.parametrize("N", [7, 40])
+def test_pinocchio_model_is_the_same_chain(N):
+    """Pinocchio's tree: its nodes (forward kinematics) at the closed-form catenary, its node
+    velocities the kick, one body per link with the node's lumped mass at the link's far end
+    (1/N, the free end 1/(2N): total 1 - 1/(2N)), a spherical joint per body."""
+    import pinocchio as pin
+
+    P = _pin_script()
+    p = P.project_problem(0.25, N, 1e-2)
+    model, data, q, v, frames = P.build_pinocchio(p)
+    assert model.njoints == N + 1 and model.nq == 4 * N and model.nv == 3 * N
+    assert all(model.joints[k].shortname() == "JointModelSpherical" for k in range(1, N + 1))
+    x, y = _catenary(0.25, N)
+    r = P.node_positions(model, data, q, frames)
+    assert np.abs(r[:, 0] - x).max() < 1e-12 and np.abs(r[:, 1] - y).max() < 1e-12 and np.abs(r[:, 2]).max() < 1e-12
+    assert np.abs(r - p.r).max() < 1e-12
+    masses = np.array([model.inertias[k].mass for k in range(1, N + 1)])[::-1]  # node 0 .. N-1
+    m = np.full(N, 1.0 / N)
+    m[0] = 0.5 / N
+    assert np.abs(masses - m).max() < 1e-15 and abs(masses.sum() - (1.0 - 0.5 / N)) < 1e-14
+    for k in range(1, N + 1):  # the mass sits at the link's far node
+        assert np.abs(model.inertias[k].lever - np.array([1.0 / N, 0.0, 0.0])).max() < 1e-15
+    pin.forwardKinematics(model, data, q, v)
+    pin.updateFramePlacements(model, data)
+    vel = np.array([pin.getFrameVelocity(model, data, f, pin.LOCAL_WORLD_ALIGNED).linear for f in frames])
+    s = 1.0 - np.arange(N + 1) / N
+    assert np.abs(vel[:, 2] - 1e-2 * np.sin(np.pi * s)).max() < 1e-14 and np.abs(vel[:, :2]).max() < 1e-14
+    assert np.abs(np.linalg.norm(q.reshape(-1, 4), axis=1) - 1.0).max() < 1e-15
+
+
+def _random_chain3d(N, seed):
+    """A chain in a random 3D state: random link lengths and masses, random unit link directions
+    (node N at the origin), random node velocities that keep every link's length."""
+    from snapping.simulate import Links
+    from snapping.spatial import Problem3D
+
+    rng = np.random.default_rng(seed)
+    h = rng.uniform(0.5, 1.5, N) / N
+    m = rng.uniform(0.5, 2.0, N) / N
+    e = rng.standard_normal((N, 3))
+    e /= np.linalg.norm(e, axis=1)[:, None]
+    u = rng.standard_normal((N, 3))
+    u -= np.einsum("ij,ij->i", u, e)[:, None] * e
+    r = np.zeros((N + 1, 3))
+    v = np.zeros((N + 1, 3))
+    for j in range(N - 1, -1, -1):
+        r[j] = r[j + 1] - h[j] * e[j]
+        v[j] = v[j + 1] - h[j] * u[j]
+    return Problem3D(Links.explicit(h, m), r, v)
+
+
+@needs_pin
+@pytest.mark.parametrize("case", ["kick-9", "kick-40", "random-7", "random-30"])
+def test_pinocchio_aba_equals_the_tension_solve(case):
+    """Two independent solvers of the same chain: Pinocchio's articulated-body algorithm (rigid
+    bodies, spherical joints, a spin inertia) and this project's tridiagonal tension system
+    (chain3d.rhs3d) give the same node accelerations, at the benchmark's start and at random 3D
+    states of random chains; and the spin about each link's axis has zero acceleration (the
+    axial inertia does not change the motion)."""
+    import pinocchio as pin
+
+    P = _pin_script()
+    kind, n = case.split("-")
+    N = int(n)
+    p = P.project_problem(0.25, N, 1e-2) if kind == "kick" else _random_chain3d(N, N)
+    model, data, q, v, frames = P.build_pinocchio(p)
+    assert np.abs(P.node_positions(model, data, q, frames) - p.r).max() < 1e-12
+    a = pin.aba(model, data, q, v, np.zeros(model.nv)).copy()
+    acc = P.node_accelerations(model, data, q, v, a, frames)
+    ref = P.project_accelerations(p)
+    assert np.abs(ref).max() > 0.5
+    if kind == "random":
+        assert np.abs(ref[:, 2]).max() > 0.1
+    assert np.abs(acc - ref).max() < 1e-9 * max(1.0, np.abs(ref).max())
+    pin.forwardKinematics(model, data, q, v, a)
+    alpha = np.array([data.a[k].angular for k in range(1, N + 1)])  # in each body's frame, its axis x
+    assert np.abs(alpha[:, 0]).max() < 1e-6 * np.abs(alpha).max()  # (round-off: ill-conditioned, see the script)
+
+
+@needs_pin
+def test_dexpinv_inverts_pinocchios_integrate_jacobian():
+    """The Lie-group RK4's dexp^{-1} per spherical joint against Pinocchio's dIntegrate (d q/d v),
+    at large and tiny rotation vectors."""
+    import pinocchio as pin
+
+    P = _pin_script()
+    model, data, q, v, _ = P.build_pinocchio(P.project_problem(0.25, 6))
+    rng = np.random.default_rng(3)
+    for scale in (1.5, 1e-5):
+        xi = scale * rng.standard_normal(model.nv)
+        w = rng.standard_normal(model.nv)
+        J = pin.dIntegrate(model, q, xi, pin.ARG1)
+        assert np.abs(J @ P.dexpinv(xi.reshape(-1, 3), w.reshape(-1, 3)).ravel() - w).max() < 1e-13
+
+
+def test_hermite_max_of_a_cubic():
+    P = _pin_script()
+    s = lambda t: 2.0 + 0.3 * t - 4.0 * (t - 0.4) ** 2 + 1.5 * (t - 0.4) ** 3  # noqa: E731
+    ds = lambda t: 0.3 - 8.0 * (t - 0.4) + 4.5 * (t - 0.4) ** 2  # noqa: E731
+    vp, tp = P.hermite_max(0.1, 0.8, s(0.1), s(0.8), ds(0.1), ds(0.8))
+    tt = np.linspace(0.1, 0.8, 700001)
+    k = int(np.argmax(s(tt)))
+    assert abs(tp - tt[k]) < 2e-6 and abs(vp - s(tt).max()) < 1e-12 and abs(ds(tp)) < 1e-12
+
+
+@needs_pin
+def test_pinocchio_quick_run():
+    """--quick runs (under 30 s of CPU), and Pinocchio's RK4 peak agrees with this project's
+    reference to 1e-8 (both solve the same chain)."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    out = subprocess.run([sys.executable, str(PIN_SCRIPT), "--quick"], capture_output=True, text=True, env=_env(),
+                         timeout=300)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    assert out.returncode == 0, out.stderr[-2000:]
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    assert cpu < 30.0, f"--quick took {cpu:.1f} s of CPU"
+    rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("Pinocchio ")]
+    assert len(rows) == 2
+    assert all(float(r[-2]) < 1e-8 for r in rows)  # (rel err; the last column is the ABA-only time)
+
+
+@needs_pin
+def test_pinocchio_crba_dynamics_equals_the_tension_solve():
+    """The script's other forward dynamics (CRBA + dense Cholesky) gives the tension solve's node
+    accelerations at a random 3D state of a random chain."""
+    P = _pin_script()
+    p = _random_chain3d(25, 5)
+    model, data, q, v, frames = P.build_pinocchio(p)
+    a = P.forward_dynamics(model, data, "crba")(q, v)
+    acc = P.node_accelerations(model, data, q, v, a, frames)
+    ref = P.project_accelerations(p)
+    assert np.abs(acc - ref).max() < 1e-9 * max(1.0, np.abs(ref).max())
