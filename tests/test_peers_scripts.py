@@ -8,7 +8,6 @@ from __future__ import annotations
 import importlib.util
 import math
 import os
-import resource
 import subprocess
 import sys
 from pathlib import Path
@@ -141,15 +140,11 @@ def test_pyelastica_rod_falls_under_gravity_with_its_end_pinned():
 
 @needs_elastica
 def test_quick_run():
-    """--quick runs (under 30 s of CPU), and PyElastica's stiffest rod there agrees with this
+    """--quick runs (about 30 s; no timing is asserted), and PyElastica's stiffest rod there agrees with this
     project's exact chain to its extensibility error (1e-2)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     out = subprocess.run([sys.executable, str(SCRIPT), "--quick"], capture_output=True, text=True, env=_env(),
                          timeout=300)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     assert out.returncode == 0, out.stderr[-2000:]
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    assert cpu < 30.0, f"--quick took {cpu:.1f} s of CPU"
     rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("PyElastica ")]
     assert len(rows) == 2
     assert float(rows[-1][-1]) < 1e-2
@@ -300,15 +295,11 @@ def test_hermite_max_of_a_cubic():
 
 @needs_pin
 def test_pinocchio_quick_run():
-    """--quick runs (under 30 s of CPU), and Pinocchio's RK4 peak agrees with this project's
+    """--quick runs (about 30 s; no timing is asserted), and Pinocchio's RK4 peak agrees with this project's
     reference to 1e-8 (both solve the same chain)."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     out = subprocess.run([sys.executable, str(PIN_SCRIPT), "--quick"], capture_output=True, text=True, env=_env(),
                          timeout=300)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     assert out.returncode == 0, out.stderr[-2000:]
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    assert cpu < 30.0, f"--quick took {cpu:.1f} s of CPU"
     rows = [ln.split() for ln in out.stdout.splitlines() if ln.strip().startswith("Pinocchio ")]
     assert len(rows) == 2
     assert all(float(r[-2]) < 1e-8 for r in rows)  # (rel err; the last column is the ABA-only time)
