@@ -108,7 +108,7 @@ def test_every_schema_variable_has_a_kind():
     names = set(schema.ALL_VARS) | set(schema.COORDS) - {"snapshot_kind"}
     assert names <= set(units.VARIABLE_KINDS), sorted(names - set(units.VARIABLE_KINDS))
     strings = {"method", "chords", "initial", "status", "stop_reason", "failure", "snap_note", "snapping_version",
-               "wall_time", "problem", "pin_motion", "start", "body"}
+               "wall_time", "problem", "pin_motion", "start", "body", "start_rest"}
     numeric = (set(schema.INPUT_ATTRS) | set(schema.RESULT_ATTRS) | set(schema.PROBLEM_ATTRS)) - strings
     assert numeric <= set(units.VALUE_KINDS), sorted(numeric - set(units.VALUE_KINDS))
     assert set(units.VARIABLE_KINDS.values()) | set(units.VALUE_KINDS.values()) <= set(units.KIND_UNITS)

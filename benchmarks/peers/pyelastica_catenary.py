@@ -70,10 +70,12 @@ SAFETY = 0.6
 # ---------------------------------------------------------------- the problem, in both codes
 def project_problem(chi: float, N: int, beta: float):
     """This project's problem: the catenary, ``Links.uniform(N, lumping="shared")``, bending
-    ``beta``, the held end a free hinge."""
+    ``beta``, the held end a free hinge. Released from the catenary itself (``start="catenary"``,
+    not the rest shape that is the default of a line with bending): PyElastica's rod is built
+    on the same nodes."""
     from snapping.simulate import Body, Links, Problem
 
-    return Problem.catenary(chi, links=Links.uniform(N, lumping="shared"), body=Body(bending=beta))
+    return Problem.catenary(chi, links=Links.uniform(N, lumping="shared"), body=Body(bending=beta), start="catenary")
 
 
 @dataclass(frozen=True)

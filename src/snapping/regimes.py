@@ -46,30 +46,12 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
+from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem"]
 
-#: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
-MECHANISMS = {
-    "bending": ("beta", "uniform", "bending stiffness B/(lambda g L^3)"),
-    "drag": ("drag_normal", "fold", "air drag: normal number d, tangential d*pi*C_t/C_n (default coefficients)"),
-    "drag-normal": ("drag_normal", "fold", "normal (cross-flow) air drag alone"),
-    "drag-tangential": ("drag_tangential", "fold", "tangential air drag (skin friction) alone"),
-    "end-mass": ("end_mass", "fold", "a point mass M_end/(lambda L) at the free end"),
-}
-
-#: accuracy presets: levels, first level, links of level 0 of uniform chains (n0), tolerance. Measured
-#: (ideal chain, `benchmarks`-free check in the guide): coarse gives 34.1 +- 2.0 at chi = 0.1 and
-#: 11.33 +- 0.13 at chi = 0.25 (fold-graded 493-1857 and 193-639 links), medium 32.98 +- 0.10 and
-#: 11.282 +- 0.004 (947-7328 and 341-2436 links); the paper's limits are 32.97 and 11.28
-ACCURACY = {
-    "coarse": {"levels": 3, "first": -2, "n0": 50, "tol": 1e-7},
-    "medium": {"levels": 4, "first": -1, "n0": 50, "tol": 1e-7},
-    "fine": {"levels": 4, "first": 0, "n0": 100, "tol": 1e-7},
-}
-
-#: the largest number a cell takes (every mechanism's number is a ratio to the chain's scales)
-NUMBER_MAX = 1e4
+# the mechanisms, accuracy presets and NUMBER_MAX live in snapping.regimes_spec (light: the CLI
+# builds its parser from them without importing xarray)
 
 
 def _drag_ratio() -> float:

@@ -7,7 +7,7 @@ from ._common import PLOT_BYTES, _floats, _formatter, print_json
 
 
 def _add_regimes(sub) -> None:
-    from ..regimes import ACCURACY, MECHANISMS
+    from ..regimes_spec import ACCURACY, MECHANISMS
 
     p = sub.add_parser(
         "regimes",

@@ -1,0 +1,31 @@
+"""The mechanisms and accuracy presets of a regime study (:mod:`snapping.regimes`).
+
+Kept apart from the study (which needs xarray and the continuum tools) so that the command
+line can build its parser, and answer a table query, without importing them.
+"""
+
+from __future__ import annotations
+
+__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX"]
+
+#: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
+MECHANISMS = {
+    "bending": ("beta", "uniform", "bending stiffness B/(lambda g L^3)"),
+    "drag": ("drag_normal", "fold", "air drag: normal number d, tangential d*pi*C_t/C_n (default coefficients)"),
+    "drag-normal": ("drag_normal", "fold", "normal (cross-flow) air drag alone"),
+    "drag-tangential": ("drag_tangential", "fold", "tangential air drag (skin friction) alone"),
+    "end-mass": ("end_mass", "fold", "a point mass M_end/(lambda L) at the free end"),
+}
+
+#: accuracy presets: levels, first level, links of level 0 of uniform chains (n0), tolerance. Measured
+#: (ideal chain, `benchmarks`-free check in the guide): coarse gives 34.1 +- 2.0 at chi = 0.1 and
+#: 11.33 +- 0.13 at chi = 0.25 (fold-graded 493-1857 and 193-639 links), medium 32.98 +- 0.10 and
+#: 11.282 +- 0.004 (947-7328 and 341-2436 links); the paper's limits are 32.97 and 11.28
+ACCURACY = {
+    "coarse": {"levels": 3, "first": -2, "n0": 50, "tol": 1e-7},
+    "medium": {"levels": 4, "first": -1, "n0": 50, "tol": 1e-7},
+    "fine": {"levels": 4, "first": 0, "n0": 100, "tol": 1e-7},
+}
+
+#: the largest number a cell takes (every mechanism's number is a ratio to the chain's scales)
+NUMBER_MAX = 1e4
