@@ -458,12 +458,16 @@ class Engine(CheckpointMixin):
 
     def restore(self, ds) -> None:
         """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
+        self._restore_from(ds, (("checkpoint_dense", self.F), ("checkpoint_dense_ok", self.DOK)))
+
+    def _restore_from(self, ds, own) -> None:
+        """Restore the state every step loop of this engine shares, then the loop's ``own``
+        (name, array) pairs (the steps' stages, slots, control, peaks, scales and history)."""
         get = checkpoint_getter(ds)
         for name, arr in (("checkpoint_Y0", self.Y0), ("checkpoint_Y1", self.Y1), ("checkpoint_stages", self.KK),
-                          ("checkpoint_dense", self.F), ("checkpoint_step_t", self.TS),
-                          ("checkpoint_step_h", self.HS), ("checkpoint_dense_ok", self.DOK),
+                          ("checkpoint_step_t", self.TS), ("checkpoint_step_h", self.HS),
                           ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
-                          ("checkpoint_meas0", self.meas0)):
+                          ("checkpoint_meas0", self.meas0), *own):
             arr[...] = get(name, arr.shape)
         self._restore_ctl(get, R.NQ)
         self._restore_scales(ds, get)

@@ -35,7 +35,6 @@ from .. import general as G
 from .. import models as MD
 from .. import rk as R
 from .. import rosenbrock as RB
-from .._engine_common import checkpoint_getter
 from ..stiff_system import NCOL
 from . import dop853 as DP
 
@@ -172,18 +171,7 @@ class Engine(DP.Engine):
 
     def restore(self, ds) -> None:
         """Continue from the checkpoint in run Dataset ``ds`` (the inverse of :meth:`checkpoint_vars`)."""
-        get = checkpoint_getter(ds)
-        for name, arr in (("checkpoint_Y0", self.Y0), ("checkpoint_Y1", self.Y1), ("checkpoint_stages", self.KK),
-                          ("checkpoint_step_t", self.TS), ("checkpoint_step_h", self.HS),
-                          ("checkpoint_jacobian", self.Dj), ("checkpoint_counts", self.cnt),
-                          ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
-                          ("checkpoint_meas0", self.meas0)):
-            arr[...] = get(name, arr.shape)
-        self._restore_ctl(get, R.NQ)
-        self._restore_scales(ds, get)
-        peak_t = float(get("checkpoint_peak_t", ()))
-        self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
-        self._restore_history(ds, get, R.Q_NREC)
+        self._restore_from(ds, (("checkpoint_jacobian", self.Dj), ("checkpoint_counts", self.cnt)))
 
 
 _compiled = False
