@@ -372,6 +372,7 @@ SPATIAL_NODE_PROFILE_VARS: dict[str, dict[str, str]] = {
 SPATIAL_PROBLEM_VARS: dict[str, dict[str, str]] = {
     "start_z": _v("node position at t = 0, e3 component"),
     "start_vz": _v("node velocity at t = 0, e3 component"),
+    "pin_table_z": _v("e3 position of the held end at the sample times (cubic spline between; a 3D table)"),
 }
 #: Global attributes of a 3D run, besides the planar ones that mean the same.
 SPATIAL_ATTRS: dict[str, str] = {

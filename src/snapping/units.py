@@ -18,6 +18,8 @@ acceleration   g               ``m s-2``
 force          M g             ``N``
 energy         M g L           ``J``
 curvature      1/L             ``m-1``
+rate           sqrt(g/L)       ``s-1``
+angular_mom.   M L sqrt(g L)   ``kg m2 s-1``
 dimensionless  1               ``1``
 =============  ==============  ==========
 
@@ -67,6 +69,8 @@ KIND_UNITS: dict[str, str] = {
     "force": "N",
     "energy": "J",
     "curvature": "m-1",
+    "rate": "s-1",
+    "angular_momentum": "kg m2 s-1",
     "dimensionless": "1",
 }
 
@@ -77,6 +81,7 @@ NONDIMENSIONAL_NOTE = ("units: nondimensional (lengths in chain lengths L, masse
 
 _L, _M, _T, _V, _A, _F, _E, _K, _1 = ("length", "mass", "time", "speed", "acceleration", "force", "energy",
                                       "curvature", "dimensionless")
+_W, _H = "rate", "angular_momentum"
 
 #: The kind of every variable and coordinate of a run Dataset (:mod:`snapping.schema`; a test
 #: checks that none is missing), and of the ``chi``/``N`` coordinates of a combined sweep.
@@ -100,6 +105,9 @@ VARIABLE_KINDS: dict[str, str] = {
     # the problem of a general run
     "link_length": _L, "node_mass": _M, "start_x": _L, "start_y": _L, "start_vx": _V, "start_vy": _V,
     "pin_table_t": _T, "pin_table_x": _L, "pin_table_y": _L,
+    # a 3D run (snapping.spatial.dataset3d; snapping.schema.SPATIAL_VARS)
+    "z": _L, "vz": _V, "az": _A, "start_z": _L, "start_vz": _V, "z_amp": _L, "vz_amp": _V,
+    "angular_momentum_g": _H, "pin_table_z": _L,
 }
 
 #: The kind of every numeric input and result attribute of a run (the keys of its summary, and
@@ -116,6 +124,9 @@ VALUE_KINDS: dict[str, str] = {
     "energy_initial": _E, "dt_min_accepted": _T, "dt_max_accepted": _T, "n_steps": _1, "n_rejected": _1,
     "n_rhs": _1, "min_tension": _F, "t_min_tension": _T, "s_min_tension": _L, "t_compression": _T,
     "compression_tolerance": _1,
+    # a 3D run (snapping.schema.SPATIAL_ATTRS)
+    "dims": _1, "whirl": _W, "z_amp_snap": _L, "vz_amp_snap": _V, "z_amp_max": _L, "angular_momentum_drift": _H,
+    "link_error_max": _1,
 }
 
 #: Suffixes of a value that has the kind of the value it is appended to (an error bar, a limit).

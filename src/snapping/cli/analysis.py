@@ -283,6 +283,10 @@ def _dense_rerun(ds, frames: int, path: str):
     times = animation.dense_snapshot_times(t_snap, frames)[1:]  # (t = 0 is always taken)
     print(f"snapping animate: rerunning {path} with {frames} snapshots dense towards the snap (t = {t_snap:.6g})",
           file=sys.stderr)
+    if int(ds.attrs.get("dims", 2)) == 3:  # (a 3D run: snapping.spatial, the same steps again)
+        from ..spatial.dataset3d import rerun3d
+
+        return rerun3d(ds, snapshot_times=times)
     return rerun(ds, snapshot_times=times, output=None, progress=None).dataset
 
 
@@ -366,21 +370,14 @@ def _cmd_animate(args) -> int:
 
     animation.check_output(args.output, overwrite=args.overwrite)  # before reading the run
     ds = load_run(args.file)
-    spatial = int(ds.attrs.get("dims", 2)) == 3
     if args.frames is not None:
-        if spatial:
-            from .._validate import SnappingInputError
-
-            raise SnappingInputError(f"--frames {args.frames}: {args.file} is a 3D run, which cannot be rerun from its "
-                                     f"file yet; run it again with `snapping simulate ... --snapshot-times` "
-                                     f"(snapping.animation.dense_snapshot_times gives dense times)")
         ds = _dense_rerun(ds, args.frames, args.file)
     animation.frames_of(ds, args.max_frames)  # no snapshots: refused here
     out = animation.animate(ds, args.output, fps=args.fps, max_frames=args.max_frames, overwrite=args.overwrite)
     n = len(animation.frames_of(ds, args.max_frames))
     print(f"wrote {out}: {n} frames at {args.fps:g} fps")
     # (after the work: never a hint before an error)
-    if args.frames is None and not spatial and animation.denser_run_hint(ds, args.file):
+    if args.frames is None and animation.denser_run_hint(ds, args.file):
         print(f"snapping animate: note: only {animation.snapshots_before_snap(ds)} snapshots up to the snap; for a "
               f"smoother animation add --frames 60 (reruns the run with that many snapshots dense towards the "
               f"snap)", file=sys.stderr)

@@ -169,7 +169,7 @@ def _cmd_simulate(args) -> int:
     from .simulate3d import cmd_simulate3d, wants_3d
 
     if wants_3d(args):  # the chain in space (snapping.spatial)
-        return cmd_simulate3d(args, times)
+        return cmd_simulate3d(args, times, scales)
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
     if args.resume is None and (not start_given or args.N is None):

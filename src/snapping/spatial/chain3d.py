@@ -64,15 +64,15 @@ import math
 import numpy as np
 from numba import njit
 
-from ..simulate.general import BLOCK, _pow2_near
+from ..simulate.general import BLOCK, _pow2_near, _spline
 
 __all__ = ["Work", "make_model", "rhs3d", "measure3d", "project", "pin3d", "nodes_to_state", "state_to_nodes",
-           "NMEAS", "MEAS_NAMES"]
+           "NMEAS", "MEAS_NAMES", "circle_data", "table_data", "breakpoints"]
 
 # ---------------------------------------------------------------- the model's scalar parameters
 P_GX, P_GY, P_GZ, P_PIN, P_AX, P_AY, P_AZ, P_T0, P_T1, P_NX, P_NY, P_NZ = range(12)
 NPAR = 12
-PIN_FIXED, PIN_PULL, PIN_FLICK = 0.0, 1.0, 2.0
+PIN_FIXED, PIN_PULL, PIN_FLICK, PIN_TABLE, PIN_CIRCLE = 0.0, 1.0, 2.0, 3.0, 4.0
 TWO_PI = 2.0 * math.pi
 
 # ---------------------------------------------------------------- per-step measurements
@@ -99,26 +99,124 @@ def make_model(h, invm, *, g=(0.0, 1.0, 0.0), pin=(PIN_FIXED, (0.0, 0.0, 0.0), 0
     """The model tuple ``(par, h, invm)`` of the compiled kernels (no checks: the
     :class:`snapping.spatial.starts3d.Problem3D` validates).
 
-    ``g``: the gravity vector (magnitude times direction); ``pin = (kind, accel, t0, T)``
+    ``g``: the gravity vector (magnitude times direction); ``pin = (kind, accel, t0, T[, data])``
     (:data:`PIN_FIXED`, :data:`PIN_PULL`: ``accel`` from t0 for T then constant velocity,
-    :data:`PIN_FLICK`: ``accel sin(2 pi (t - t0)/T)`` for one period); ``normal``: the unit
+    :data:`PIN_FLICK`: ``accel sin(2 pi (t - t0)/T)`` for one period; :data:`PIN_CIRCLE` (T: its
+    ramp) and :data:`PIN_TABLE` carry ``data`` (:func:`circle_data`, :func:`table_data`), which
+    is appended to ``par`` after its scalars, its offset in ``par[P_AX]``); ``normal``: the unit
     normal of the reference plane whose out-of-plane amplitude is measured.
     """
-    par = np.zeros(NPAR)
+    kind, acc, t0, T, *data = pin
+    data = np.asarray(data[0], dtype=float).ravel() if data and data[0] is not None else np.zeros(0)
+    par = np.zeros(NPAR + data.size)
     par[P_GX:P_GZ + 1] = np.asarray(g, dtype=float)
-    kind, acc, t0, T = pin
     par[P_PIN] = kind
     par[P_AX:P_AZ + 1] = np.asarray(acc, dtype=float)
+    if kind in (PIN_CIRCLE, PIN_TABLE):
+        par[P_AX:P_AZ + 1] = (float(NPAR), 0.0, 0.0)  # (the offset of the pin's data block)
+        par[NPAR:] = data
     par[P_T0], par[P_T1] = t0, T
     par[P_NX:P_NZ + 1] = np.asarray(normal, dtype=float)
     return par, np.ascontiguousarray(h, dtype=float), np.ascontiguousarray(invm, dtype=float)
 
 
+def circle_data(radius: float, omega: float, a, b) -> np.ndarray:
+    """The data block of :data:`PIN_CIRCLE`: ``[R, omega, a, b]`` (``a``: the unit vector
+    from the circle's centre to the start, ``b = axis x a``)."""
+    return np.concatenate([[radius, omega], np.asarray(a, dtype=float), np.asarray(b, dtype=float)])
+
+
+def table_data(t, cx, cy, cz) -> np.ndarray:
+    """The data block of :data:`PIN_TABLE`: ``[n, t_0..t_{n-1}, cx, cy, cz]``, ``c*`` the
+    (4, n - 1) cubic coefficients of each coordinate (scipy ``CubicSpline.c``)."""
+    t = np.asarray(t, dtype=float)
+    return np.concatenate([[float(t.size)], t] + [np.asarray(c, dtype=float).ravel() for c in (cx, cy, cz)])
+
+
 def breakpoints(par) -> list[float]:
-    """Times where the held end's acceleration (or a derivative of it) jumps: steps land on them."""
-    if par[P_PIN] in (PIN_PULL, PIN_FLICK):
-        return [float(v) for v in (par[P_T0], par[P_T0] + par[P_T1]) if math.isfinite(v)]
+    """Times where the held end's acceleration (or a derivative of it) jumps: steps land on
+    them (the start and end of a pull, a flick or a circle's ramp; a table's last sample)."""
+    kind = par[P_PIN]
+    if kind == PIN_CIRCLE and par[P_T1] == 0.0:
+        return []
+    if kind in (PIN_PULL, PIN_FLICK, PIN_CIRCLE):
+        return sorted({float(v) for v in (par[P_T0], par[P_T0] + par[P_T1]) if math.isfinite(v)})
+    if kind == PIN_TABLE:
+        o = int(par[P_AX])
+        return [float(par[o + int(par[o])])]
     return []
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _circle(t, par):
+    """The held end on a circle: the phase phi, its rate ramped from 0 to omega over T from t0
+    by ``phi'' = (omega/T)(1 - cos(2 pi tau))``, tau = (t - t0)/T (T = 0: steady from t0 = 0,
+    the held end moving from the start, no breakpoint),
+    then ``r = R((cos phi - 1) a + sin phi b)`` (the start on the circle, at the origin)."""
+    o = int(par[P_AX])
+    R = par[o]
+    w = par[o + 1]
+    t0 = par[P_T0]
+    T = par[P_T1]
+    if T > 0.0 and t <= t0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    if T > 0.0 and t <= t0 + T:
+        tau = (t - t0) / T
+        c2 = math.cos(TWO_PI * tau)
+        ph = w * T * (0.5 * tau * tau + (c2 - 1.0) / (TWO_PI * TWO_PI))
+        ph1 = w * (tau - math.sin(TWO_PI * tau) / TWO_PI)
+        ph2 = (w / T) * (1.0 - c2)
+    else:
+        ph = w * (0.5 * T + (t - t0 - T))
+        ph1 = w
+        ph2 = 0.0
+    cs = math.cos(ph)
+    sn = math.sin(ph)
+    ax, ay, az = par[o + 2], par[o + 3], par[o + 4]
+    bx, by, bz = par[o + 5], par[o + 6], par[o + 7]
+    tx, ty, tz = -sn * ax + cs * bx, -sn * ay + cs * by, -sn * az + cs * bz  # the tangent
+    nx, ny, nz = cs * ax + sn * bx, cs * ay + sn * by, cs * az + sn * bz  # outward, from the centre
+    v = R * ph1
+    at = R * ph2
+    ac = R * ph1 * ph1
+    return (R * (nx - ax), R * (ny - ay), R * (nz - az), v * tx, v * ty, v * tz,
+            at * tx - ac * nx, at * ty - ac * ny, at * tz - ac * nz)
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _table(t, par):
+    """The held end on cubic splines through samples (as the planar
+    :func:`snapping.simulate.general.pin_kinematics`): the first piece's tangent before the
+    first sample, constant velocity after the last (at the last sample: the left limit)."""
+    o = int(par[P_AX])
+    n = int(par[o])
+    m = n - 1
+    t_first = par[o + 1]
+    t_last = par[o + n]
+    c0 = o + 1 + n
+    if t <= t_first:
+        x, vx, ax = _spline(par, n, c0, 0, 0.0)
+        y, vy, ay = _spline(par, n, c0 + 4 * m, 0, 0.0)
+        z, vz, az = _spline(par, n, c0 + 8 * m, 0, 0.0)
+        dt = t - t_first
+        if dt == 0.0:
+            return x, y, z, vx, vy, vz, ax, ay, az
+        return x + vx * dt, y + vy * dt, z + vz * dt, vx, vy, vz, 0.0, 0.0, 0.0
+    if t > t_last:
+        u = t_last - par[o + m]
+        x, vx, _ = _spline(par, n, c0, m - 1, u)
+        y, vy, _ = _spline(par, n, c0 + 4 * m, m - 1, u)
+        z, vz, _ = _spline(par, n, c0 + 8 * m, m - 1, u)
+        dt = t - t_last
+        return x + vx * dt, y + vy * dt, z + vz * dt, vx, vy, vz, 0.0, 0.0, 0.0
+    i = np.searchsorted(par[o + 1:o + 1 + n], t) - 1
+    if i < 0:
+        i = 0
+    u = t - par[o + 1 + i]
+    x, vx, ax = _spline(par, n, c0, i, u)
+    y, vy, ay = _spline(par, n, c0 + 4 * m, i, u)
+    z, vz, az = _spline(par, n, c0 + 8 * m, i, u)
+    return x, y, z, vx, vy, vz, ax, ay, az
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -127,6 +225,10 @@ def pin3d(t, par):
     kind = par[P_PIN]
     if kind == PIN_FIXED:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    if kind == PIN_CIRCLE:
+        return _circle(t, par)
+    if kind == PIN_TABLE:
+        return _table(t, par)
     ax = par[P_AX]
     ay = par[P_AY]
     az = par[P_AZ]

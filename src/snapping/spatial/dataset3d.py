@@ -39,7 +39,7 @@ from .. import schema
 from . import chain3d as C
 from .solve3d import RECORD_NAMES, run3d
 
-__all__ = ["run3d_dataset", "build_dataset3d", "nodes_at"]
+__all__ = ["run3d_dataset", "build_dataset3d", "nodes_at", "problem3d_from_dataset", "rerun3d"]
 
 #: record columns of run3d that go into the Dataset, and their names there (planar names
 #: where they mean the same, schema.SPATIAL_STEP_VARS otherwise)
@@ -64,6 +64,8 @@ def nodes_at(problem, t: float, y: np.ndarray):
     the tensions from the O(N) solve of :func:`snapping.spatial.chain3d.rhs3d`."""
     par, h, invm = problem.model()
     N = h.size
+    if t in C.breakpoints(par):  # (the acceleration from t on, the right limit, as the planar snapshots)
+        t = float(np.nextafter(t, np.inf))
     k = C.pin3d(float(t), par)
     r, v = C.state_to_nodes(y, h, pin=k[:6])
     w = C.Work(N)
@@ -122,6 +124,9 @@ def build_dataset3d(problem, res: dict, *, t_end=None, stop_fraction: float = 0.
     for c, (pn, vn) in enumerate((("start_x", "start_vx"), ("start_y", "start_vy"), ("start_z", "start_vz"))):
         data_vars[pn] = (schema.NODE_DIM, problem.r[:, c].copy(), _var(pn))
         data_vars[vn] = (schema.NODE_DIM, problem.v[:, c].copy(), _var(vn))
+    if problem.pin.kind == "table":
+        for name, arr in zip(("pin_table_t", "pin_table_x", "pin_table_y", "pin_table_z"), problem.pin.table):
+            data_vars[name] = (schema.PIN_TABLE_DIM, np.asarray(arr, dtype=float).copy(), _var(name))
     coords = {
         "t": (schema.STEP_DIM, col["t"].copy(), dict(schema.COORDS["t"])),
         "t_snapshot": (schema.SNAPSHOT_DIM, np.array([s[0] for s in snaps]), dict(schema.COORDS["t_snapshot"])),
@@ -144,9 +149,7 @@ def build_dataset3d(problem, res: dict, *, t_end=None, stop_fraction: float = 0.
         "snapshot_times": np.asarray([s[0] for s in snaps if s[1] == "requested"], dtype=float),
         "initial": "problem", "tip_mass": float(problem.links.tip_mass), "gravity": float(problem.gravity),
         "pin_motion": problem.pin.kind, "start": str(start.get("kind", "")),
-        "problem": json.dumps({"start": start, "pin": {"kind": problem.pin.kind, "accel": list(problem.pin.accel),
-                                                       "t0": problem.pin.t0, "duration": problem.pin.duration}},
-                              sort_keys=True, default=float),
+        "problem": json.dumps({"start": start, "pin": problem.pin.describe()}, sort_keys=True, default=float),
         # the 3D inputs
         "dims": 3, "g_dir": np.asarray(problem.g_dir, dtype=float), "normal": np.asarray(problem.normal, dtype=float),
         "perturbation": "" if pert is None else json.dumps(pert, sort_keys=True),
@@ -193,3 +196,38 @@ def run3d_dataset(problem, *, tol: float = 1e-8, t_end: float | None = None, sto
     if output is not None:
         save(ds, output, overwrite=True)
     return ds
+
+
+def problem3d_from_dataset(ds: xr.Dataset):
+    """The :class:`snapping.spatial.starts3d.Problem3D` a 3D run file was run for: its chain
+    (``link_length``, ``node_mass``, ``tip_mass``), start (``start_*``), held end (the
+    ``problem`` attribute's ``pin``, a table's samples ``pin_table_*``), gravity and planes."""
+    from ..simulate.links import Links
+    from .held3d import Pin3D
+    from .starts3d import Problem3D
+
+    if int(ds.attrs.get("dims", 2)) != 3 or "start_z" not in ds.variables:
+        raise V.SnappingInputError("ds is not a 3D run file (no attribute dims = 3 or no start_z)")
+    desc = json.loads(str(ds.attrs["problem"]))
+    pin_d = desc.get("pin", {"kind": "fixed"})
+    table = None
+    if pin_d.get("kind") == "table":
+        table = tuple(np.asarray(ds[f"pin_table_{c}"].values, dtype=float) for c in "txyz")
+    N = int(ds.attrs["N"])
+    links = Links(np.asarray(ds["link_length"].values, dtype=float), np.asarray(ds["node_mass"].values[:N], dtype=float),
+                  float(ds.attrs["tip_mass"]))
+    r = np.column_stack([np.asarray(ds[f"start_{c}"].values, dtype=float) for c in "xyz"])
+    v = np.column_stack([np.asarray(ds[f"start_v{c}"].values, dtype=float) for c in "xyz"])
+    return Problem3D(links, r, v, pin=Pin3D.from_description(pin_d, table), gravity=float(ds.attrs["gravity"]),
+                     g_dir=tuple(np.asarray(ds.attrs["g_dir"], dtype=float).tolist()),
+                     normal=tuple(np.asarray(ds.attrs["normal"], dtype=float).tolist()), start=desc.get("start", {}))
+
+
+def rerun3d(ds: xr.Dataset, *, snapshot_times=(), output=None, overwrite: bool = False) -> xr.Dataset:
+    """The 3D run of the file ``ds`` run again (same problem, tolerance and stop), with
+    ``snapshot_times``: the same steps, so the same peaks (``snapping animate --frames``)."""
+    problem = problem3d_from_dataset(ds)
+    t_end = float(ds.attrs.get("t_end", 0.0))
+    return run3d_dataset(problem, tol=float(ds.attrs["tol"]), t_end=t_end if t_end > 0.0 else None,
+                         stop_fraction=float(ds.attrs["stop_fraction"]), snapshot_times=snapshot_times, output=output,
+                         overwrite=overwrite)

@@ -33,6 +33,7 @@ import numpy as np
 from .. import _validate as V
 from ..simulate.links import Links
 from . import chain3d as C
+from .held3d import Pin3D, unit3
 
 __all__ = ["Problem3D", "Pin3D", "MODES"]
 
@@ -44,63 +45,9 @@ RANDOM_MODES = 8
 KINDS = ("velocity", "shape")
 #: relative tolerance of a start's link lengths against the chain's, and of a unit direction's length
 SHAPE_RTOL = 1e-6
-UNIT_RTOL = 1e-9
-_PIN_KINDS = {"fixed": C.PIN_FIXED, "pull": C.PIN_PULL, "flick": C.PIN_FLICK}
 
 
-def _vec3(name: str, v) -> np.ndarray:
-    a = np.asarray(V.float_array(name, v), dtype=float).ravel()
-    if a.size != 3 or not np.all(np.isfinite(a)):
-        raise V.SnappingInputError(f"{name}={v!r} must be 3 finite numbers")
-    return a
-
-
-def _unit(name: str, v) -> np.ndarray:
-    a = _vec3(name, v)
-    n = float(np.linalg.norm(a))
-    if not abs(n - 1.0) <= UNIT_RTOL:
-        raise V.SnappingInputError(f"{name}={tuple(a.tolist())!r} has length {n:.6g}: it must be a unit vector "
-                                   f"(length 1 to within {UNIT_RTOL:g})")
-    return a
-
-
-@dataclass(frozen=True)
-class Pin3D:
-    """The held end's motion in space: ``fixed``, ``pull`` (acceleration ``accel`` from ``t0``
-    for ``duration``, then constant velocity) or ``flick`` (``accel sin(2 pi (t - t0)/duration)``
-    for one period). Starts at the origin, at rest."""
-
-    kind: str = "fixed"
-    accel: tuple = (0.0, 0.0, 0.0)
-    t0: float = 0.0
-    duration: float = math.inf
-
-    def __post_init__(self):
-        if self.kind not in _PIN_KINDS:
-            raise V.SnappingInputError(f"kind={self.kind!r} is not one of {tuple(_PIN_KINDS)}")
-        object.__setattr__(self, "accel", tuple(_vec3("accel", self.accel).tolist()))
-        t0 = V.real("t0", self.t0)
-        if not (math.isfinite(t0) and t0 >= 0.0):
-            raise V.SnappingInputError(f"t0={t0!r} is out of range: must be finite and >= 0")
-        d = float(self.duration) if self.duration == math.inf else V.real("duration", self.duration)
-        if not d > 0.0 or (self.kind == "flick" and not math.isfinite(d)):
-            raise V.SnappingInputError(f"duration={d!r} is out of range: must be > 0 (finite for a flick)")
-
-    def model_args(self) -> tuple:
-        return (_PIN_KINDS[self.kind], self.accel, float(self.t0), float(self.duration))
-
-    def kinematics(self, t: float) -> tuple:
-        """(x, y, z, vx, vy, vz, ax, ay, az) at t (the compiled :func:`snapping.spatial.chain3d.pin3d`)."""
-        par = C.make_model([1.0], [1.0], pin=self.model_args())[0]
-        return C.pin3d(float(t), par)
-
-    @classmethod
-    def from_planar(cls, pin) -> "Pin3D":
-        """The planar :class:`snapping.simulate.pin.PinMotion` in the plane z = 0 (not a table)."""
-        if pin.kind == "table":
-            raise V.SnappingInputError("pin: a sampled (table) motion has no 3D form yet; use fixed, pull or flick")
-        ax, ay = pin.accel
-        return cls(pin.kind, (ax, ay, 0.0), pin.t0, pin.duration)
+_unit = unit3
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,8 +94,10 @@ class Problem3D:
             j = int(np.argmax(rel))
             raise V.SnappingInputError(f"r: link {j} has length {lens[j]:.9g} but the chain's link is "
                                        f"{self.links.h[j]:.9g} (relative difference {rel[j]:.3g} > {SHAPE_RTOL:g})")
-        if np.any(v[N] != 0.0):
-            raise V.SnappingInputError(f"v: the held end (node {N}) starts at rest; got {v[N].tolist()}")
+        vp = np.asarray(self.pin.velocity(0.0))
+        if np.abs(v[N] - vp).max() > 1e-12 * max(1.0, float(np.abs(vp).max())):
+            raise V.SnappingInputError(f"v: the held end (node {N}) must move as the pin at t = 0, {vp.tolist()}; got "
+                                       f"{v[N].tolist()} (Problem3D.with_pin carries a start with a moving pin)")
         stretch = np.abs(np.sum(d * np.diff(v, axis=0), axis=1)) / lens
         if stretch.max() > 1e-9 * max(1.0, float(np.abs(v).max())):
             j = int(np.argmax(stretch))
@@ -236,6 +185,7 @@ class Problem3D:
             dv -= np.sum(dv * d, axis=1)[:, None] * d
             v = np.zeros_like(self.v)
             v[:-1] = -np.cumsum(dv[::-1], axis=0)[::-1]
+            v += self.v[-1]  # (the held end's own velocity, the pin's at t = 0)
         pert = {"eps": e, "mode": mode, "seed": seed, "kind": kind}
         if mode == "sin":
             pert["k"] = kk
@@ -295,7 +245,58 @@ class Problem3D:
             raise V.SnappingInputError(f"r must have 3 columns (x, y, z) and at least 2 rows; got shape {r.shape}")
         if links is None:
             links = Links.uniform(r.shape[0] - 1)
-        return cls(links, r, np.zeros_like(r) if v is None else v, **kw)
+        if r.shape[0] != links.N + 1:
+            raise V.SnappingInputError(f"r has {r.shape[0]} nodes but the chain has {links.N} links ({links.N + 1} "
+                                       f"nodes)")
+        from .shape3d import check_no_crossing
+
+        check_no_crossing(r, name="r")
+        if v is None:  # (at rest, or moving with the held end)
+            v = np.zeros_like(r) + np.asarray(kw.get("pin", Pin3D()).velocity(0.0))[None, :]
+        return cls(links, r, v, **kw)
+
+    def with_pin(self, pin: Pin3D) -> "Problem3D":
+        """This start with the held end moving as ``pin``: every node's velocity changed by the
+        difference of the two motions' velocities at t = 0 (a Galilean shift: the motion
+        relative to the held end is kept; nothing changes for motions that start at rest)."""
+        if not isinstance(pin, Pin3D):
+            raise V.SnappingInputError(f"pin={type(pin).__name__} is not a Pin3D")
+        dv = np.asarray(pin.velocity(0.0)) - np.asarray(self.pin.velocity(0.0))
+        return replace(self, pin=pin, v=self.v + dv[None, :])
+
+    @classmethod
+    def hanging(cls, N: int | None = None, *, links: Links | None = None, **kw) -> "Problem3D":
+        """The chain hanging straight down (along +y) from its held end, at rest."""
+        links = Links.uniform(V.integer("N", N, 1)) if links is None else links
+        s = np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]])
+        r = np.column_stack([np.zeros_like(s), s, np.zeros_like(s)])
+        return cls(links, r, np.zeros_like(r), start={"kind": "hanging"}, **kw)
+
+    @classmethod
+    def spun_up(cls, omega: float, N: int | None = None, *, radius: float = 0.05, ramp: float = 2.0,
+                links: Links | None = None, gravity: float = 1.0) -> "Problem3D":
+        """The whirl spun up: the chain hanging straight at rest, its held end driven around a
+        horizontal circle of ``radius`` about the vertical (:meth:`Pin3D.circle`), the rate
+        ramped from 0 to ``omega`` over ``ramp`` (continuous acceleration). No damping: the
+        chain swings about the whirling shape of :meth:`whirling` rather than settling on it."""
+        p = cls.hanging(N, links=links, gravity=gravity)
+        p = p.with_pin(Pin3D.circle(radius, omega, ramp))
+        return replace(p, start={"kind": "spun_up", "omega": float(omega), "radius": float(radius),
+                                 "ramp": float(ramp)})
+
+    @classmethod
+    def curve(cls, points, N: int | None = None, *, links: Links | None = None, name: str = "curve",
+              **kw) -> "Problem3D":
+        """Nodes at chords exactly ``h_j`` along a curve in space: ``points`` ((n, 3), listed from
+        the held end at the origin), interpolated by cubic splines on the cumulative chord
+        length (:func:`snapping.spatial.shape3d.place_on_curve3d`); refused when the curve is
+        too short for the chain or the placed chain crosses itself."""
+        from .shape3d import check_no_crossing, place_on_curve3d
+
+        links = Links.uniform(V.integer("N", N, 1)) if links is None else links
+        r = place_on_curve3d(points, links.h, name=name)
+        check_no_crossing(r, name=name)
+        return cls(links, r, np.zeros_like(r), start={"kind": "curve", "name": str(name)}, **kw)
 
     # -- the compiled form
     def model(self):
