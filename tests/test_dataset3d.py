@@ -140,7 +140,6 @@ def test_cli_whirl_runs_the_steady_shape(tmp_path, capsys):
     (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--bending", "1e-3"], "no 3D form"),
     (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--dims", "2"], "--dims 2"),
     (["--whirl", "2.5", "--N", "10", "--chi", "0.3"], "--whirl"),
-    (["--dims", "3", "--chi", "0.25", "--N", "10", "--length", "2", "--mass", "0.1"], "--length/--mass"),
     (["--dims", "3", "--chi", "0.25", "--N", "10", "--method", "euler-richardson"], "--method"),
 ])
 def test_cli_3d_bad_input_is_one_line_exit_2(argv, word, capsys):

@@ -97,6 +97,10 @@ def _problem3d(args):
 
         if args.chi is not None or args.supports is not None:
             raise SnappingInputError("--shape is the start: give no --chi/--supports with it")
+        from ._body import body_from_args
+
+        if body_from_args(args) is not None:
+            raise SnappingInputError("a body (bending, drag) has no 3D form yet (with a 3D --shape)")
         problem = Problem3D.curve(read_shape3d(args.shape), links=chain_links(), name=str(args.shape),
                                   gravity=args.gravity, **kw)
         return problem.with_pin(pin)

@@ -220,7 +220,11 @@ class Pin3D:
         return (_CODES[self.kind], self.accel, float(self.t0), float(self.duration), data)
 
     def _par(self):
-        return C.make_model([1.0], [1.0], pin=self.model_args())[0]
+        par = self.__dict__.get("_par_cache")
+        if par is None:  # (built once: a table's splines)
+            par = C.make_model([1.0], [1.0], pin=self.model_args())[0]
+            object.__setattr__(self, "_par_cache", par)
+        return par
 
     @property
     def breakpoints(self) -> list[float]:
@@ -301,7 +305,7 @@ def _checked_table(t, x, y, z):
     for name, a in arrs.items():
         if not np.all(np.isfinite(a)):
             i = int(np.flatnonzero(~np.isfinite(a))[0])
-            raise V.SnappingInputError(f"pin motion {name}[{i}]={a[i]!r} is not finite")
+            raise V.SnappingInputError(f"pin motion {name}[{i}]={float(a[i])!r} is not finite")
         hi = T_MAX if name == "t" else POSITION_MAX
         if np.abs(a).max() > hi:
             i = int(np.argmax(np.abs(a)))
