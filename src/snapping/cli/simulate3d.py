@@ -45,8 +45,15 @@ _ONLY_3D = ("perturb", "whirl", "spin_up", "g_dir", "pin_axis")
 
 def wants_3d(args) -> bool:
     spec = str(getattr(args, "pin_motion", None) or "")
-    return (args.dims == 3 or any(getattr(args, k, None) is not None for k in _ONLY_3D)
-            or spec.split(":")[0].strip() in ("pull3d", "flick3d", "circle", "table"))
+    if args.dims == 3 or any(getattr(args, k, None) is not None for k in _ONLY_3D):
+        return True
+    if spec.split(":")[0].strip() in ("pull3d", "flick3d", "circle", "table"):
+        return True
+    if getattr(args, "shape", None) is not None and args.dims != 2:  # (a curve in space: x, y, z columns)
+        from ..spatial.shape3d import is_3d_shape
+
+        return is_3d_shape(args.shape)
+    return False
 
 
 #: planar-only options, refused with a 3D run (name, value that means 'not given')

@@ -34,12 +34,35 @@ from scipy.optimize import brentq
 
 from .. import _validate as V
 
-__all__ = ["read_shape3d", "place_on_curve3d", "check_no_crossing", "CROSS_RTOL"]
+__all__ = ["read_shape3d", "place_on_curve3d", "check_no_crossing", "is_3d_shape", "CROSS_RTOL"]
 
 #: two links that are not neighbours closer than this fraction of the shortest link: the curve crosses itself
 CROSS_RTOL = 1e-6
 #: how far a polyline is extended along its end tangent, as a fraction of its length
 EXTRAPOLATION = 0.01
+
+
+def is_3d_shape(path) -> bool:
+    """Whether the shape file ``path`` holds a curve in space (a CSV of 3 columns, a netCDF
+    file with ``z``): what makes ``snapping simulate --shape`` a 3D run. False when it
+    cannot be read (the reader of the run says why)."""
+    import os
+
+    try:
+        if str(path).endswith((".nc", ".nc4", ".cdf")):
+            from ..simulate._netcdf import open_netcdf
+
+            return "z" in open_netcdf(str(path)).variables
+        if not os.path.isfile(path):
+            return False
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                line = line.split("#")[0].strip()
+                if line:
+                    return len(line.split(",")) == 3
+    except Exception:  # noqa: BLE001 - unreadable: the planar reader names the problem
+        return False
+    return False
 
 
 def read_shape3d(path) -> np.ndarray:
