@@ -102,3 +102,22 @@ def test_cli_bad_3d_shape_is_one_line_exit_2(tmp_path, capsys, pts, word):
     assert main(["simulate", "--shape", f, "--dims", "3", "--N", "20", "--t-end", "0.01"]) == 2
     err = capsys.readouterr().err.strip()
     assert word in err and len(err.splitlines()) == 1
+
+
+def test_segment_distance_against_dense_sampling():
+    """The closest distance of two segments (clamped cases included) against the minimum
+    over a dense grid of points on both, refined by the grid's spacing."""
+    from snapping.spatial.shape3d import _segment_distance
+
+    rng = np.random.default_rng(7)
+    u = np.linspace(0.0, 1.0, 801)
+    for _ in range(40):
+        p0, p1, q0, q1 = rng.standard_normal((4, 3))
+        if _ % 4 == 0:
+            q1 = q0 + 0.3 * (p1 - p0)  # (parallel segments: the degenerate branch)
+        P = p0 + u[:, None] * (p1 - p0)
+        Q = q0 + u[:, None] * (q1 - q0)
+        dense = np.sqrt(((P[:, None, :] - Q[None, :, :]) ** 2).sum(-1)).min()
+        d = _segment_distance(p0, p1, q0, q1)
+        assert d <= dense + 1e-12
+        assert dense - d <= 0.5 * (np.linalg.norm(p1 - p0) + np.linalg.norm(q1 - q0)) / 800 + 1e-12

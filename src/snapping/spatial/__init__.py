@@ -4,7 +4,11 @@
   cosines between neighbouring links), the compiled right-hand side and diagnostics;
 * :mod:`snapping.spatial.solve3d`: compiled DOP853 stepping with dense-output peaks, to the snap;
 * :mod:`snapping.spatial.starts3d`: :class:`Problem3D`, planar starts in space and the
-  out-of-plane perturbations only 3D has;
+  out-of-plane perturbations only 3D has, the whirling start (steady or spun up), any curve;
+* :mod:`snapping.spatial.held3d`: :class:`Pin3D`, the held end's motion in space (pull,
+  flick, a circle, sampled points of any curve);
+* :mod:`snapping.spatial.shape3d`: start curves in space (files of x, y, z; exact chords;
+  a start that crosses itself refused);
 * :mod:`snapping.spatial.dataset3d`: the run Dataset of a 3D run (the planar names, and
   ``z``, ``vz``, ``z_amp``, ... of ``snapping.schema.SPATIAL_VARS``);
 * :mod:`snapping.spatial.figures3d`: the out-of-plane amplitude against eps, the chain in space.
@@ -16,6 +20,7 @@ planar simulator does not import it.
 """
 
 from .solve3d import run3d
-from .starts3d import Pin3D, Problem3D
+from .held3d import Pin3D
+from .starts3d import Problem3D
 
 __all__ = ["run3d", "Problem3D", "Pin3D"]

@@ -35,7 +35,7 @@ from ..simulate.links import Links
 from . import chain3d as C
 from .held3d import Pin3D, unit3
 
-__all__ = ["Problem3D", "Pin3D", "MODES"]
+__all__ = ["Problem3D", "MODES"]  # (Pin3D: snapping.spatial.held3d, importable here too)
 
 #: perturbation modes of :meth:`Problem3D.perturbed`
 MODES = ("sin", "random", "modes")
