@@ -426,7 +426,7 @@ def _cli_cases():
     add("nosuchcommand")
     # #25 section 3: silently accepted or dropped before
     add("simulate", "--shape", "{shape_text_row}", "--N", "4", "--method", "fast", "--t-end", "0.01")
-    add("simulate", "--shape", "{shape_three_columns}", "--N", "4", "--method", "fast", "--t-end", "0.01")
+    add("simulate", "--shape", "{shape_three_columns}", "--dims", "2", "--N", "4", "--method", "fast", "--t-end", "0.01")
     add("simulate", "--supports", "0.4,0.2", "--N", "6", "--chords", "arclength", "--t-end", "0.01")
     add("simulate", "--chi", "0.5", "--N", "6", "--t-end", "0.01", "--snapshot-times", "0.5", "-o", "{root}/new.nc")
     add("design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--plot", "")

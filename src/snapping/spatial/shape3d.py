@@ -49,12 +49,12 @@ def is_3d_shape(path) -> bool:
     import os
 
     try:
+        if not os.path.isfile(path):  # (a directory, a FIFO, a device: never opened here)
+            return False
         if str(path).endswith((".nc", ".nc4", ".cdf")):
             from ..simulate._netcdf import open_netcdf
 
             return "z" in open_netcdf(str(path)).variables
-        if not os.path.isfile(path):
-            return False
         with open(path, encoding="utf-8", errors="replace") as f:
             for line in f:
                 line = line.split("#")[0].strip()
