@@ -19,6 +19,7 @@ Usage::
     python benchmarks/bench_chain3d.py --parts growth --N 100,200,400 --chi 0.25,0.1
     python benchmarks/bench_chain3d.py --parts growth --N 200 --chi 0.25 --mode random --seed 1
     python benchmarks/bench_chain3d.py --parts cost,big --tol 1e-8
+    python benchmarks/bench_chain3d.py --parts profile          # where a 3D step's time goes
 """
 
 from __future__ import annotations
@@ -116,6 +117,38 @@ def cost(N, chi, tol, eps=1e-4):
           f"stepping {(rc / r['n_rhs']) / (pc / pn):.2f}x", flush=True)
 
 
+def profile(N, chi, tol, eps=1e-4):
+    """Where a 3D step's time goes at N links (least CPU time of each part, one step's worth):
+    the 12 evaluations of an attempted step against the stage arithmetic, the end state, the
+    error norm, the per-step measurements and the projection, all O(6N + 1) in the state."""
+    from snapping.simulate import rk as R
+    from snapping.spatial import Problem3D
+    from snapping.spatial import chain3d as C
+    from snapping.spatial import solve3d as S
+
+    p3 = Problem3D.catenary(chi, N).perturbed(eps)
+    par, h, invm = p3.model()
+    y0 = p3.initial_state()
+    n = y0.size
+    K = np.random.default_rng(0).random((R.NSX, n))
+    ytmp, y1, w = np.zeros(n), np.zeros(n), C.Work(N)
+    meas, snode = np.zeros(C.NMEAS), np.zeros(N + 1)
+
+    def stages():
+        for st in range(1, R.NS):
+            R._stage_state(n, st, 0.01, y0, K, ytmp)
+
+    best = _time_calls({
+        "12 evaluations": lambda: [C.rhs3d(N, 0.0, y0, K[1], w.T, w.cp, w.dp, par, h, invm) for _ in range(R.NS)],
+        "stage states": stages, "end state": lambda: R.end_state(n, 0.01, y0, K, y1),
+        "error norm": lambda: S.step_error3d(N, 0.01, tol, y0, y0, K, ytmp),
+        "measurements": lambda: C.measure3d(N, 0.0, y0, w.T, meas, snode, par, h, invm),
+        "projection": lambda: C.project(N, y0.copy())}, n=30, rounds=10)
+    tot = sum(best.values())
+    print(f"# one attempted 3D step at N={N} (state {n}; least CPU time, {_load()}): "
+          + ", ".join(f"{k} {v * 1e6:.1f} us ({v / tot:.0%})" for k, v in best.items()))
+
+
 def big(N, chi, tol, eps=1e-4):
     from snapping.spatial import Problem3D, run3d
 
@@ -153,6 +186,8 @@ def main(argv=None):
                [float(e) for e in a.eps.split(",")], a.tol, a.mode, a.seed)
     if "cost" in parts:
         cost(a.cost_N, 0.25, a.cost_tol)
+    if "profile" in parts:
+        profile(a.cost_N, 0.25, a.cost_tol)
     if "big" in parts:
         big(a.big_N, 0.25, a.cost_tol)
 
