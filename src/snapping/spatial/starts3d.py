@@ -5,7 +5,10 @@ held end at the origin), the chain (:class:`snapping.simulate.links.Links`: link
 and lumped node masses, tip mass), the held end's motion (:class:`Pin3D`), gravity (a
 magnitude and a unit direction, default ``(0, 1, 0)``: ``y`` downward as in the planar
 problems) and the normal of the reference plane whose out-of-plane amplitude is measured
-(default ``(0, 0, 1)``).
+(default ``(0, 0, 1)``), and what the line is made of (``body``: a
+:class:`snapping.simulate.Body`: bending stiffness, Kelvin-Voigt bending damping, quadratic
+and linear drag, a 3D wind, tip drag; :mod:`snapping.spatial.forces3d`; no clamped held end
+yet, and a natural curvature only in a planar problem).
 
 Starts: any planar :class:`snapping.simulate.problem.Problem` placed in the plane z = 0
 (:meth:`Problem3D.from_planar`), the paper's catenary (:meth:`Problem3D.catenary`), node
@@ -116,6 +119,7 @@ class Problem3D:
     g_dir: tuple = (0.0, 1.0, 0.0)
     normal: tuple = (0.0, 0.0, 1.0)
     start: dict = field(default_factory=dict)
+    body: object = None
 
     def __post_init__(self):
         if not isinstance(self.links, Links):
@@ -154,6 +158,40 @@ class Problem3D:
             j = int(np.argmax(stretch))
             raise V.SnappingInputError(f"v: the initial velocities stretch link {j} at the rate {stretch[j]:.3g}: "
                                        f"they must keep every link's length")
+        self._check_body()
+
+    def _check_body(self) -> None:
+        """A body in space: its profiles against the chain; no clamp (refused); a natural
+        curvature only when the whole problem lies in the reference plane."""
+        from ..simulate.body import Body
+
+        b = self.body
+        if b is None:
+            return
+        if not isinstance(b, Body):
+            raise V.SnappingInputError(f"body={type(b).__name__} is not a snapping.simulate.Body")
+        b.check(self.links.h, dims=3)
+        if b.clamp is not None:
+            raise V.SnappingInputError(f"clamp={b.clamp!r}: a clamped held end has no 3D form yet (it would hold the "
+                                       f"line's direction in space, and with a twisting rope its frame); use a hinged "
+                                       f"held end (clamp=None) or the planar method")
+        if not np.all(b.node_values("curvature", self.links.h) == 0.0):
+            n = np.asarray(self.normal)
+            wind = np.zeros(3)
+            wind[:len(b.wind)] = b.wind
+            off = {"r": float(np.abs(self.r @ n).max()), "v": float(np.abs(self.v @ n).max()),
+                   "g_dir": abs(float(np.asarray(self.g_dir) @ n)), "pin accel": abs(float(np.asarray(self.pin.accel) @ n)),
+                   "wind": abs(float(wind @ n))}
+            bad = [k for k, x in off.items() if x != 0.0]
+            if bad:
+                raise V.SnappingInputError(f"curvature: a natural curvature in space needs a material frame to curl in "
+                                           f"(a chain has none; a twisting rope would): it is accepted only in a planar "
+                                           f"problem, but {', '.join(bad)} leave the plane normal to {tuple(n.tolist())}")
+
+    @property
+    def body_active(self) -> bool:
+        """Whether the run has body forces (a body that changes nothing is solved as none)."""
+        return self.body is not None and self.body.active
 
     @property
     def N(self) -> int:
@@ -163,9 +201,9 @@ class Problem3D:
     @classmethod
     def from_planar(cls, problem, **kw) -> "Problem3D":
         """A planar :class:`snapping.simulate.problem.Problem` in the plane z = 0 (same chain,
-        nodes, velocities, held end and gravity; no body)."""
+        nodes, velocities, held end, gravity and body)."""
         if problem.body is not None:
-            raise V.SnappingInputError("problem: a body (bending, drag) has no 3D form yet")
+            kw.setdefault("body", problem.body)
         N = problem.N
         r = np.column_stack([problem.x, problem.y, np.zeros(N + 1)])
         v = np.column_stack([problem.vx, problem.vy, np.zeros(N + 1)])
@@ -301,8 +339,16 @@ class Problem3D:
     def model(self):
         """The model tuple ``(par, h, invm)`` of :mod:`snapping.spatial.chain3d`."""
         g = self.gravity * np.asarray(self.g_dir)
-        return C.make_model(self.links.h, 1.0 / self.links.m, g=g, pin=self.pin.model_args(), normal=self.normal)
+        body = None
+        if self.body_active:
+            b = self.body
+            body = {"arrays": b.node_arrays(self.links.h), "wind": b.wind, "tip_drag": b.tip_drag,
+                    "signed": not np.all(b.node_values("curvature", self.links.h) == 0.0)}
+        return C.make_model(self.links.h, 1.0 / self.links.m, g=g, pin=self.pin.model_args(), normal=self.normal,
+                            body=body)
 
     def initial_state(self) -> np.ndarray:
-        """``[e, u, W = 0]`` of the start (:func:`snapping.spatial.chain3d.nodes_to_state`)."""
-        return C.nodes_to_state(self.r, self.v, self.links.h)
+        """``[e, u, W = 0]`` of the start (:func:`snapping.spatial.chain3d.nodes_to_state`), and
+        ``D = 0`` (the energy dissipated) with a body."""
+        y = C.nodes_to_state(self.r, self.v, self.links.h)
+        return np.append(y, 0.0) if self.body_active else y
