@@ -275,3 +275,28 @@ def test_body_run_dataset_has_the_planar_body_names():
     assert '"wind": [0.0, 0.0, 0.2]' in ds.attrs["body"]
     bal = ds["energy"] - ds["pin_work"] + ds["dissipated"]
     assert float(abs(bal - bal[0]).max()) < 1e-7
+
+
+def test_a_stiff_3d_run_warns_and_a_hopeless_one_is_refused_before_any_work():
+    from snapping.simulate.stiffness import CostWarning, shortest_wave
+    from snapping.spatial.stiffness3d import check_cost3d, shortest_wave3d
+
+    planar = Problem.catenary(0.25, 40, body=Body(1e7, damping=1e-6))
+    assert shortest_wave3d(Problem3D.from_planar(planar)) == shortest_wave(planar.model())  # (the planar wave)
+    with pytest.warns(CostWarning, match="no stiff method in space"):
+        check_cost3d(Problem3D.from_planar(planar))  # (omega_max ~ 4 N^2 sqrt(beta) = 2e7: ~4e6 steps to t = 1.2)
+    with pytest.raises(SnappingInputError, match="refused above"):
+        run3d(Problem3D.catenary(0.25, 400, body=Body(1e8)))
+    check_cost3d(Problem3D.from_planar(planar), t_end=1e-3)  # (a short run is not warned about)
+
+
+def test_cli_runs_a_3d_body_with_a_3d_wind(capsys):
+    from snapping.cli import main
+
+    argv = ["simulate", "--dims", "3", "--chi", "0.3", "--N", "10", "--bending", "1e-3", "--drag-normal", "0.5",
+            "--wind", "0.1,0,0.3", "--t-end", "0.4", "--json"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert '"wind": [' in out and '"dissipated"' in out
+    assert main(["simulate", "--chi", "0.3", "--N", "10", "--drag-normal", "0.5", "--wind", "0.1,0,0.3"]) == 2
+    assert "out of the plane" in capsys.readouterr().err

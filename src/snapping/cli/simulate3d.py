@@ -57,6 +57,9 @@ def cmd_simulate3d(args, times) -> int:
         raise SnappingInputError(f"--method {args.method}: a 3D run is stepped by DOP853 (fast or dop853)")
     if args.N is None:
         raise SnappingInputError("the argument --N is required")
+    from ._body import body_from_args
+
+    body = body_from_args(args)  # (bending, damping, drag, a 3D wind: snapping.spatial.forces3d)
     if args.whirl is not None:
         if args.chi is not None or args.supports is not None or args.shape is not None:
             raise SnappingInputError("--whirl starts from the steady whirling shape: give no --chi/--supports/--shape")
@@ -68,11 +71,11 @@ def cmd_simulate3d(args, times) -> int:
         given = from_options(chi=0.5, N=args.N, tip_mass=args.tip_mass, lumping=args.lumping,
                              taper=None if args.taper is None else _taper(args), links=line_links(args))
         links = Links.uniform(args.N) if given is None else given.links
-        problem = Problem3D.whirling(args.whirl, args.N, links=links, gravity=args.gravity)
+        problem = Problem3D.whirling(args.whirl, args.N, links=links, gravity=args.gravity, body=body)
     else:
         if args.chi is None and args.supports is None and args.shape is None:
             raise SnappingInputError("the arguments --chi (or --supports/--shape, or --whirl) and --N are required")
-        from ._body import attach_body, body_from_args, line_links
+        from ._body import attach_body, line_links
         from ._common import _numbers
         from ..simulate.problem import from_options
 
@@ -85,10 +88,9 @@ def cmd_simulate3d(args, times) -> int:
             from ..simulate.problem import Problem
 
             planar = Problem.catenary(args.chi, args.N, chords=args.chords)
-        body = body_from_args(args)
-        if body is not None:
-            planar = attach_body(planar, body, args)
-        problem = Problem3D.from_planar(planar)
+        if body is not None:  # (the planar problem places the start; the body in space keeps its 3D wind)
+            planar = attach_body(planar, _planar_body(body), args)
+        problem = Problem3D.from_planar(planar, body=body if body is None or body.clamp is None else planar.body)
     if args.perturb is not None:
         problem = problem.perturbed(args.perturb, args.perturb_mode, seed=args.seed, k=args.perturb_k,
                                     kind=args.perturb_kind)
@@ -98,6 +100,11 @@ def cmd_simulate3d(args, times) -> int:
     summary = {k: ds.attrs[k] for k in _KEYS}
     summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
     summary["dims"] = 3
+    if problem.body_active:
+        from ..simulate.body import summarize
+
+        summary["body"] = summarize(ds.attrs["body"])
+        summary["dissipated"] = float(ds["dissipated"].values[-1])
     if args.output:
         summary["output"] = args.output
     if args.json:
@@ -112,6 +119,15 @@ def cmd_simulate3d(args, times) -> int:
         print(f"snapping simulate: error: the 3D run failed: {summary['stop_reason']}", file=sys.stderr)
         return 1
     return 0
+
+
+def _planar_body(body):
+    """The body with its wind in the plane (what the planar problem that places the start takes)."""
+    if len(body.wind) == 2:
+        return body
+    from ..simulate import Body
+
+    return Body.from_describe({**body.describe(), "wind": list(body.wind[:2])})
 
 
 def _taper(args):

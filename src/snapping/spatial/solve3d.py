@@ -462,6 +462,9 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     if not 0.0 <= stop_fraction < 1.0:
         raise SnappingInputError(f"stop_fraction={stop_fraction!r} is out of range: must lie in [0, 1)")
     auto = t_end is None
+    from .stiffness3d import check_cost3d
+
+    check_cost3d(problem, None if auto else t_end)  # (a body's bending: CostWarning, or refused, before any work)
     st = Stepper3D(problem.model(), problem.initial_state(), tol=float(tol),
                    t_end=t_end_max if auto else float(t_end), stop_fraction=stop_fraction if auto else 0.0,
                    reeval=reeval, max_link_error=max_link_error)
