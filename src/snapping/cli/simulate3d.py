@@ -42,6 +42,7 @@ def cmd_simulate3d(args, times) -> int:
     from .._validate import SnappingInputError
     from ..spatial import Problem3D
     from ..spatial.dataset3d import run3d_dataset
+    from ..spatial.starts3d import planar_body
 
     if args.dims == 2:
         raise SnappingInputError("--dims 2 with --perturb or --whirl: an out-of-plane perturbation or a whirl is 3D; "
@@ -89,7 +90,7 @@ def cmd_simulate3d(args, times) -> int:
 
             planar = Problem.catenary(args.chi, args.N, chords=args.chords)
         if body is not None:  # (the planar problem places the start; the body in space keeps its 3D wind)
-            planar = attach_body(planar, _planar_body(body), args)
+            planar = attach_body(planar, planar_body(body), args)
         problem = Problem3D.from_planar(planar, body=body if body is None or body.clamp is None else planar.body)
     if args.perturb is not None:
         problem = problem.perturbed(args.perturb, args.perturb_mode, seed=args.seed, k=args.perturb_k,
@@ -119,15 +120,6 @@ def cmd_simulate3d(args, times) -> int:
         print(f"snapping simulate: error: the 3D run failed: {summary['stop_reason']}", file=sys.stderr)
         return 1
     return 0
-
-
-def _planar_body(body):
-    """The body with its wind in the plane (what the planar problem that places the start takes)."""
-    if len(body.wind) == 2:
-        return body
-    from ..simulate import Body
-
-    return Body.from_describe({**body.describe(), "wind": list(body.wind[:2])})
 
 
 def _taper(args):

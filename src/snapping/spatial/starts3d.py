@@ -37,7 +37,7 @@ from .. import _validate as V
 from ..simulate.links import Links
 from . import chain3d as C
 
-__all__ = ["Problem3D", "Pin3D", "MODES"]
+__all__ = ["Problem3D", "Pin3D", "MODES", "planar_body"]
 
 #: perturbation modes of :meth:`Problem3D.perturbed`
 MODES = ("sin", "random", "modes")
@@ -104,6 +104,16 @@ class Pin3D:
             raise V.SnappingInputError("pin: a sampled (table) motion has no 3D form yet; use fixed, pull or flick")
         ax, ay = pin.accel
         return cls(pin.kind, (ax, ay, 0.0), pin.t0, pin.duration)
+
+
+def planar_body(body):
+    """``body`` with its wind in the plane (what a planar problem that places a 3D start takes;
+    the 3D problem keeps the body as given); None stays None."""
+    if body is None or len(body.wind) == 2:
+        return body
+    from ..simulate.body import Body
+
+    return Body.from_describe({**body.describe(), "wind": list(body.wind[:2])})
 
 
 @dataclass(frozen=True, eq=False)
@@ -213,10 +223,13 @@ class Problem3D:
     @classmethod
     def catenary(cls, chi: float, N: int | None = None, **kw) -> "Problem3D":
         """The planar catenary start (:meth:`snapping.simulate.problem.Problem.catenary`, same
-        keywords: ``links``, ``chords``, ``pin``, ``gravity``) in the plane z = 0."""
+        keywords: ``links``, ``chords``, ``pin``, ``gravity``, ``body``: a body with bending
+        starts from its rest shape, as in the plane; its wind may blow out of the plane) in the
+        plane z = 0."""
         from ..simulate.problem import Problem
 
-        return cls.from_planar(Problem.catenary(chi, N, **kw))
+        body = kw.pop("body", None)
+        return cls.from_planar(Problem.catenary(chi, N, body=planar_body(body), **kw), body=body)
 
     def perturbed(self, eps: float, mode: str = "sin", *, seed: int | None = None, k: int = 1,
                   kind: str = "velocity") -> "Problem3D":
