@@ -381,7 +381,7 @@ def test_energy_balance_of_a_run_with_bending_damping_drag_wind_and_a_moving_cla
     ({"drag_linear_normal": -1.0}, "drag_linear_normal="), ({"drag_linear_tangential": math.nan},
                                                               "drag_linear_tangential="),
     ({"curvature": math.nan}, "curvature="), ({"tip_drag": -0.1}, "tip_drag="), ({"wind": 1.0}, "wind="),
-    ({"wind": (1.0, 2.0, 3.0)}, "wind="), ({"wind": (math.nan, 0.0)}, "wind="), ({"clamp": 0.3}, "clamp="),
+    ({"wind": (1.0, 2.0, 3.0, 4.0)}, "wind="), ({"wind": (math.nan, 0.0)}, "wind="), ({"clamp": 0.3}, "clamp="),
     ({"bending": 1e-3, "clamp": math.inf}, "clamp="), ({"bending": 1e-3, "clamp": ([0.5, 1.0], [0.0, 0.1])}, "clamp"),
     ({"bending": [[1.0]]}, "bending"),
 ])

@@ -137,7 +137,7 @@ def test_cli_whirl_runs_the_steady_shape(tmp_path, capsys):
     (["--chi", "0.25", "--N", "10", "--perturb", "nan"], "eps=nan"),
     (["--chi", "0.25", "--N", "10", "--perturb", "inf", "--perturb-mode", "random", "--seed", "1"], "eps=inf"),
     (["--whirl", "0.5", "--N", "10"], "omega=0.5 has no steady whirling shape"),
-    (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--bending", "1e-3"], "no 3D form"),
+    (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--bending", "1e-3", "--clamped"], "no 3D form"),
     (["--chi", "0.25", "--N", "10", "--perturb", "1e-3", "--dims", "2"], "--dims 2"),
     (["--whirl", "2.5", "--N", "10", "--chi", "0.3"], "--whirl"),
     (["--dims", "3", "--chi", "0.25", "--N", "10", "--method", "euler-richardson"], "--method"),

@@ -35,8 +35,8 @@ def add_body_options(p) -> None:
                    help="quadratic tangential (skin friction) drag per length, units of lambda/L")
     g.add_argument("--drag-linear", default=None, metavar="KN[,KT]",
                    help="linear (Stokes) drag per length, normal [and tangential], units of lambda sqrt(g/L)")
-    g.add_argument("--wind", default=None, metavar="WX,WY",
-                   help="uniform wind velocity (y downward), units of sqrt(gL)")
+    g.add_argument("--wind", default=None, metavar="WX,WY[,WZ]",
+                   help="uniform wind velocity (y downward), units of sqrt(gL); WZ (out of the plane) with --dims 3")
     g.add_argument("--tip-drag", type=float, default=0.0, metavar="CD",
                    help="body drag of the free end's tip body, force CD |u| u, units of M/L")
     g.add_argument("--clamped", dest="clamp", nargs="?", const="start", default=None, metavar="ANGLE",
@@ -150,7 +150,8 @@ def body_from_args(args):
         try:
             w = [float(x) for x in args.wind.split(",")]
         except ValueError:
-            raise SnappingInputError(f"--wind={args.wind!r} must be two comma-separated numbers WX,WY") from None
+            raise SnappingInputError(f"--wind={args.wind!r} must be two comma-separated numbers WX,WY (three, "
+                                     f"WX,WY,WZ, with --dims 3)") from None
         kw["wind"] = w
     clamp = args.clamp
     if clamp is not None and clamp != "start":
@@ -163,7 +164,7 @@ def body_from_args(args):
     if si is not None:
         kw.update(_si_numbers(args, si))
     body = Body(**kw)
-    if body.wind != (0.0, 0.0) and body.tip_drag == 0.0 and all(
+    if any(body.wind) and body.tip_drag == 0.0 and all(
             body._zero(k) for k in ("drag_normal", "drag_tangential", "drag_linear_normal", "drag_linear_tangential")):
         # (the API's Body takes it, as an inactive body; on the command line it would be an option silently dropped)
         opt = "--wind-si" if args.wind is None else "--wind"

@@ -65,7 +65,8 @@ def _problem3d(args):
     from .._validate import SnappingInputError
     from ..spatial import Problem3D
     from ..spatial.held3d import parse_pin3d
-    from ._body import line_links
+    from ..spatial.starts3d import planar_body
+    from ._body import body_from_args, line_links
     from ._common import _numbers
     from ..simulate.links import Links
     from ..simulate.problem import from_options
@@ -76,7 +77,8 @@ def _problem3d(args):
     g_dir = (0.0, 1.0, 0.0) if args.g_dir is None else tuple(_numbers("--g-dir", args.g_dir, 3, 3))
     axis = None if args.pin_axis is None else tuple(_numbers("--pin-axis", args.pin_axis, 3, 3))
     pin = parse_pin3d(args.pin_motion, axis)
-    kw = {"g_dir": g_dir}
+    body = body_from_args(args)  # (bending, damping, drag, a 3D wind: snapping.spatial.forces3d)
+    kw = {"g_dir": g_dir} if body is None else {"g_dir": g_dir, "body": body}
     if args.spin_up is not None and args.whirl is None:
         raise SnappingInputError(f"--spin-up {args.spin_up} needs --whirl OMEGA (the rate it spins up to)")
 
@@ -95,8 +97,8 @@ def _problem3d(args):
         if args.spin_up is not None:
             ramp, *rad = _numbers("--spin-up", args.spin_up, 1, 2)
             return Problem3D.spun_up(args.whirl, args.N, ramp=ramp, radius=rad[0] if rad else 0.05,
-                                     links=chain_links(), gravity=args.gravity)
-        return Problem3D.whirling(args.whirl, args.N, links=chain_links(), gravity=args.gravity)
+                                     links=chain_links(), gravity=args.gravity, **kw)
+        return Problem3D.whirling(args.whirl, args.N, links=chain_links(), gravity=args.gravity, **kw)
     if args.chi is None and args.supports is None and args.shape is None:
         raise SnappingInputError("the arguments --chi (or --supports/--shape, or --whirl) and --N are required")
     if args.shape is not None:
@@ -104,14 +106,10 @@ def _problem3d(args):
 
         if args.chi is not None or args.supports is not None:
             raise SnappingInputError("--shape is the start: give no --chi/--supports with it")
-        from ._body import body_from_args
-
-        if body_from_args(args) is not None:
-            raise SnappingInputError("a body (bending, drag) has no 3D form yet (with a 3D --shape)")
         problem = Problem3D.curve(read_shape3d(args.shape), links=chain_links(), name=str(args.shape),
                                   gravity=args.gravity, **kw)
         return problem.with_pin(pin)
-    from ._body import attach_body, body_from_args
+    from ._body import attach_body
 
     supports = None if args.supports is None else _numbers("--supports", args.supports, 2, 2)
     planar = from_options(chi=args.chi, N=args.N, chords=args.chords, supports=supports, shape=None,
@@ -121,9 +119,9 @@ def _problem3d(args):
         from ..simulate.problem import Problem
 
         planar = Problem.catenary(args.chi, args.N, chords=args.chords)
-    body = body_from_args(args)
-    if body is not None:
-        planar = attach_body(planar, body, args)
+    if body is not None:  # (the planar problem places the start; the body in space keeps its 3D wind)
+        planar = attach_body(planar, planar_body(body), args)
+        kw["body"] = body if body.clamp is None else planar.body
     return Problem3D.from_planar(planar, **kw).with_pin(pin)
 
 
@@ -149,6 +147,11 @@ def cmd_simulate3d(args, times, scales=None) -> int:
     summary = {k: ds.attrs[k] for k in _KEYS}
     summary = {k: (v.item() if hasattr(v, "item") else v) for k, v in summary.items()}
     summary["dims"] = 3
+    if problem.body_active:
+        from ..simulate.body import summarize
+
+        summary["body"] = summarize(ds.attrs["body"])
+        summary["dissipated"] = float(ds["dissipated"].values[-1])
     if args.output:
         summary["output"] = args.output
     from .. import units

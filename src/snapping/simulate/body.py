@@ -15,7 +15,8 @@ in the units of the chain (length L, mass M of the chain, g; ``lambda = M/L``):
   ``lambda/L``; a line falling broadside reaches ``1/sqrt(drag_normal)``), same forms;
   ``drag_linear_normal``, ``drag_linear_tangential``: linear (Stokes) drag per unit length
   (units of ``lambda sqrt(g/L)``); ``wind``: a uniform air velocity ``(wx, wy)``
-  (y downward); ``tip_drag``: body drag ``c_d`` of the free end's tip body
+  (y downward; ``(wx, wy, wz)`` in space, :mod:`snapping.spatial`; a planar run takes
+  ``wz = 0`` only); ``tip_drag``: body drag ``c_d`` of the free end's tip body
   (force ``-c_d |u| u``, units of ``M/L``);
 * ``clamp``: None (the held end a free hinge, the default), ``"start"`` (clamped in the
   direction the start leaves the held end, set when the problem is built), an angle (radians: the
@@ -133,10 +134,10 @@ class Body:
             w = np.asarray(wind, dtype=float)
         except (TypeError, ValueError):
             raise V.SnappingInputError(f"wind={wind!r} must be two numbers (wx, wy)") from None
-        if w.shape != (2,) or not np.all(np.isfinite(w)) or np.abs(w).max() > PROFILE_MAX:
+        if w.shape not in ((2,), (3,)) or not np.all(np.isfinite(w)) or np.abs(w).max() > PROFILE_MAX:
             raise V.SnappingInputError(f"wind={wind!r} must be two finite numbers (wx, wy) (units of sqrt(g L), "
-                                       f"y downward); got shape {w.shape}")
-        set_(self, "wind", (float(w[0]), float(w[1])))
+                                       f"y downward; three (wx, wy, wz) in space); got shape {w.shape}")
+        set_(self, "wind", tuple(float(x) for x in w))
         cd = V.real("tip_drag", tip_drag)
         if not (math.isfinite(cd) and 0.0 <= cd <= PROFILE_MAX):
             raise V.SnappingInputError(f"tip_drag={cd!r} is out of range: must be finite and >= 0 (units of M/L)")
@@ -277,8 +278,12 @@ class Body:
             return v.copy()
         return np.full(N + 1, float(v))
 
-    def check(self, h) -> None:
-        """Check the per-node profiles against a chain with links ``h`` (SnappingInputError)."""
+    def check(self, h, dims: int = 2) -> None:
+        """Check the per-node profiles against a chain with links ``h`` (SnappingInputError); a
+        planar chain (``dims = 2``) takes no out-of-plane wind."""
+        if dims == 2 and len(self.wind) == 3 and self.wind[2] != 0.0:
+            raise V.SnappingInputError(f"wind={self.wind!r} blows out of the plane (wz != 0): a planar run takes "
+                                       f"(wx, wy); run it in space (snapping.spatial, --dims 3)")
         for name in _PROFILES:
             self.node_values(name, np.asarray(h, dtype=float))
         if self.clamp is not None and self.node_values("bending", np.asarray(h, dtype=float))[-1] == 0.0:
@@ -308,25 +313,8 @@ class Body:
         if isinstance(self.clamp, str):
             raise V.SnappingInputError("clamp='start' is set from a start: build the Problem with this body")
         h = np.asarray(h, dtype=float)
-        N = h.size
-        l = np.zeros(N + 1)
-        l[0] = 0.5 * h[0]
-        l[1:N] = 0.5 * (h[:-1] + h[1:])
-        l[N] = 0.5 * h[N - 1]
-        B = self.node_values("bending", h)
-        k0 = self.node_values("curvature", h)
-        eta = self.node_values("damping", h)
         clamped = self.clamp is not None
-        inner = np.zeros(N + 1)
-        inner[1:N] = 1.0
-        if clamped:
-            inner[N] = 1.0
-        arrays = {"Bl": inner * B / l, "K0L": inner * k0 * l, "El": inner * eta / l}
-        drag = np.ones(N + 1)
-        drag[N] = 0.0
-        for key, name in (("CN", "drag_normal"), ("CT", "drag_tangential"), ("KN", "drag_linear_normal"),
-                          ("KT", "drag_linear_tangential")):
-            arrays[key] = drag * self.node_values(name, h) * l
+        arrays = self.node_arrays(h, clamped)
         alpha, table = 0.0, None
         if clamped:
             if isinstance(self.clamp, tuple):
@@ -342,6 +330,32 @@ class Body:
             alpha = (phi + 2.0 * math.pi * k) - (a0 if table is not None else 0.0)
         return FR.make_body_model(mdl, arrays, clamped=clamped, alpha=alpha, clamp_table=table, wind=self.wind,
                                   tip_drag=self.tip_drag)
+
+    def node_arrays(self, h, clamped: bool = False) -> dict:
+        """The compiled models' node arrays (N + 1 each, by node) of a chain with links ``h``:
+        ``Bl = B/l``, ``K0L = kappa0 l``, ``El = eta/l`` at the inner nodes (and node N when
+        ``clamped``), the drags ``CN, CT, KN, KT`` times ``l`` at nodes 0 .. N - 1; ``l`` the
+        node's share of length."""
+        h = np.asarray(h, dtype=float)
+        N = h.size
+        l = np.zeros(N + 1)
+        l[0] = 0.5 * h[0]
+        l[1:N] = 0.5 * (h[:-1] + h[1:])
+        l[N] = 0.5 * h[N - 1]
+        B = self.node_values("bending", h)
+        k0 = self.node_values("curvature", h)
+        eta = self.node_values("damping", h)
+        inner = np.zeros(N + 1)
+        inner[1:N] = 1.0
+        if clamped:
+            inner[N] = 1.0
+        arrays = {"Bl": inner * B / l, "K0L": inner * k0 * l, "El": inner * eta / l}
+        drag = np.ones(N + 1)
+        drag[N] = 0.0
+        for key, name in (("CN", "drag_normal"), ("CT", "drag_tangential"), ("KN", "drag_linear_normal"),
+                          ("KT", "drag_linear_tangential")):
+            arrays[key] = drag * self.node_values(name, h) * l
+        return arrays
 
     def describe(self, h=None) -> dict:
         """JSON-friendly description; with the chain's links ``h``, a profile given as a
@@ -412,7 +426,7 @@ def summarize(d: dict) -> dict:
             out[name] = float(v)
     w = d.get("wind") or [0.0, 0.0]
     if any(w):
-        out["wind"] = [float(w[0]), float(w[1])]
+        out["wind"] = [float(x) for x in w]
     if d.get("tip_drag"):
         out["tip_drag"] = float(d["tip_drag"])
     c = d.get("clamp")

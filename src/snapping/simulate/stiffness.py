@@ -56,7 +56,7 @@ from . import forced as FR
 from . import general as G
 
 __all__ = ["R_DOP853", "ZETA_MIN", "CHOICE_RATIO", "RODAS4_PRICE", "WARN_STEPS", "REFUSE_STEPS", "shortest_wave",
-           "largest_eigenvalue", "explicit_steps", "stiff_steps", "accuracy_steps", "choose", "check_cost",
+           "largest_eigenvalue", "explicit_steps", "wave_of", "stiff_steps", "accuracy_steps", "choose", "check_cost",
            "CostWarning"]
 
 #: DOP853's stability boundary (min over the imaginary and negative real axes, from its tableau)
@@ -93,11 +93,19 @@ def shortest_wave(mdl) -> tuple[float, float]:
     n1 = N + 1
     Bl = tab[o + FR.B_BL * n1:o + FR.B_BL * n1 + N]
     El = tab[o + FR.B_EL * n1:o + FR.B_EL * n1 + N]
+    return wave_of(Bl, El, h, invm, par[G.P_G])
+
+
+def wave_of(Bl, El, h, invm, g: float) -> tuple[float, float]:
+    """``(omega_max, zeta)`` of node arrays ``Bl = B/l``, ``El = eta/l`` (nodes 0 .. N - 1), links
+    ``h``, inverse node masses ``invm`` and gravity ``g`` (:func:`shortest_wave`'s formula; the
+    3D chain's, :mod:`snapping.spatial`, is the same)."""
+    N = h.size
     m = 1.0 / invm  # node masses of nodes 0 .. N - 1 (node N is held)
     hn = np.empty(N)  # a node's shorter neighbouring link
     hn[0] = h[0]
     hn[1:] = np.minimum(h[:-1], h[1:])
-    weight = abs(par[G.P_G]) * float(np.sum(m))
+    weight = abs(g) * float(np.sum(m))
     w2 = 16.0 * Bl / (m * hn ** 2) + 4.0 * weight / (m * hn)
     i = int(np.argmax(w2))
     om = math.sqrt(w2[i])

@@ -14,6 +14,8 @@
 * :mod:`snapping.spatial.figures3d`: the out-of-plane amplitude against eps, the chain in space.
 * :mod:`snapping.spatial.stability`: does the planar snap stay planar? The out-of-plane
   amplification at the snap against N, extrapolated, and a computed verdict.
+* :mod:`snapping.spatial.forces3d`: a line's body in space (bending, damping, drag, a 3D
+  wind) as node forces; :mod:`snapping.spatial.stiffness3d`: how stiff bending makes a 3D run.
 
 It imports from :mod:`snapping.simulate` (links, the catenary, the DOP853 tableau); the
 planar simulator does not import it.

@@ -65,13 +65,15 @@ import numpy as np
 from numba import njit
 
 from ..simulate.general import BLOCK, _pow2_near, _spline
+from . import forces3d as F3
 
 __all__ = ["Work", "make_model", "rhs3d", "measure3d", "project", "pin3d", "nodes_to_state", "state_to_nodes",
-           "NMEAS", "MEAS_NAMES", "circle_data", "table_data", "breakpoints"]
+           "NMEAS", "MEAS_NAMES", "circle_data", "table_data", "breakpoints", "M_BEND", "M_DISS", "BODY_MEAS_NAMES",
+           "nmeas"]
 
 # ---------------------------------------------------------------- the model's scalar parameters
-P_GX, P_GY, P_GZ, P_PIN, P_AX, P_AY, P_AZ, P_T0, P_T1, P_NX, P_NY, P_NZ = range(12)
-NPAR = 12
+P_GX, P_GY, P_GZ, P_PIN, P_AX, P_AY, P_AZ, P_T0, P_T1, P_NX, P_NY, P_NZ, P_BODY = range(13)
+NPAR = 13
 PIN_FIXED, PIN_PULL, PIN_FLICK, PIN_TABLE, PIN_CIRCLE = 0.0, 1.0, 2.0, 3.0, 4.0
 TWO_PI = 2.0 * math.pi
 
@@ -82,6 +84,14 @@ NMEAS = 14
 #: names of the measurements (the columns of a 3D run's record after t, dt, err)
 MEAS_NAMES = ("v_max", "a_max", "sigma_max", "v_end", "a_end", "energy", "pin_work", "angular_momentum_g",
               "z_amp", "vz_amp", "link_error", "v_rel_max", "s_v_max", "finite")
+#: measurements of a run with a body (:mod:`snapping.spatial.forces3d`), after MEAS_NAMES
+M_BEND, M_DISS = NMEAS, NMEAS + 1
+BODY_MEAS_NAMES = ("bending_energy", "dissipated")
+
+
+def nmeas(par) -> int:
+    """The number of measurements of a model's runs (more with a body)."""
+    return NMEAS + (len(BODY_MEAS_NAMES) if par[P_BODY] > 0.0 else 0)
 
 
 class Work:
@@ -95,7 +105,7 @@ class Work:
 
 
 def make_model(h, invm, *, g=(0.0, 1.0, 0.0), pin=(PIN_FIXED, (0.0, 0.0, 0.0), 0.0, math.inf),
-               normal=(0.0, 0.0, 1.0)):
+               normal=(0.0, 0.0, 1.0), body=None):
     """The model tuple ``(par, h, invm)`` of the compiled kernels (no checks: the
     :class:`snapping.spatial.starts3d.Problem3D` validates).
 
@@ -104,7 +114,11 @@ def make_model(h, invm, *, g=(0.0, 1.0, 0.0), pin=(PIN_FIXED, (0.0, 0.0, 0.0), 0
     :data:`PIN_FLICK`: ``accel sin(2 pi (t - t0)/T)`` for one period; :data:`PIN_CIRCLE` (T: its
     ramp) and :data:`PIN_TABLE` carry ``data`` (:func:`circle_data`, :func:`table_data`), which
     is appended to ``par`` after its scalars, its offset in ``par[P_AX]``); ``normal``: the unit
-    normal of the reference plane whose out-of-plane amplitude is measured.
+    normal of the reference plane whose out-of-plane amplitude is measured; ``body``: None
+    (a chain), or the keywords of :func:`snapping.spatial.forces3d.extend_par` (``arrays``,
+    ``signed``, ``wind``, ``tip_drag``): bending, damping and drag, appended after the pin's
+    data, its offset in ``par[P_BODY]`` (0: no body); the model's state then has one
+    component more (``D``, the energy dissipated).
     """
     kind, acc, t0, T, *data = pin
     data = np.asarray(data[0], dtype=float).ravel() if data and data[0] is not None else np.zeros(0)
@@ -117,6 +131,9 @@ def make_model(h, invm, *, g=(0.0, 1.0, 0.0), pin=(PIN_FIXED, (0.0, 0.0, 0.0), 0
         par[NPAR:] = data
     par[P_T0], par[P_T1] = t0, T
     par[P_NX:P_NZ + 1] = np.asarray(normal, dtype=float)
+    if body is not None:
+        par[P_BODY] = float(par.size)  # (the offset of the body's block)
+        par = F3.extend_par(par, np.size(h), **body)
     return par, np.ascontiguousarray(h, dtype=float), np.ascontiguousarray(invm, dtype=float)
 
 
@@ -262,6 +279,11 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
     for i in range(n3):
         f[i] = y[n3 + i]
     px, py, pz, pvx, pvy, pvz, pax, pay, paz = pin3d(t, par)
+    body = F3.has_body(par, int(par[P_BODY]))  # (a body: node forces F, their link accelerations a^F_j in the rows)
+    pF = 0.0
+    if body:
+        pF, dD = F3.node_forces(N, y, par, int(par[P_BODY]), h, pvx, pvy, pvz, par[P_NX], par[P_NY], par[P_NZ])
+        f[6 * N + 1] = dD
     Ex = pax - par[P_GX]
     Ey = pay - par[P_GY]
     Ez = paz - par[P_GZ]
@@ -285,6 +307,9 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
             uy = y[U + Y + j]
             uz = y[U + Z + j]
             r = -h[j] * (ux * ux + uy * uy + uz * uz)
+            if body:
+                fx, fy, fz = F3.link_accel(N, j, par, int(par[P_BODY]), invm)
+                r -= fx * y[X + j] + fy * y[Y + j] + fz * y[Z + j]
             if j < N - 1:
                 b = -(invm[j] + invm[j + 1])
                 C = y[X + j] * y[X + j + 1] + y[Y + j] * y[Y + j + 1] + y[Z + j] * y[Z + j + 1]
@@ -329,6 +354,11 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
         f[U + X + j] = (anx - ajx) * ih
         f[U + Y + j] = (any_ - ajy) * ih
         f[U + Z + j] = (anz - ajz) * ih
+        if body:
+            fx, fy, fz = F3.link_accel(N, j, par, int(par[P_BODY]), invm)
+            f[U + X + j] += fx * ih
+            f[U + Y + j] += fy * ih
+            f[U + Z + j] += fz * ih
         ajx = anx
         ajy = any_
         ajz = anz
@@ -338,6 +368,12 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
     f[U + Y + j] = (Ey - ajy) * ih
     f[U + Z + j] = (Ez - ajz) * ih
     f[6 * N] = T[j] * (y[X + j] * pvx + y[Y + j] * pvy + y[Z + j] * pvz)
+    if body:
+        fx, fy, fz = F3.link_accel(N, j, par, int(par[P_BODY]), invm)
+        f[U + X + j] += fx * ih
+        f[U + Y + j] += fy * ih
+        f[U + Z + j] += fz * ih
+        f[6 * N] -= pF
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -428,7 +464,10 @@ def measure3d(N, t, y, T, meas, snode, par, h, invm):
         le = abs(math.sqrt(ex * ex + ey * ey + ez * ez) - 1.0)
         if le > lerr:
             lerr = le
-    # accelerations a_j = (T_j e_j - T_{j-1} e_{j-1})/m_j + g
+    body = F3.has_body(par, int(par[P_BODY]))
+    if body:  # (the body's node forces at this state, into the model's scratch)
+        F3.node_forces(N, y, par, int(par[P_BODY]), h, pvx, pvy, pvz, nx, ny, nz)
+    # accelerations a_j = (T_j e_j - T_{j-1} e_{j-1} + F_j)/m_j + g
     amax2 = 0.0
     smax = -np.inf
     atip = 0.0
@@ -442,6 +481,11 @@ def measure3d(N, t, y, T, meas, snode, par, h, invm):
             sx -= Tm * y[j - 1]
             sy -= Tm * y[N + j - 1]
             sz -= Tm * y[2 * N + j - 1]
+        if body:
+            fx, fy, fz = F3.node_force(N, j, par, int(par[P_BODY]))
+            sx += fx
+            sy += fy
+            sz += fz
         im = invm[j]
         ax = sx * im + gx
         ay = sy * im + gy
@@ -460,6 +504,11 @@ def measure3d(N, t, y, T, meas, snode, par, h, invm):
     meas[M_VTIP] = math.sqrt(vx * vx + vy * vy + vz * vz)
     meas[M_ATIP] = atip
     meas[M_ENERGY] = 0.5 * ke + pe
+    if body:
+        vb = F3.bending_energy(N, y, par, int(par[P_BODY]), nx, ny, nz)
+        meas[M_ENERGY] += vb
+        meas[M_BEND] = vb
+        meas[M_DISS] = y[6 * N + 1]
     meas[M_WORK] = y[6 * N]
     meas[M_LG] = lg
     meas[M_ZAMP] = zamp
@@ -467,6 +516,8 @@ def measure3d(N, t, y, T, meas, snode, par, h, invm):
     meas[M_LINKERR] = lerr
     meas[M_VREL] = math.sqrt(vrel2)
     tot = ke + pe + amax2 + smax + lg + y[6 * N]
+    if body:
+        tot += meas[M_ENERGY] + y[6 * N + 1]
     meas[M_FINITE] = 1.0 if (tot - tot) == 0.0 else 0.0
 
 

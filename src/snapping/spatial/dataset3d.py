@@ -46,12 +46,13 @@ __all__ = ["run3d_dataset", "build_dataset3d", "nodes_at", "problem3d_from_datas
 STEP_NAMES = {"dt": "dt", "err": "error_estimate", "v_max": "v_max", "a_max": "a_max", "sigma_max": "sigma_max",
               "v_end": "v_end", "a_end": "a_end", "energy": "energy", "pin_work": "pin_work",
               "v_rel_max": "v_rel_max", "s_v_max": "s_v_max", "link_error": "link_error",
-              "z_amp": "z_amp", "vz_amp": "vz_amp", "angular_momentum_g": "angular_momentum_g"}
+              "z_amp": "z_amp", "vz_amp": "vz_amp", "angular_momentum_g": "angular_momentum_g",
+              "bending_energy": "bending_energy", "dissipated": "dissipated"}
 METHOD = "dop853-3d"
 
 
 def _var(name: str) -> dict:
-    for table in (schema.STEP_VARS, schema.PIN_STEP_VARS, schema.NODE_PROFILE_VARS, schema.LINK_PROFILE_VARS,
+    for table in (schema.STEP_VARS, schema.PIN_STEP_VARS, schema.BODY_STEP_VARS, schema.NODE_PROFILE_VARS, schema.LINK_PROFILE_VARS,
                   schema.PROBLEM_VARS, schema.SPATIAL_VARS):
         if name in table:
             return dict(table[name])
@@ -61,7 +62,8 @@ def _var(name: str) -> dict:
 def nodes_at(problem, t: float, y: np.ndarray):
     """Positions, velocities, accelerations ((N + 1, 3) each) and link tensions (N) of the
     state ``y`` at time ``t``: the nodes walked from the held end (its prescribed motion),
-    the tensions from the O(N) solve of :func:`snapping.spatial.chain3d.rhs3d`."""
+    the tensions from the O(N) solve of :func:`snapping.spatial.chain3d.rhs3d` (with a body,
+    its node forces in the accelerations)."""
     par, h, invm = problem.model()
     N = h.size
     if t in C.breakpoints(par):  # (the acceleration from t on, the right limit, as the planar snapshots)
@@ -75,6 +77,10 @@ def nodes_at(problem, t: float, y: np.ndarray):
     s = w.T[:, None] * e
     s[1:] -= s[:-1].copy()
     a = np.zeros((N + 1, 3))
+    if par[C.P_BODY] > 0.0:  # (the body's node forces, left by rhs3d in the model's scratch)
+        from . import forces3d as F3
+
+        s += F3.node_force_arrays(N, par, int(par[C.P_BODY]))[:N]
     a[:N] = s * invm[:, None] + par[[C.P_GX, C.P_GY, C.P_GZ]][None, :]
     a[N] = k[6:9]
     return r, v, a, w.T.copy()
@@ -86,12 +92,14 @@ def build_dataset3d(problem, res: dict, *, t_end=None, stop_fraction: float = 0.
     h, m = problem.links.h, problem.links.m
     N = h.size
     rec = res["record"]
-    col = {name: rec[:, i] for i, name in enumerate(RECORD_NAMES)}
+    col = {name: rec[:, i] for i, name in enumerate(res.get("record_names", RECORD_NAMES))}
     s_node = np.concatenate([np.cumsum(h[::-1])[::-1], [0.0]])
     # energy: the planar zero (hanging straight down at rest from the origin) is -g sum m_j s_j
     e_hang = -problem.gravity * float(np.sum(m * s_node[:N]))
     data_vars = {}
     for src, name in STEP_NAMES.items():
+        if src not in col:
+            continue
         vals = col[src].copy()
         if name == "energy":
             vals -= e_hang
@@ -167,6 +175,8 @@ def build_dataset3d(problem, res: dict, *, t_end=None, stop_fraction: float = 0.
         "z_amp_max": float(res["z_amp_max"]), "angular_momentum_drift": float(res["angular_momentum_drift"]),
         "link_error_max": float(res["link_error_max"]),
     }
+    if problem.body_active:
+        attrs["body"] = json.dumps(problem.body.describe(h), sort_keys=True)
     for q in ("v", "a", "sigma"):
         attrs[f"{q}_peak"] = float(res[f"{q}_peak"])
         attrs[f"t_snap_{q}"] = float(res[f"t_snap_{q}"]) if snap else math.nan

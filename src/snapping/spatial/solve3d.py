@@ -94,8 +94,9 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
         for c in range(3):
             ytmp[c * N + j] = se
             ytmp[n3 + c * N + j] = su
-    ytmp[2 * n3] = max(abs(y0[2 * n3]), abs(y1[2 * n3]))
-    n = 2 * n3 + 1
+    n = y0.shape[0]
+    for i in range(2 * n3, n):  # W (and D with a body): their own size
+        ytmp[i] = max(abs(y0[i]), abs(y1[i]))
     for i in range(n):  # (rk's branch-free component error with |y| := the link's norm: vectorises)
         ytmp[i] = R.scaled_error(Kst, i, ytmp[i], ytmp[i], h, tol)
     err = 0.0
@@ -241,7 +242,7 @@ def advance3d(N, Y0, Y1, KK, TS, HS, DOK, ytmp, T, cp, dp, ctl, rec, pk, meas, s
         rec[nrec, 0] = t
         rec[nrec, 1] = h
         rec[nrec, 2] = err * tol
-        for q in range(C.NMEAS):
+        for q in range(meas.shape[0]):
             rec[nrec, 3 + q] = meas[q]
         nrec += 1
         ctl[Q_NREC] = float(nrec)
@@ -263,6 +264,12 @@ def advance3d(N, Y0, Y1, KK, TS, HS, DOK, ytmp, T, cp, dp, ctl, rec, pk, meas, s
             return RET_CALL_LIMIT
 
 
+def record_names(mdl) -> tuple:
+    """The record columns of a model's runs: :data:`RECORD_NAMES`, and with a body
+    ``bending_energy`` and ``dissipated`` (:data:`snapping.spatial.chain3d.BODY_MEAS_NAMES`)."""
+    return RECORD_NAMES + (C.BODY_MEAS_NAMES if C.nmeas(mdl[0]) > C.NMEAS else ())
+
+
 class Stepper3D:
     """State and buffers of a 3D run (:func:`run3d` drives it)."""
 
@@ -272,15 +279,15 @@ class Stepper3D:
         N = h.size
         self.N, self.mdl = N, mdl
         self.snode = np.concatenate([np.cumsum(h[::-1])[::-1], [0.0]])
-        n = 6 * N + 1
+        n = len(y0)  # 6N + 1, or 6N + 2 with a body (D)
         self.Y0, self.Y1 = np.zeros((2, n)), np.zeros((2, n))
         self.KK = np.zeros((2, R.NSX, n))
         self.F = np.zeros((2, R.NI, n))
         self.TS, self.HS, self.DOK = np.zeros(2), np.zeros(2), np.zeros(2)
         self.ytmp = np.zeros(n)
         self.w, self.rw = C.Work(N), C.Work(N)
-        self.meas = np.zeros(C.NMEAS)
-        self.rec = np.zeros((RECORD_CHUNK, NREC))
+        self.meas = np.zeros(C.nmeas(par))
+        self.rec = np.zeros((RECORD_CHUNK, 3 + self.meas.size))
         self.chunks: list[np.ndarray] = []
         self.breaks = [b for b in C.breakpoints(par) if b > 0.0]
         y = np.array(y0, dtype=float)
@@ -341,7 +348,7 @@ class Stepper3D:
 
     def records(self) -> np.ndarray:
         self.drain()
-        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, NREC))
+        return np.concatenate(self.chunks) if self.chunks else np.zeros((0, self.rec.shape[1]))
 
     def state_at(self, t: float) -> np.ndarray:
         """The state at time t within the last two accepted steps (dense output; not projected)."""
@@ -368,7 +375,7 @@ class Stepper3D:
         f = np.empty_like(y)
         C.rhs3d(self.N, t, y, f, w.T, w.cp, w.dp, par, h, invm)
         self.ctl[Q_NRHS] += 1.0
-        meas = np.zeros(C.NMEAS)
+        meas = np.zeros(self.meas.size)
         C.measure3d(self.N, t, y, w.T, meas, self.snode, par, h, invm)
         return meas
 
@@ -455,6 +462,9 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     if not 0.0 <= stop_fraction < 1.0:
         raise SnappingInputError(f"stop_fraction={stop_fraction!r} is out of range: must lie in [0, 1)")
     auto = t_end is None
+    from .stiffness3d import check_cost3d
+
+    check_cost3d(problem, None if auto else t_end)  # (a body's bending: CostWarning, or refused, before any work)
     st = Stepper3D(problem.model(), problem.initial_state(), tol=float(tol),
                    t_end=t_end_max if auto else float(t_end), stop_fraction=stop_fraction if auto else 0.0,
                    reeval=reeval, max_link_error=max_link_error)
@@ -463,7 +473,9 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
     code = st.loop(snapshot_times)
     wall = time.perf_counter() - t0
     rec = st.records()
-    col = {name: rec[:, i] for i, name in enumerate(RECORD_NAMES)}
+    names = record_names(st.mdl)
+    col = {name: rec[:, i] for i, name in enumerate(names)}
+    diss = col["dissipated"] if "dissipated" in col else 0.0
     out = {"status": "ok" if code < RET_FAIL_NAN else "failed", "stop_reason": {RET_STOP: "snap", RET_END: "t_end"}.get(
         code, FAILURES.get(code, str(code))), "t_final": st.t}
     for qi, name in enumerate(PEAK_NAMES):
@@ -475,11 +487,11 @@ def run3d(problem, *, tol: float = 1e-8, t_end: float | None = None, t_end_max: 
                 "z_amp_final": float(col["z_amp"][-1]), "vz_amp_max": float(col["vz_amp"].max()),
                 "n_rhs": int(st.ctl[Q_NRHS]), "n_steps": int(st.ctl[Q_NSTEPS]), "n_rejected": int(st.ctl[Q_NREJ]),
                 "wall_time": wall, "tol": float(tol), "N": st.N,
-                "energy_drift": float(np.max(np.abs((col["energy"] - col["pin_work"])
+                "energy_drift": float(np.max(np.abs((col["energy"] - col["pin_work"] + diss)
                                                      - (col["energy"][0] - col["pin_work"][0])))),
                 "angular_momentum_drift": float(np.max(np.abs(col["angular_momentum_g"]
                                                               - col["angular_momentum_g"][0]))),
-                "link_error_max": float(col["link_error"].max()), "record": rec, "state": st.current_state(),
+                "link_error_max": float(col["link_error"].max()), "record": rec, "record_names": names, "state": st.current_state(),
                 "peak_state": st.peak_state, "snapshots": st.snapshots})
     return out
 

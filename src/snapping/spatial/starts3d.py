@@ -5,7 +5,10 @@ held end at the origin), the chain (:class:`snapping.simulate.links.Links`: link
 and lumped node masses, tip mass), the held end's motion (:class:`Pin3D`), gravity (a
 magnitude and a unit direction, default ``(0, 1, 0)``: ``y`` downward as in the planar
 problems) and the normal of the reference plane whose out-of-plane amplitude is measured
-(default ``(0, 0, 1)``).
+(default ``(0, 0, 1)``), and what the line is made of (``body``: a
+:class:`snapping.simulate.Body`: bending stiffness, Kelvin-Voigt bending damping, quadratic
+and linear drag, a 3D wind, tip drag; :mod:`snapping.spatial.forces3d`; no clamped held end
+yet, and a natural curvature only in a planar problem).
 
 Starts: any planar :class:`snapping.simulate.problem.Problem` placed in the plane z = 0
 (:meth:`Problem3D.from_planar`), the paper's catenary (:meth:`Problem3D.catenary`), node
@@ -35,7 +38,7 @@ from ..simulate.links import Links
 from . import chain3d as C
 from .held3d import Pin3D, unit3
 
-__all__ = ["Problem3D", "MODES"]  # (Pin3D: snapping.spatial.held3d, importable here too)
+__all__ = ["Problem3D", "MODES", "planar_body"]  # (Pin3D: snapping.spatial.held3d, importable here too)
 
 #: perturbation modes of :meth:`Problem3D.perturbed`
 MODES = ("sin", "random", "modes")
@@ -48,6 +51,16 @@ SHAPE_RTOL = 1e-6
 
 
 _unit = unit3
+
+
+def planar_body(body):
+    """``body`` with its wind in the plane (what a planar problem that places a 3D start takes;
+    the 3D problem keeps the body as given); None stays None."""
+    if body is None or len(body.wind) == 2:
+        return body
+    from ..simulate.body import Body
+
+    return Body.from_describe({**body.describe(), "wind": list(body.wind[:2])})
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,6 +76,7 @@ class Problem3D:
     g_dir: tuple = (0.0, 1.0, 0.0)
     normal: tuple = (0.0, 0.0, 1.0)
     start: dict = field(default_factory=dict)
+    body: object = None
 
     def __post_init__(self):
         if not isinstance(self.links, Links):
@@ -103,6 +117,40 @@ class Problem3D:
             j = int(np.argmax(stretch))
             raise V.SnappingInputError(f"v: the initial velocities stretch link {j} at the rate {stretch[j]:.3g}: "
                                        f"they must keep every link's length")
+        self._check_body()
+
+    def _check_body(self) -> None:
+        """A body in space: its profiles against the chain; no clamp (refused); a natural
+        curvature only when the whole problem lies in the reference plane."""
+        from ..simulate.body import Body
+
+        b = self.body
+        if b is None:
+            return
+        if not isinstance(b, Body):
+            raise V.SnappingInputError(f"body={type(b).__name__} is not a snapping.simulate.Body")
+        b.check(self.links.h, dims=3)
+        if b.clamp is not None:
+            raise V.SnappingInputError(f"clamp={b.clamp!r}: a clamped held end has no 3D form yet (it would hold the "
+                                       f"line's direction in space, and with a twisting rope its frame); use a hinged "
+                                       f"held end (clamp=None) or the planar method")
+        if not np.all(b.node_values("curvature", self.links.h) == 0.0):
+            n = np.asarray(self.normal)
+            wind = np.zeros(3)
+            wind[:len(b.wind)] = b.wind
+            off = {"r": float(np.abs(self.r @ n).max()), "v": float(np.abs(self.v @ n).max()),
+                   "g_dir": abs(float(np.asarray(self.g_dir) @ n)), "pin accel": abs(float(np.asarray(self.pin.accel) @ n)),
+                   "wind": abs(float(wind @ n))}
+            bad = [k for k, x in off.items() if x != 0.0]
+            if bad:
+                raise V.SnappingInputError(f"curvature: a natural curvature in space needs a material frame to curl in "
+                                           f"(a chain has none; a twisting rope would): it is accepted only in a planar "
+                                           f"problem, but {', '.join(bad)} leave the plane normal to {tuple(n.tolist())}")
+
+    @property
+    def body_active(self) -> bool:
+        """Whether the run has body forces (a body that changes nothing is solved as none)."""
+        return self.body is not None and self.body.active
 
     @property
     def N(self) -> int:
@@ -112,9 +160,9 @@ class Problem3D:
     @classmethod
     def from_planar(cls, problem, **kw) -> "Problem3D":
         """A planar :class:`snapping.simulate.problem.Problem` in the plane z = 0 (same chain,
-        nodes, velocities, held end and gravity; no body)."""
+        nodes, velocities, held end, gravity and body)."""
         if problem.body is not None:
-            raise V.SnappingInputError("problem: a body (bending, drag) has no 3D form yet")
+            kw.setdefault("body", problem.body)
         N = problem.N
         r = np.column_stack([problem.x, problem.y, np.zeros(N + 1)])
         v = np.column_stack([problem.vx, problem.vy, np.zeros(N + 1)])
@@ -124,10 +172,13 @@ class Problem3D:
     @classmethod
     def catenary(cls, chi: float, N: int | None = None, **kw) -> "Problem3D":
         """The planar catenary start (:meth:`snapping.simulate.problem.Problem.catenary`, same
-        keywords: ``links``, ``chords``, ``pin``, ``gravity``) in the plane z = 0."""
+        keywords: ``links``, ``chords``, ``pin``, ``gravity``, ``body``: a body with bending
+        starts from its rest shape, as in the plane; its wind may blow out of the plane) in the
+        plane z = 0."""
         from ..simulate.problem import Problem
 
-        return cls.from_planar(Problem.catenary(chi, N, **kw))
+        body = kw.pop("body", None)
+        return cls.from_planar(Problem.catenary(chi, N, body=planar_body(body), **kw), body=body)
 
     def perturbed(self, eps: float, mode: str = "sin", *, seed: int | None = None, k: int = 1,
                   kind: str = "velocity") -> "Problem3D":
@@ -274,12 +325,12 @@ class Problem3D:
 
     @classmethod
     def spun_up(cls, omega: float, N: int | None = None, *, radius: float = 0.05, ramp: float = 2.0,
-                links: Links | None = None, gravity: float = 1.0) -> "Problem3D":
+                links: Links | None = None, gravity: float = 1.0, **kw) -> "Problem3D":
         """The whirl spun up: the chain hanging straight at rest, its held end driven around a
         horizontal circle of ``radius`` about the vertical (:meth:`Pin3D.circle`), the rate
         ramped from 0 to ``omega`` over ``ramp`` (continuous acceleration). No damping: the
         chain swings about the whirling shape of :meth:`whirling` rather than settling on it."""
-        p = cls.hanging(N, links=links, gravity=gravity)
+        p = cls.hanging(N, links=links, gravity=gravity, **kw)
         p = p.with_pin(Pin3D.circle(radius, omega, ramp))
         return replace(p, start={"kind": "spun_up", "omega": float(omega), "radius": float(radius),
                                  "ramp": float(ramp)})
@@ -302,8 +353,16 @@ class Problem3D:
     def model(self):
         """The model tuple ``(par, h, invm)`` of :mod:`snapping.spatial.chain3d`."""
         g = self.gravity * np.asarray(self.g_dir)
-        return C.make_model(self.links.h, 1.0 / self.links.m, g=g, pin=self.pin.model_args(), normal=self.normal)
+        body = None
+        if self.body_active:
+            b = self.body
+            body = {"arrays": b.node_arrays(self.links.h), "wind": b.wind, "tip_drag": b.tip_drag,
+                    "signed": not np.all(b.node_values("curvature", self.links.h) == 0.0)}
+        return C.make_model(self.links.h, 1.0 / self.links.m, g=g, pin=self.pin.model_args(), normal=self.normal,
+                            body=body)
 
     def initial_state(self) -> np.ndarray:
-        """``[e, u, W = 0]`` of the start (:func:`snapping.spatial.chain3d.nodes_to_state`)."""
-        return C.nodes_to_state(self.r, self.v, self.links.h)
+        """``[e, u, W = 0]`` of the start (:func:`snapping.spatial.chain3d.nodes_to_state`), and
+        ``D = 0`` (the energy dissipated) with a body."""
+        y = C.nodes_to_state(self.r, self.v, self.links.h)
+        return np.append(y, 0.0) if self.body_active else y
