@@ -125,7 +125,8 @@ def test_energy_balances_through_slack_and_taut(damping):
     assert s["energy_drift"] < (1e-8 if damping else 1e-10)
     if damping:
         assert s["dissipated_total"] > 5e-5
-        assert np.all(np.diff(r.dataset["dissipated"].values) >= 0.0)
+        # (a Rosenbrock step's weights are not all positive: D may fall by the step's error)
+        assert np.diff(r.dataset["dissipated"].values).min() > -1e-9
     np.testing.assert_allclose(r.dataset["energy"] + r.dataset["dissipated"] - r.dataset["pin_work"],
                                s["energy_initial"], atol=1e-8 if damping else 1e-10)
 
