@@ -4,6 +4,7 @@
   line itself (:class:`ElasticLine`: the problem's links as springs, the starts, the statics);
 * :mod:`~snapping.simulate.elastic_kernels`: the compiled forces, banded Jacobian, measures;
 * :mod:`~snapping.simulate.elastic_solve`: the stepping (:func:`solve`) and the run Dataset;
+* :mod:`~snapping.simulate.elastic_rodas`: the compiled RODAS4 (``method="rodas4"``);
 * :mod:`~snapping.simulate.elastic_loads`: snap loads in SI (:func:`climbing_fall`).
 
 Example

@@ -6,6 +6,10 @@ analytic block-tridiagonal Jacobian as a sparse matrix: its LU factors are bande
 factorisation, so a stiff line (a large wave speed c) costs steps set by the accuracy of the
 motion, not by c. ``"DOP853"`` (scipy's explicit 8th-order method, the same compiled
 right-hand side) is there to compare: its steps are bounded by stability, dt ~ h/c.
+``"rodas4"`` is a compiled RODAS4 (:mod:`snapping.simulate.elastic_rodas`: the exact banded
+Jacobian, W and D rows included, the stage system reduced to the velocities, O(N) a step):
+as many evaluations as Radau for the same peak accuracy or fewer (5x fewer at N = 100, c = 300)
+and 10-70x less wall time.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -35,10 +39,11 @@ from scipy.integrate import DOP853, Radau
 from .. import _validate as V
 from .. import schema
 from .elastic_model import STARTS, Elastic, ElasticLine
+from .elastic_rodas import RodasStepper
 
 __all__ = ["solve", "ElasticRun", "METHODS"]
 
-METHODS = {"radau": Radau, "dop853": DOP853}
+METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
 #: points per step at which the dense output is sampled around each peak
 PEAK_SAMPLES = 24
 #: the per-step record's columns (the Dataset's step variables, in this order)
@@ -143,8 +148,10 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         ``stop_fraction`` of its running peak (or at ``t_end_max``).
     tol : float
         Relative and absolute tolerance of the error control (rtol = atol).
-    method : {"radau", "dop853"}
-        scipy's Radau IIA (with the analytic banded Jacobian) or explicit DOP853.
+    method : {"radau", "dop853", "rodas4"}
+        scipy's Radau IIA (with the analytic banded Jacobian), explicit DOP853, or the compiled
+        RODAS4 of :mod:`snapping.simulate.elastic_rodas` (exact banded Jacobian, O(N) a step;
+        its tolerance is a max norm, Radau's and DOP853's an rms norm).
     start : {"stretched", "unstretched"}
         See :mod:`snapping.simulate.elastic`; ignored when ``initial`` is given.
     initial : (x, y, vx, vy), optional
@@ -185,8 +192,11 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         count[0] += 1
         return line.rhs(t, z)
 
-    kw = {"jac": line.jac} if method == "radau" else {}
-    solver = METHODS[method](fun, 0.0, z0, t_bound, rtol=tol, atol=tol, **kw)
+    if method == "rodas4":
+        solver = RodasStepper(line, 0.0, z0, t_bound, tol)
+    else:
+        kw = {"jac": line.jac} if method == "radau" else {}
+        solver = METHODS[method](fun, 0.0, z0, t_bound, rtol=tol, atol=tol, **kw)
 
     mm0 = line.measure(0.0, z0)
     rows = [_record(line, 0.0, z0, 0.0, mm0)]
@@ -222,7 +232,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         if not np.all(np.isfinite(z)):
             status, stop_reason = "failed", "non-finite state"
             break
-        if count[0] > max_rhs:
+        if max(count[0], solver.nfev) > max_rhs:
             status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
             break
         if t_end is None and mm[0] < stop_fraction * running:
