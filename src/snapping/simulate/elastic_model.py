@@ -306,12 +306,162 @@ class ElasticLine:
         return float(mm[12] + mm[13] + mm[14])
 
     # -- statics
+    def _strain_of(self, T: np.ndarray) -> np.ndarray:
+        """The strain at which each link's law gives the tension ``T`` (>= 0): ``T/EA`` or the
+        table's inverse (extended with its last slope)."""
+        if self.tabe.size == 0:
+            return T / self.ea
+        e, t = self.tabe, self.tabt
+        out = np.interp(T, t, e)
+        far = T > t[-1]
+        out[far] = e[-1] + (T[far] - t[-1]) * (e[-1] - e[-2]) / (t[-1] - t[-2])
+        return out
+
+    def _mixed(self, z: np.ndarray, free: np.ndarray, max_iter: int):
+        """The statics in mixed form, from ``z``'s shape taken as a rigid chain: unknowns the
+        node positions and the link tensions, equations the force balance of the free nodes
+        and each link's length ``l_j = h_j (1 + e_j(T_j))``; its Newton matrix stays well
+        conditioned however stiff the links (EA -> infinity is the rigid chain), so a few steps
+        (O(N) each: sparse, banded) take the rigid shape to the stretched one. Returns
+        (positions z, Newton steps), or (None, steps) where it does not converge or some
+        tension comes out negative (a slack equilibrium: the caller's damped iteration
+        takes over)."""
+        N = self.N
+        pin = self.pin_state(0.0)
+        X = np.empty(3 * N)
+        X[0:2 * N:2], X[1:2 * N:2] = z[0:4 * N:4], z[1:4 * N:4]
+        X[2 * N:] = 0.0
+        held0 = X[0:2].copy()
+        e0 = self.ea if self.tabe.size == 0 else np.full(N, (self.tabt[1] - self.tabt[0]) / (self.tabe[1] - self.tabe[0]))
+        j = np.arange(N)
+        px, py = 2 * j, 2 * j + 1  # position unknowns of node j
+        tj = 2 * N + j  # tension unknowns
+        nxt = j + 1 < N
+
+        def residual_jac(X):
+            x, y = np.append(X[0:2 * N:2], pin[0]), np.append(X[1:2 * N:2], pin[1])
+            T = X[2 * N:]
+            dx, dy = np.diff(x), np.diff(y)
+            ln = np.hypot(dx, dy)
+            ux, uy = dx / ln, dy / ln
+            e = np.where(T > 0.0, self._strain_of(np.maximum(T, 0.0)), T / e0)
+            if self.tabe.size == 0:
+                slope = self.ea
+            else:  # (the segment's slope, as the law's)
+                k = np.clip(np.searchsorted(self.tabe, e) - 1, 0, self.tabe.size - 2)
+                slope = np.maximum(np.diff(self.tabt)[k] / np.diff(self.tabe)[k], 1e-300)
+            de = 1.0 / np.where(T > 0.0, slope, e0)
+            # force balance: node i gets +T_i u_i and -T_{i-1} u_{i-1}, gravity g e_y
+            Fx, Fy = T * ux, T * uy + self.m * self.g
+            Fx[1:] -= (T * ux)[:-1]
+            Fy[1:] -= (T * uy)[:-1]
+            G = ln / self.h - 1.0 - e
+            R = np.concatenate([np.column_stack([Fx, Fy]).ravel(), G])
+            q = T / ln
+            Pxx, Pxy, Pyy = q * (1 - ux * ux), -q * ux * uy, q * (1 - uy * uy)
+            rows, cols, vals = [], [], []
+
+            def add(r, c, v):
+                rows.append(r), cols.append(c), vals.append(v)
+
+            # link j between node j and node j+1 (the pin beyond N-1): dF_j/dr_j = -P_j, dF_j/dr_{j+1} = P_j
+            for (ra, ca, v) in ((px, px, Pxx), (px, py, Pxy), (py, px, Pxy), (py, py, Pyy)):
+                add(ra, ca, -v)
+                add(ra[nxt], ca[nxt] + 2, v[nxt])  # node j, by node j+1
+                add(ra[nxt] + 2, ca[nxt], v[nxt])  # node j+1, by node j
+                add(ra[nxt] + 2, ca[nxt] + 2, -v[nxt])  # node j+1, by itself
+            add(px, tj, ux)
+            add(py, tj, uy)
+            add(px[nxt] + 2, tj[nxt], -ux[nxt])
+            add(py[nxt] + 2, tj[nxt], -uy[nxt])
+            add(tj, px, -ux / self.h)
+            add(tj, py, -uy / self.h)
+            add(tj[nxt], px[nxt] + 2, ux[nxt] / self.h[nxt])
+            add(tj[nxt], py[nxt] + 2, uy[nxt] / self.h[nxt])
+            add(tj, tj, -de)
+            r, c, v = (np.concatenate(a) for a in (rows, cols, vals))
+            if not free[0]:  # node 0 held: its rows say X[0:2] = held0
+                keep = r >= 2
+                r, c, v = np.concatenate([r[keep], [0, 1]]), np.concatenate([c[keep], [0, 1]]), \
+                    np.concatenate([v[keep], [1.0, 1.0]])
+                R[0:2] = X[0:2] - held0
+            return R, sp.csc_matrix((v, (r, c)), shape=(3 * N, 3 * N)), T
+
+        X[2 * N:] = self._rigid_tensions(z, free)
+        for it in range(1, max_iter + 1):
+            R, J, T = residual_jac(X)
+            dX = sp.linalg.spsolve(J, -R)
+            if not np.all(np.isfinite(dX)):
+                return None, it
+            X = X + dX
+            if np.abs(dX[:2 * N]).max() <= 1e-13 * max(1.0, float(np.abs(X[:2 * N]).max())):
+                if X[2 * N:].min() < 0.0:
+                    return None, it
+                zz = z.copy()
+                zz[0:4 * N:4], zz[1:4 * N:4] = X[0:2 * N:2], X[1:2 * N:2]
+                return zz, it
+        return None, max_iter
+
+    def _rigid_tensions(self, z: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """The link tensions (>= 0) that balance gravity on ``z``'s shape held as a rigid chain:
+        least squares over the free nodes' force balance (banded normal equations; exact when
+        the shape is the rigid chain's equilibrium, as the catenary start)."""
+        N = self.N
+        x, y = np.append(z[0:4 * N:4], self.pin_state(0.0)[0]), np.append(z[1:4 * N:4], self.pin_state(0.0)[1])
+        dx, dy = np.diff(x), np.diff(y)
+        ln = np.hypot(dx, dy)
+        ux, uy = dx / ln, dy / ln
+        # node i (free): T_i u_i - T_{i-1} u_{i-1} = -m_i g e_y
+        nodes = np.flatnonzero(free)
+        rows, cols, vals = [], [], []
+        for comp, u in ((0, ux), (1, uy)):
+            r = 2 * np.arange(nodes.size) + comp
+            rows += [r, r[nodes > 0]]
+            cols += [nodes, nodes[nodes > 0] - 1]
+            vals += [u[nodes], -u[nodes[nodes > 0] - 1]]
+        A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(2 * nodes.size, N))
+        b = np.zeros(2 * nodes.size)
+        b[1::2] = -self.m[nodes] * self.g
+        AtA = (A.T @ A).tocsc()
+        # (a link no free node touches has no equation: keep its tension at zero)
+        AtA = AtA + sp.diags(np.where(AtA.diagonal() > 0.0, 0.0, 1.0))
+        return np.maximum(sp.linalg.spsolve(AtA, A.T @ b), 0.0)
+
+    def _prestretched(self, z: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """A first guess for the damped iteration: ``z``'s shape with each link stretched to the
+        strain that carries its :meth:`_rigid_tensions`, placed walking from the held end;
+        with node 0 held, the free end's miss is spread along the line in proportion to the
+        rest arclength."""
+        N = self.N
+        x, y = np.append(z[0:4 * N:4], self.pin_state(0.0)[0]), np.append(z[1:4 * N:4], self.pin_state(0.0)[1])
+        dx, dy = np.diff(x), np.diff(y)
+        ln = np.hypot(dx, dy)
+        ux, uy = dx / ln, dy / ln
+        T = self._rigid_tensions(z, free)
+        lt = self.h * (1.0 + self._strain_of(T))
+        xs = x[N] - np.cumsum((lt * ux)[::-1])[::-1]
+        ys = y[N] - np.cumsum((lt * uy)[::-1])[::-1]
+        if not free[0]:
+            w = self.snode / self.snode[0]
+            xs, ys = xs + (x[0] - xs[0]) * w, ys + (y[0] - ys[0]) * w
+        zg = z.copy()
+        zg[0:4 * N:4], zg[1:4 * N:4] = xs, ys
+        return zg
+
     def statics(self, z0: np.ndarray, *, hold_free_end: bool = False, tol: float = 1e-12,
                 max_iter: int = 200) -> np.ndarray:
         """The static equilibrium nearest ``z0`` (velocities zero; the held end at its t = 0
         position; with ``hold_free_end`` node 0 held too): the minimum of the potential energy
-        (elastic + gravity), convex for tension-only links, by Newton steps on the banded
-        stiffness, Levenberg-damped where the line has no stiffness yet (slack or at rest length)."""
+        (elastic + gravity), convex for tension-only links. First :meth:`_mixed` (Newton in
+        positions and tensions from ``z0``'s shape as a rigid chain: a few steps at any N and
+        stiffness), then Newton steps on the banded stiffness (O(N) each) to the force's
+        round-off, with a backtracking line search on the force norm, Levenberg-damped only
+        where a step and its halvings all fail; where the mixed form fails (a slack
+        equilibrium), these start from :meth:`_prestretched`. (Newton on the stiffness alone
+        from the unstretched shape stalls on a stiff line: the geometric stiffness T/l is
+        zero there and a full step overstretches by EA times its transverse part squared.)
+        ``self.statics_iterations`` records the Newton steps taken."""
         N = self.N
         z = z0.copy()
         z[2:4 * N:4] = z[3:4 * N:4] = 0.0
@@ -321,26 +471,28 @@ class ElasticLine:
             free[0] = False
         idx = np.sort(np.concatenate([4 * np.flatnonzero(free), 4 * np.flatnonzero(free) + 1]))
         mrow = np.repeat(self.m[free], 2)
-
-        def potential(zz):
-            mm = self.measure(0.0, zz)
-            return float(mm[13] + mm[14])
+        mdiag = sp.diags(np.concatenate([np.repeat(self.m, 4), [1.0, 1.0]]))
 
         def grad_hess(zz):
             dz = self.rhs(0.0, zz)
             J = self.jac(0.0, zz)
             # forces (mass x acceleration) and the stiffness -dF/dr, on the free position unknowns
             f = (dz[idx + 2] * mrow)
-            K = -(sp.diags(np.concatenate([np.repeat(self.m, 4), [1.0, 1.0]])) @ J).tocsr()[idx + 2][:, idx].tocsc()
+            K = -(mdiag @ J).tocsr()[idx + 2][:, idx].tocsc()
             return f, K
 
         scale = float(self.m.sum()) * max(self.g, 1e-300)
         # the force's round-off: a position's last bit times the stiffest link's EA/h
         floor = 16.0 * np.finfo(float).eps * float((self.ea / self.h).max()) * max(1.0, float(np.abs(z).max()))
-        mu = 1e-3 * float(self.ea.max() / self.h.min())
-        P = potential(z)
-        for _ in range(max_iter):
-            f, K = grad_hess(z)
+        kscale = float(self.ea.max() / self.h.min())
+        D = sp.diags(mrow / self.m.mean())
+        zm, done = self._mixed(z, free, min(max_iter, 30))
+        z = zm if zm is not None else self._prestretched(z, free)
+        f, K = grad_hess(z)
+        fn = float(np.linalg.norm(f))
+        mu = 0.0
+        self.statics_iterations = 0
+        for it in range(done, max_iter):
             if np.abs(f).max() <= tol * scale + floor:
                 for _ in range(3):  # polish: plain Newton steps while the force still falls
                     zt = z.copy()
@@ -349,20 +501,26 @@ class ElasticLine:
                     if not np.abs(ft).max() < np.abs(f).max():
                         break
                     z, f, K = zt, ft, Kt
+                self.statics_iterations = it  # (mixed and stiffness Newton steps together)
                 return z
-            A = (K + sp.diags(mu * mrow / self.m.mean())).tocsc()
-            step = sp.linalg.spsolve(A, f)
-            zt = z.copy()
-            zt[idx] += step
-            Pt = potential(zt)
-            # (near the minimum the potential's change drowns in round-off: the force decides)
-            if Pt < P - 1e-12 * (abs(P) + scale) or np.abs(grad_hess(zt)[0]).max() < np.abs(f).max():
-                z, P = zt, Pt
-                mu *= 0.1
+            step = sp.linalg.spsolve((K + mu * D).tocsc() if mu > 0.0 else K, f)
+            alpha, ok = 1.0, False
+            if np.all(np.isfinite(step)):
+                for _ in range(30):  # backtrack on the force norm (Armijo)
+                    zt = z.copy()
+                    zt[idx] += alpha * step
+                    ft, Kt = grad_hess(zt)
+                    ftn = float(np.linalg.norm(ft))
+                    if ftn <= (1.0 - 1e-4 * alpha) * fn:
+                        ok = True
+                        break
+                    alpha *= 0.5
+            if ok:
+                z, f, K, fn = zt, ft, Kt, ftn
+                mu = 0.0 if mu < 1e-9 * kscale else 0.1 * mu
             else:
-                mu = max(mu * 10.0, 1e-12)
+                mu = max(10.0 * mu, 1e-9 * kscale)
         from .errors import SimulationError
 
         raise SimulationError(f"statics: no equilibrium within {max_iter} Newton steps (largest force "
-                              f"{np.abs(grad_hess(z)[0]).max():.3g})")
-
+                              f"{np.abs(f).max():.3g})")
