@@ -2,6 +2,7 @@
 
 * :mod:`~snapping.simulate.elastic_model`: what the line is made of (:class:`Elastic`) and the
   line itself (:class:`ElasticLine`: the problem's links as springs, the starts, the statics);
+* :mod:`~snapping.simulate.elastic_statics`: the static equilibrium (the stretched start);
 * :mod:`~snapping.simulate.elastic_kernels`: the compiled forces, banded Jacobian, measures;
 * :mod:`~snapping.simulate.elastic_solve`: the stepping (:func:`solve`) and the run Dataset;
 * :mod:`~snapping.simulate.elastic_rodas`: the compiled RODAS4 (``method="rodas4"``);

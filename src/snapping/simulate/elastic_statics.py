@@ -1,0 +1,258 @@
+"""The static equilibrium of the extensible line (:class:`~snapping.simulate.elastic_model.ElasticLine`):
+the ``"stretched"`` start, and the hanging line's stretch.
+
+The equilibrium minimises the potential energy (elastic + gravity), convex for tension-only
+links. Newton on the stiffness alone stalls on a long, stiff line started from its
+unstretched shape (links at rest length carry no tension, so the geometric stiffness
+``T/l`` that holds the nodes sideways is zero, and a step's sideways part ``d`` overstretches
+a link by ``d^2/(2 h)``, a force ``EA d^2/(2 h^2)``): N = 1000, c = 30 took 2,000 damped
+steps. So :func:`statics` first takes the start as a rigid chain (:func:`rigid_tensions`)
+and solves for the small stretch in mixed form (:func:`mixed`: positions and tensions, a
+Newton matrix that stays well conditioned as EA -> infinity), a few O(N) steps at any N
+and stiffness; a few Newton steps on the stiffness then reach the force's round-off.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg  # noqa: F401  (so that sp.linalg is there)
+
+__all__ = ["statics", "mixed", "rigid_tensions", "strain_of"]
+
+
+def _solve(A, b) -> np.ndarray:
+    """``spsolve``, with NaNs (no warning) where ``A`` is singular: the callers fall back."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", sp.linalg.MatrixRankWarning)
+        return sp.linalg.spsolve(A, b)
+
+
+def strain_of(line, T: np.ndarray) -> np.ndarray:
+    """The strain at which each link's law gives the tension ``T`` (>= 0): ``T/EA`` or the
+    table's inverse (extended with its last slope)."""
+    if line.tabe.size == 0:
+        return T / line.ea
+    e, t = line.tabe, line.tabt
+    out = np.interp(T, t, e)
+    far = T > t[-1]
+    out[far] = e[-1] + (T[far] - t[-1]) * (e[-1] - e[-2]) / (t[-1] - t[-2])
+    return out
+
+
+def mixed(line, z: np.ndarray, free: np.ndarray, max_iter: int):
+    """The statics in mixed form, from ``z``'s shape taken as a rigid chain: unknowns the
+    node positions and the link tensions, equations the force balance of the free nodes
+    and each link's length ``l_j = h_j (1 + e_j(T_j))``; its Newton matrix stays well
+    conditioned however stiff the links (EA -> infinity is the rigid chain), so a few steps
+    (O(N) each: sparse, banded) take the rigid shape to the stretched one. Returns
+    (positions z, Newton steps), or (None, steps) where it does not converge or some
+    tension comes out negative (a slack equilibrium: the caller's damped iteration
+    takes over)."""
+    N = line.N
+    pin = line.pin_state(0.0)
+    X = np.empty(3 * N)
+    X[0:2 * N:2], X[1:2 * N:2] = z[0:4 * N:4], z[1:4 * N:4]
+    X[2 * N:] = 0.0
+    held0 = X[0:2].copy()
+    e0 = line.ea if line.tabe.size == 0 else np.full(N, (line.tabt[1] - line.tabt[0]) / (line.tabe[1] - line.tabe[0]))
+    j = np.arange(N)
+    px, py = 2 * j, 2 * j + 1  # position unknowns of node j
+    tj = 2 * N + j  # tension unknowns
+    nxt = j + 1 < N
+
+    def residual_jac(X):
+        x, y = np.append(X[0:2 * N:2], pin[0]), np.append(X[1:2 * N:2], pin[1])
+        T = X[2 * N:]
+        dx, dy = np.diff(x), np.diff(y)
+        ln = np.hypot(dx, dy)
+        ux, uy = dx / ln, dy / ln
+        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), T / e0)
+        if line.tabe.size == 0:
+            slope = line.ea
+        else:  # (the segment's slope, as the law's)
+            k = np.clip(np.searchsorted(line.tabe, e) - 1, 0, line.tabe.size - 2)
+            slope = np.maximum(np.diff(line.tabt)[k] / np.diff(line.tabe)[k], 1e-300)
+        de = 1.0 / np.where(T > 0.0, slope, e0)
+        # force balance: node i gets +T_i u_i and -T_{i-1} u_{i-1}, gravity g e_y
+        Fx, Fy = T * ux, T * uy + line.m * line.g
+        Fx[1:] -= (T * ux)[:-1]
+        Fy[1:] -= (T * uy)[:-1]
+        G = ln / line.h - 1.0 - e
+        R = np.concatenate([np.column_stack([Fx, Fy]).ravel(), G])
+        q = T / ln
+        Pxx, Pxy, Pyy = q * (1 - ux * ux), -q * ux * uy, q * (1 - uy * uy)
+        rows, cols, vals = [], [], []
+
+        def add(r, c, v):
+            rows.append(r), cols.append(c), vals.append(v)
+
+        # link j between node j and node j+1 (the pin beyond N-1): dF_j/dr_j = -P_j, dF_j/dr_{j+1} = P_j
+        for (ra, ca, v) in ((px, px, Pxx), (px, py, Pxy), (py, px, Pxy), (py, py, Pyy)):
+            add(ra, ca, -v)
+            add(ra[nxt], ca[nxt] + 2, v[nxt])  # node j, by node j+1
+            add(ra[nxt] + 2, ca[nxt], v[nxt])  # node j+1, by node j
+            add(ra[nxt] + 2, ca[nxt] + 2, -v[nxt])  # node j+1, by itself
+        add(px, tj, ux)
+        add(py, tj, uy)
+        add(px[nxt] + 2, tj[nxt], -ux[nxt])
+        add(py[nxt] + 2, tj[nxt], -uy[nxt])
+        add(tj, px, -ux / line.h)
+        add(tj, py, -uy / line.h)
+        add(tj[nxt], px[nxt] + 2, ux[nxt] / line.h[nxt])
+        add(tj[nxt], py[nxt] + 2, uy[nxt] / line.h[nxt])
+        add(tj, tj, -de)
+        r, c, v = (np.concatenate(a) for a in (rows, cols, vals))
+        if not free[0]:  # node 0 held: its rows say X[0:2] = held0
+            keep = r >= 2
+            r, c, v = np.concatenate([r[keep], [0, 1]]), np.concatenate([c[keep], [0, 1]]), \
+                np.concatenate([v[keep], [1.0, 1.0]])
+            R[0:2] = X[0:2] - held0
+        return R, sp.csc_matrix((v, (r, c)), shape=(3 * N, 3 * N)), T
+
+    X[2 * N:] = rigid_tensions(line, z, free)
+    for it in range(1, max_iter + 1):
+        R, J, T = residual_jac(X)
+        dX = _solve(J, -R)
+        if not np.all(np.isfinite(dX)):
+            return None, it
+        X = X + dX
+        if np.abs(dX[:2 * N]).max() <= 1e-13 * max(1.0, float(np.abs(X[:2 * N]).max())):
+            if X[2 * N:].min() < 0.0:
+                return None, it
+            zz = z.copy()
+            zz[0:4 * N:4], zz[1:4 * N:4] = X[0:2 * N:2], X[1:2 * N:2]
+            return zz, it
+    return None, max_iter
+
+
+def rigid_tensions(line, z: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """The link tensions (>= 0) that balance gravity on ``z``'s shape held as a rigid chain:
+    least squares over the free nodes' force balance (banded normal equations; exact when
+    the shape is the rigid chain's equilibrium, as the catenary start)."""
+    N = line.N
+    x, y = np.append(z[0:4 * N:4], line.pin_state(0.0)[0]), np.append(z[1:4 * N:4], line.pin_state(0.0)[1])
+    dx, dy = np.diff(x), np.diff(y)
+    ln = np.hypot(dx, dy)
+    ux, uy = dx / ln, dy / ln
+    # node i (free): T_i u_i - T_{i-1} u_{i-1} = -m_i g e_y
+    nodes = np.flatnonzero(free)
+    rows, cols, vals = [], [], []
+    for comp, u in ((0, ux), (1, uy)):
+        r = 2 * np.arange(nodes.size) + comp
+        rows += [r, r[nodes > 0]]
+        cols += [nodes, nodes[nodes > 0] - 1]
+        vals += [u[nodes], -u[nodes[nodes > 0] - 1]]
+    A = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(2 * nodes.size, N))
+    b = np.zeros(2 * nodes.size)
+    b[1::2] = -line.m[nodes] * line.g
+    AtA = (A.T @ A).tocsc()
+    # (a link no free node touches has no equation: its tension stays zero; a shape that
+    # does not fix its tensions, a straight line across gravity, gets the smallest ones)
+    d = AtA.diagonal()
+    AtA = AtA + sp.diags(np.where(d > 0.0, 1e-12 * d, 1.0))
+    return np.maximum(_solve(AtA, A.T @ b), 0.0)
+
+
+def statics(line, z0: np.ndarray, *, hold_free_end: bool = False, tol: float = 1e-12,
+            max_iter: int = 200) -> np.ndarray:
+    """The static equilibrium nearest ``z0`` (velocities zero; the held end at its t = 0
+    position; with ``hold_free_end`` node 0 held too): the minimum of the potential energy
+    (elastic + gravity), convex for tension-only links. First :func:`mixed` (Newton in
+    positions and tensions from ``z0``'s shape as a rigid chain: a few steps at any N and
+    stiffness), then at most a few Newton steps on the banded stiffness (O(N) each) to the
+    force's round-off, with a backtracking line search on the force norm. Where that fails
+    (a slack equilibrium, a shape far from any rigid equilibrium such as a straight line
+    across gravity), a Levenberg-damped Newton iteration on the stiffness. (That one alone
+    stalls on a long stiff line from the unstretched shape: the geometric stiffness T/l is
+    zero there, and a step's transverse part d overstretches the links by d^2/(2 h).)
+    ``line.statics_iterations`` records the Newton steps taken."""
+    N = line.N
+    z = z0.copy()
+    z[2:4 * N:4] = z[3:4 * N:4] = 0.0
+    z[4 * N:] = 0.0
+    free = np.ones(N, bool)
+    if hold_free_end:
+        free[0] = False
+    idx = np.sort(np.concatenate([4 * np.flatnonzero(free), 4 * np.flatnonzero(free) + 1]))
+    mrow = np.repeat(line.m[free], 2)
+    mdiag = sp.diags(np.concatenate([np.repeat(line.m, 4), [1.0, 1.0]]))
+
+    def grad_hess(zz):
+        dz = line.rhs(0.0, zz)
+        J = line.jac(0.0, zz)
+        # forces (mass x acceleration) and the stiffness -dF/dr, on the free position unknowns
+        f = (dz[idx + 2] * mrow)
+        K = -(mdiag @ J).tocsr()[idx + 2][:, idx].tocsc()
+        return f, K
+
+    scale = float(line.m.sum()) * max(line.g, 1e-300)
+    # the force's round-off: a position's last bit times the stiffest link's EA/h
+    floor = 16.0 * np.finfo(float).eps * float((line.ea / line.h).max()) * max(1.0, float(np.abs(z).max()))
+    kscale = float(line.ea.max() / line.h.min())
+    D = sp.diags(mrow / line.m.mean())
+
+    def potential(zz):
+        mm = line.measure(0.0, zz)
+        return float(mm[13] + mm[14])
+
+    def finish(z, f, K, it):
+        for _ in range(3):  # polish: plain Newton steps while the force still falls
+            zt = z.copy()
+            zt[idx] += _solve(K, f)
+            ft, Kt = grad_hess(zt)
+            if not np.abs(ft).max() < np.abs(f).max():
+                break
+            z, f, K = zt, ft, Kt
+        line.statics_iterations = it  # (mixed, stiffness and damped Newton steps together)
+        return z
+
+    zm, it = mixed(line, z, free, min(max_iter, 30))
+    if zm is not None:  # Newton on the stiffness, a backtracking line search on the force norm
+        z = zm
+        f, K = grad_hess(z)
+        fn = float(np.linalg.norm(f))
+        for _ in range(10):
+            if np.abs(f).max() <= tol * scale + floor:
+                return finish(z, f, K, it)
+            step = _solve(K, f)
+            alpha, ok = 1.0, False
+            while np.all(np.isfinite(step)) and alpha > 1e-6:
+                zt = z.copy()
+                zt[idx] += alpha * step
+                ft, Kt = grad_hess(zt)
+                ftn = float(np.linalg.norm(ft))
+                if ftn <= (1.0 - 1e-4 * alpha) * fn:
+                    ok = True
+                    break
+                alpha *= 0.5
+            if not ok:
+                break
+            z, f, K, fn = zt, ft, Kt, ftn
+            it += 1
+    # the damped iteration (where the mixed form fails: slack or a shape far from any rigid
+    # equilibrium, a straight line across gravity), Levenberg on the stiffness
+    mu = 1e-3 * kscale
+    P = potential(z)
+    for it in range(it, max_iter):
+        f, K = grad_hess(z)
+        if np.abs(f).max() <= tol * scale + floor:
+            return finish(z, f, K, it)
+        A = (K + mu * D).tocsc()
+        step = _solve(A, f)
+        zt = z.copy()
+        zt[idx] += step
+        Pt = potential(zt)
+        # (near the minimum the potential's change drowns in round-off: the force decides)
+        if Pt < P - 1e-12 * (abs(P) + scale) or np.abs(grad_hess(zt)[0]).max() < np.abs(f).max():
+            z, P = zt, Pt
+            mu *= 0.1
+        else:
+            mu = max(mu * 10.0, 1e-12)
+    from .errors import SimulationError
+
+    raise SimulationError(f"statics: no equilibrium within {max_iter} Newton steps (largest force "
+                          f"{np.abs(grad_hess(z)[0]).max():.3g})")
