@@ -121,8 +121,9 @@ def test_energy_balances_through_slack_and_taut(damping):
     s = r.summary()
     assert s["n_slack_steps"] > 10
     # (measured 1.2e-11 undamped; damped 3.1e-9 at tol 1e-9 and 1.1e-8 at 1e-7: with damping the
-    # tension jumps by c de/dt where a link goes taut, and the balance stalls at the jumps, as Radau's)
-    assert s["energy_drift"] < (1e-8 if damping else 1e-10)
+    # tension jumps by c de/dt where a link goes taut, and the balance stalls at the jumps, as Radau's;
+    # there it hangs on round-off: a start moved by 6e-17 (elfix's statics) gives 1.7e-8)
+    assert s["energy_drift"] < (3e-8 if damping else 1e-10)
     if damping:
         assert s["dissipated_total"] > 5e-5
         # (a Rosenbrock step's weights are not all positive: D may fall by the step's error)
