@@ -113,18 +113,22 @@ def mixed(line, z: np.ndarray, free: np.ndarray, max_iter: int):
         return R, sp.csc_matrix((v, (r, c)), shape=(3 * N, 3 * N)), T
 
     X[2 * N:] = rigid_tensions(line, z, free)
+    rprev = np.inf
     for it in range(1, max_iter + 1):
         R, J, T = residual_jac(X)
+        rn = float(np.abs(R).max())
         dX = _solve(J, -R)
         if not np.all(np.isfinite(dX)):
             return None, it
         X = X + dX
-        if np.abs(dX[:2 * N]).max() <= 1e-13 * max(1.0, float(np.abs(X[:2 * N]).max())):
+        # (converged: the step at the positions' round-off, or the residual no longer falls)
+        if np.abs(dX[:2 * N]).max() <= 1e-13 * max(1.0, float(np.abs(X[:2 * N]).max())) or rn >= rprev:
             if X[2 * N:].min() < 0.0:
                 return None, it
             zz = z.copy()
             zz[0:4 * N:4], zz[1:4 * N:4] = X[0:2 * N:2], X[1:2 * N:2]
             return zz, it
+        rprev = rn
     return None, max_iter
 
 
