@@ -512,6 +512,11 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
     t1 = time.perf_counter()
     stability_lines = _stability(plan, out, figdir, log)
     timings["stability (3D)"] = time.perf_counter() - t1
+    t1 = time.perf_counter()
+    from .caps_report import section as caps_section  # beyond the paper: what caps the snap (issue 24)
+
+    caps_lines = caps_section(mode, out, figdir, log)
+    timings["what caps the snap"] = time.perf_counter() - t1
 
     # ---------------------------------------------------------------- REPORT.md
     timings["total"] = time.perf_counter() - t0
@@ -522,7 +527,7 @@ def reproduce(out_dir, mode: str = "quick", *, workers: int | None = None, progr
              "| claim | measured here | paper | verdict |", "|---|---|---|---|"]
     lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
     lines += [""] + continuum_lines + [""]
-    lines += stability_lines + [""]
+    lines += stability_lines + [""] + caps_lines + [""]
     lines += ["", "## Fit report per run (Fig. 3 as numbers)", ""]
     for res in results:
         lines += [f"### chi = {res.chi:g}, N = {res.N}: t*_chi = {res.snap.t_star:.6f} ± {res.snap.t_star_err:.1e}", "", "```"]
