@@ -85,7 +85,8 @@ def test_stretching_left_out_below_the_threshold_and_run_above():
 
 
 @pytest.mark.parametrize("kw,name", [({"ei": -1.0}, "ei"), ({"ea": 0.0}, "ea"), ({"diameter": -1e-3}, "diameter"),
-                                     ({"end_mass": -0.1}, "end_mass"), ({"air_density": 0.0}, "air_density"),
+                                     ({"end_mass": -0.1}, "end_mass"), ({"end_mass": 1e308}, "end_mass"),
+                                     ({"air_density": 0.0}, "air_density"),
                                      ({"cd_normal": float("nan")}, "cd_normal"), ({"length": -2.0}, "length")])
 def test_bad_input_is_refused_naming_the_parameter(kw, name):
     with pytest.raises(SnappingInputError, match=rf"^{name}="):

@@ -165,10 +165,19 @@ def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None
                     ln if ln.taper is not None else None)
 
 
+#: the largest end mass, as a ratio to the line's mass
+END_MASS_MAX = 1e4
+
+
 def _as_spec(line_or_spec, params: dict) -> LineSpec:
     if isinstance(line_or_spec, LineSpec):
-        return replace(line_or_spec, **params) if params else line_or_spec
-    return spec(line_or_spec, **params)
+        sp = replace(line_or_spec, **params) if params else line_or_spec
+    else:
+        sp = spec(line_or_spec, **params)
+    if sp.end_mass > END_MASS_MAX * sp.mass:
+        raise V.SnappingInputError(f"end_mass={sp.end_mass!r} is out of range: at most {END_MASS_MAX:g} times the "
+                                   f"line's mass ({sp.mass:g} kg)")
+    return sp
 
 
 def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper"):
