@@ -10,8 +10,9 @@ Two parts, each claim a computed verdict:
   (:func:`snapping.regimes.load_study`), else a small live study (:data:`LIVE`), reported by
   :func:`snapping.regimes_analysis.report` (laws and crossovers) with the regime map.
 
-:func:`section` is what :func:`snapping.reproduce.reproduce` calls (``quick``: N = 100 and the
-smallest live study, about 10-20 s; ``full``: N = 400 and a larger one).
+:func:`section` is what :func:`snapping.reproduce.reproduce` calls with the plan's ``caps_N`` and
+``caps_live`` (``quick``: N = 100 and the smallest live study, about 10 s of CPU; ``full``:
+N = 400 and two live studies of 3 chi x 4-5 numbers at 4 levels).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ OWN_LINKS = {"ball-chain": 229}
 #: an answer is resolved when its tension moves by at most this much from N/2 to N
 RESOLVED = 0.01
 #: the live studies when no study file is shipped: mode -> (mechanism, chis, numbers, levels, first level)
-LIVE = {"quick": [("end-mass", (0.4,), (0.03, 0.3, 3.0), 3, -3)],
+LIVE = {"tiny": [("end-mass", (0.5,), (1.0,), 2, -4)],
+        "quick": [("end-mass", (0.4,), (0.03, 0.3, 3.0), 3, -3)],
         "full": [("end-mass", (0.15, 0.25, 0.4), (0.01, 0.1, 0.3, 1.0, 3.0), 4, -1),
                  ("drag", (0.15, 0.25, 0.4), (0.01, 0.1, 1.0, 10.0), 4, -1)]}
 
@@ -53,15 +55,16 @@ def resolved_words(r: dict) -> str:
             f"not resolved to {RESOLVED:.0%} ({d:+.1%} from N/2)")
 
 
-def catalogue_table(answers: list[dict]) -> list[str]:
+def catalogue_table(answers: list[dict], seconds: bool = True) -> list[str]:
     """Markdown rows: line, chi, N, ideal and real peak tension (N), factor, capping
-    mechanism, resolution, evaluations and CPU seconds."""
+    mechanism, resolution, evaluations and (``seconds``) CPU seconds."""
     out = ["| line | chi | N | ideal peak tension (N) | real peak tension (N) | factor | capped by | resolution "
-           "(tension) | evaluations | CPU s |", "|---|---|---|---|---|---|---|---|---|---|"]
+           "(tension) | evaluations |" + (" CPU s |" if seconds else ""),
+           "|---|---|---|---|---|---|---|---|---|" + ("---|" if seconds else "")]
     for r in answers:
         out.append(f"| {r['line']} | {r['chi']:g} | {r['N']} | {r['ideal']['sigma_peak']:.4g} | "
                    f"{r['real']['sigma_peak']:.4g} | {r['factor']['sigma_peak']:.3f} | {r['cap']} | "
-                   f"{resolved_words(r)} | {r['n_rhs']} | {r.get('cpu', r['wall']):.1f} |")
+                   f"{resolved_words(r)} | {r['n_rhs']} |" + (f" {r.get('cpu', r['wall']):.1f} |" if seconds else ""))
     return out
 
 
@@ -108,7 +111,7 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
              "the full inextensible model (bending + drag + end mass + taper), stretching as an elastic/rigid factor "
              f"where the ideal peak speed reaches {caps.STRETCH_MATTERS:g} of the wave speed, and each mechanism "
              f"alone. Rule: {answers[0]['rule'] if answers else ''}.", ""]
-    lines += catalogue_table(answers) + [""]
+    lines += catalogue_table(answers, seconds=False) + [""]
     for r in answers:
         q = r["quantity"]
         who = ("nothing but the ideal chain's own cap" if r["cap"] == "none" else f"**{r['cap']}**")
@@ -132,15 +135,33 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
     return lines
 
 
-def section(mode: str, out: Path, figdir: Path, log=print) -> list[str]:
-    """Compute and write the section for :func:`snapping.reproduce.reproduce` (``mode`` quick
-    or full): the catalogue at chi = 0.25, the studies, a regime map per study."""
+def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
+    """Compute and write the section for :func:`snapping.reproduce.reproduce`: the catalogue at
+    chi = 0.25 on ``N`` links (kept in ``out/caps/answers.json`` and reused while ``N`` is the
+    same), the studies (shipped, else the live studies ``LIVE[live]``, kept in
+    ``out/regimes``), a regime map per study."""
+    import json
+
     from . import figures
+    from ._files import write_atomic
     from .regimes_analysis import regime_map
 
     t0 = time.perf_counter()
-    answers = catalogue(0.25, CATALOGUE_N.get(mode, CATALOGUE_N["full"]))
-    found = studies(mode if mode in LIVE else "full", out_dir=Path(out) / "regimes", log=log)
+    if live not in LIVE:
+        from ._validate import SnappingInputError
+
+        raise SnappingInputError(f"live={live!r} is not one of {sorted(LIVE)}")
+    path = Path(out) / "caps" / "answers.json"
+    params = {"chi": 0.25, "N": int(N), "tol": 1e-6}
+    saved = json.loads(path.read_text()) if path.is_file() else {}
+    if saved.get("params") == params:
+        answers = saved["answers"]
+    else:
+        answers = catalogue(params["chi"], params["N"], tol=params["tol"])
+        path.parent.mkdir(parents=True, exist_ok=True)
+        text = json.dumps({"params": params, "answers": answers}, default=float)
+        write_atomic(path, lambda tmp: Path(tmp).write_text(text), name="caps answers")
+    found = studies(live, out_dir=Path(out) / "regimes", log=log)
     names = []
     for ds in found:
         name = f"fig7_regime_map_{ds.attrs['mechanism']}"
