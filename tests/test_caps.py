@@ -157,3 +157,15 @@ def test_report_uses_shipped_study_files(tmp_path):
     text = "\n".join(caps_report.report_section([_answer("a", 10.0, 9.5, "none", 0.001)], found, ["fig"]))
     assert "### Regime study: end-mass (shipped study file)" in text and "**Verdict (computed, v_peak): chi=0.5:" in text
     assert "![fig](figures/fig.png)" in text
+
+
+def test_auto_links_stop_when_the_peak_moves_by_one_percent():
+    # heavy drag (drag number 3.8): its tension is resolved to 1% by 200-400 links
+    r = caps.cap(None, 0.3, N="auto", length=L, mass=M, diameter=0.05, alone=False)
+    assert r["auto_N"][0] == 100 and r["N"] == r["auto_N"][-1] and r["resolved"]
+    direct = {n: _si(run(Problem.catenary(0.3, links=Links.uniform(n), body=Body.from_si(L, M, G, diameter=0.05)),
+                         method="fast", tol=1e-6, progress=False).dataset, L, M)["sigma_peak"] for n in r["auto_N"][-2:]}
+    lo, hi = r["auto_N"][-2:]
+    assert r["real"]["sigma_peak"] == pytest.approx(direct[hi], rel=1e-9)
+    assert r["resolution"]["sigma_peak"] == pytest.approx((direct[hi] - direct[lo]) / direct[hi], rel=1e-9)
+    assert abs(r["resolution"]["sigma_peak"]) <= 0.01

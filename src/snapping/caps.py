@@ -49,13 +49,16 @@ from dataclasses import dataclass, replace
 
 from . import _validate as V
 
-__all__ = ["LineSpec", "spec", "cap", "design", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS",
+__all__ = ["LineSpec", "spec", "cap", "design", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
 #: the ideal run's peak speed over the wave speed above which the stretching is run
 STRETCH_MATTERS = 0.05
 #: links of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
+#: the links tried by ``N="auto"``, doubling, and the change of a peak from one to the next that stops it
+AUTO_N = (100, 200, 400, 800, 1600)
+RESOLVED = 0.01
 #: the peaks answered: (name, SI units)
 QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
 #: the mechanisms, in the order they are tried
@@ -252,8 +255,10 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         A catalogue line, a Line, a :class:`LineSpec`, or None (the ``params`` alone).
     chi : float
         End separation over the length, in (0, 1).
-    N : int
-        Links of the runs (2 to 20000).
+    N : int or "auto"
+        Links of the runs (2 to 20000); ``"auto"``: doubled from 100 (:data:`AUTO_N`) until the
+        full run's ``quantity`` moves by at most 1% (:data:`RESOLVED`; then ``resolved`` True
+        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False).
     tol : float
         The fast method's tolerance.
     quantity : str
@@ -279,6 +284,8 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
     t0, c0 = time.perf_counter(), time.process_time()
     sp = _as_spec(line, params)
     chi = check_chi(chi)
+    if isinstance(N, str) and N == "auto":
+        return _auto(sp, chi, tol, quantity, alone, t0, c0)
     N = V.integer("N", N, 2, 20000)
     tol = V.open_interval("tol", tol, 0.0, 1e-2)
     if quantity not in QUANTITIES:
@@ -345,6 +352,29 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
             "n_rhs": n_rhs, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
 
 
+def _auto(sp: LineSpec, chi: float, tol: float, quantity: str, alone: bool, t0: float, c0: float) -> dict:
+    """``N="auto"``: the full run on :data:`AUTO_N` links, doubling, until ``quantity`` moves by at
+    most :data:`RESOLVED` from one to the next (or the last); then :func:`cap` on those links,
+    its resolution the last two full runs'."""
+    if quantity not in QUANTITIES:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
+    on = tuple(m for m in MECHANISMS[:-1] if sp.has(m))
+    prev, n_rhs = None, 0
+    for n in AUTO_N:
+        cur = _run(problem(sp, chi, n, on), tol)
+        n_rhs += cur["n_rhs"]
+        if prev is not None and abs(cur[quantity] - prev[quantity]) <= RESOLVED * abs(cur[quantity]):
+            break
+        prev = cur
+    r = cap(sp, chi, N=n, tol=tol, quantity=quantity, check=False, alone=alone)
+    r["resolution"] = {q: (cur[q] - prev[q]) / cur[q] for q in QUANTITIES}
+    r["resolved"] = abs(r["resolution"][quantity]) <= RESOLVED
+    r["auto_N"] = [m for m in AUTO_N if m <= n]
+    r["n_rhs"] += n_rhs
+    r["wall"], r["cpu"] = time.perf_counter() - t0, time.process_time() - c0
+    return r
+
+
 def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int = 200, tol: float = 1e-6,
            max_tension=None, max_speed=None, max_acceleration=None, **params) -> dict:
     """Which end separations keep the real line's peaks under the limits: :func:`cap` (ideal
@@ -383,6 +413,9 @@ def format_answer(r: dict) -> list[str]:
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
             f"{m} {v[r['quantity']]:.5g}" for m, v in r["alone"].items()))
     out.append(f"  stretching: {r['stretching']['why']}")
+    if r.get("auto_N"):
+        out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
+                   f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
     if r["resolution"]:
         out.append("  resolution (full run, N/2 -> N): " + ", ".join(f"{q} {v:+.2%}" for q, v in r["resolution"].items()))
     verdict = ("nothing but the ideal chain's own cap (real within 10% of ideal)" if r["cap"] == "none" else r["cap"])

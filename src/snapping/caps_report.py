@@ -38,10 +38,11 @@ LIVE = {"tiny": [("end-mass", (0.5,), (1.0,), 2, -4)],
 
 def catalogue(chi: float = 0.25, N: int = 200, *, tol: float = 1e-6, check: bool = True, names=None) -> list[dict]:
     """:func:`snapping.caps.cap` for each catalogue line (``names``: all) at ``chi``, on ``N``
-    links (a line with links of its own, the ball chain: on those)."""
+    links (``"auto"``: :func:`snapping.caps.cap`'s; a line with links of its own, the ball chain:
+    on those)."""
     from . import caps, lines
 
-    return [caps.cap(name, chi, N=OWN_LINKS.get(name, N), tol=tol, check=check)
+    return [caps.cap(name, chi, N=OWN_LINKS.get(name, N), tol=tol, check=check and N != "auto")
             for name in (names or lines.names())]
 
 

@@ -25,6 +25,9 @@ def add_real_options(p) -> None:
     g.add_argument("--end-mass", type=float, default=None, metavar="KG", help="a point mass at the free end, kg")
     g.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",
                    help="drag area C_d A of the free end's tip body in m^2")
+    g.add_argument("--resolve", action="store_true",
+                   help="double the links from 100 (to 1600 at most) until the peak of --quantity moves by at most "
+                        "1%% (instead of --links)")
     g.add_argument("--quantity", default="sigma_peak", choices=("sigma_peak", "v_peak", "a_peak"),
                    help="the peak that decides the capping mechanism (default the tension)")
 
@@ -66,7 +69,10 @@ def cmd_real_estimate(args) -> int:
     if args.tip_mass:
         raise SnappingInputError(f"--tip-mass {args.tip_mass:g} is a ratio for the ideal chain; give --end-mass KG")
     sp = _spec(args)
-    r = caps.cap(sp, _chi(args, sp), N=200 if args.links is None else args.links, quantity=args.quantity)
+    if args.resolve and args.links is not None:
+        raise SnappingInputError("--resolve chooses the links itself: give --resolve or --links, not both")
+    N = "auto" if args.resolve else (200 if args.links is None else args.links)
+    r = caps.cap(sp, _chi(args, sp), N=N, quantity=args.quantity)
     if args.json:
         print_json({**r, "dimensionless_numbers": r["numbers"]})
     else:
@@ -83,6 +89,8 @@ def cmd_real_design(args) -> int:
         raise SnappingInputError("--plot is drawn from the ideal chain's table; a real line's design prints its rows")
     if args.tip_mass is not None:
         raise SnappingInputError(f"--tip-mass {args.tip_mass:g} is a ratio for the ideal chain; give --end-mass KG")
+    if args.resolve:
+        raise SnappingInputError("--resolve is snapping estimate's: give --links for a design")
     sp = _spec(args)
     kw = {} if args.chis is None else {"chis": args.chis}
     d = caps.design(sp, N=200 if args.links is None else args.links, max_tension=args.max_tension,
