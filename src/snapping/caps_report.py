@@ -31,7 +31,7 @@ OWN_LINKS = {"ball-chain": 229}
 RESOLVED = 0.01
 #: the live studies when no study file is shipped: mode -> (mechanism, chis, numbers, levels, first level)
 LIVE = {"tiny": [("end-mass", (0.5,), (1.0,), 2, -4)],
-        "quick": [("end-mass", (0.4,), (0.03, 0.3, 3.0), 3, -3)],
+        "quick": [("end-mass", (0.5,), (0.001, 0.01), 3, -3)],
         "full": [("end-mass", (0.15, 0.25, 0.4), (0.01, 0.1, 0.3, 1.0, 3.0), 4, -1),
                  ("drag", (0.15, 0.25, 0.4), (0.01, 0.1, 1.0, 10.0), 4, -1)]}
 
