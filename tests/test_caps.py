@@ -169,3 +169,15 @@ def test_auto_links_stop_when_the_peak_moves_by_one_percent():
     assert r["real"]["sigma_peak"] == pytest.approx(direct[hi], rel=1e-9)
     assert r["resolution"]["sigma_peak"] == pytest.approx((direct[hi] - direct[lo]) / direct[hi], rel=1e-9)
     assert abs(r["resolution"]["sigma_peak"]) <= 0.01
+
+
+def test_auto_links_not_resolved_says_so(monkeypatch):
+    """Past the last links the answer is not resolved, and its resolution is the last two runs' change."""
+    monkeypatch.setattr(caps, "AUTO_N", (10, 20))
+    r = caps.cap(None, 0.3, N="auto", length=L, mass=M, end_mass=0.05, alone=False)
+    runs = {n: _si(run(Problem.catenary(0.3, links=Links.uniform(n, tip_mass=0.5)), method="fast", tol=1e-6,
+                       progress=False).dataset, L, M) for n in (10, 20)}
+    change = (runs[20]["sigma_peak"] - runs[10]["sigma_peak"]) / runs[20]["sigma_peak"]
+    assert abs(change) > 0.01  # (this chain is not resolved at 20 links)
+    assert r["N"] == 20 and r["auto_N"] == [10, 20] and r["resolved"] is False
+    assert r["resolution"]["sigma_peak"] == pytest.approx(change, rel=1e-9)

@@ -359,13 +359,13 @@ def _auto(sp: LineSpec, chi: float, tol: float, quantity: str, alone: bool, t0: 
     if quantity not in QUANTITIES:
         raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
     on = tuple(m for m in MECHANISMS[:-1] if sp.has(m))
-    prev, n_rhs = None, 0
+    runs, n_rhs = [], 0
     for n in AUTO_N:
-        cur = _run(problem(sp, chi, n, on), tol)
-        n_rhs += cur["n_rhs"]
-        if prev is not None and abs(cur[quantity] - prev[quantity]) <= RESOLVED * abs(cur[quantity]):
+        runs.append(_run(problem(sp, chi, n, on), tol))
+        n_rhs += runs[-1]["n_rhs"]
+        if len(runs) > 1 and abs(runs[-1][quantity] - runs[-2][quantity]) <= RESOLVED * abs(runs[-1][quantity]):
             break
-        prev = cur
+    prev, cur = runs[-2], runs[-1]
     r = cap(sp, chi, N=n, tol=tol, quantity=quantity, check=False, alone=alone)
     r["resolution"] = {q: (cur[q] - prev[q]) / cur[q] for q in QUANTITIES}
     r["resolved"] = abs(r["resolution"][quantity]) <= RESOLVED
