@@ -42,8 +42,11 @@ def catalogue(chi: float = 0.25, N: int = 200, *, tol: float = 1e-6, check: bool
     on those)."""
     from . import caps, lines
 
-    return [caps.cap(name, chi, N=OWN_LINKS.get(name, N), tol=tol, check=check and N != "auto")
-            for name in (names or lines.names())]
+    out = []
+    for name in names or lines.names():
+        n = OWN_LINKS.get(name, N)
+        out.append(caps.cap(name, chi, N=n, tol=tol, check=check and n != "auto"))
+    return out
 
 
 def resolved_words(r: dict) -> str:
