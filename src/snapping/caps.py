@@ -37,8 +37,16 @@ With ``check=True`` the full run is repeated on N/2 links: the relative change o
 the answer's resolution check (the peaks of a continuous line converge as the links shrink
 below the capping scale; the ideal chain's do not: its peaks grow with N).
 
->>> r = cap("ball-chain", 0.25, N=40, check=False)            # doctest: +SKIP
->>> r["cap"], round(r["factor"]["sigma_peak"], 3)             # doctest: +SKIP
+>>> sp = spec("bungee-cord")                      # 1 m of 10 mm shock cord (snapping.lines)
+>>> [m for m in MECHANISMS if sp.has(m)], round(sp.ea, 1)
+(['bending', 'drag', 'stretching'], 200.0)
+>>> r = cap(None, 0.3, N=16, check=False, length=2.0, mass=0.1)   # every mechanism off: the ideal chain
+>>> r["cap"], r["factor"]["sigma_peak"]
+('none', 1.0)
+>>> spec(None, length=2.0, mass=0.1, ei=-1.0)
+Traceback (most recent call last):
+...
+snapping._validate.SnappingInputError: ei=-1.0 is out of range: must be finite and >= 0 (N m2)
 """
 
 from __future__ import annotations
