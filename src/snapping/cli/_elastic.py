@@ -100,17 +100,22 @@ def elastic_from_args(args, scales):
     given = _given(args)
     if not given:
         return None
-    if args.method in ("euler-richardson", "euler-richardson-fixed"):
+    if getattr(args, "method", None) in ("euler-richardson", "euler-richardson-fixed"):
         opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
         raise SnappingInputError(f"{opt} (the extensible line) with --method {args.method}: the paper's method steps "
                                  f"rigid links only; use --method fast (Radau) or dop853")
     for dest, why in NOT_ELASTIC.items():
         if dest in getattr(args, "_explicit", ()) and getattr(args, dest, None) not in (None, False):
             raise SnappingInputError(f"{why} cannot be given with the extensible line (--ea/--stretching/...)")
+    if getattr(args, "method", None) not in (None, "fast", "dop853", "radau", "euler-richardson",
+                                             "euler-richardson-fixed"):
+        opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
+        raise SnappingInputError(f"--method {args.method} with {opt} (the extensible line): its methods are fast "
+                                 f"(Radau on the banded Jacobian) and dop853")
     from ._body import body_from_args
     from .simulate3d import wants_3d
 
-    if wants_3d(args):
+    if hasattr(args, "dims") and wants_3d(args):
         raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
                                  "--perturb or --whirl")
     if body_from_args(args) is not None:
