@@ -141,10 +141,12 @@ def figure(ds, path=None):
         raise V.SnappingInputError("ds is not a run of the extensible line (no 'strain' and 'elastic_energy')")
     fig, (a0, a1, a2) = plt.subplots(1, 3, figsize=(15.5, 4.4))
     fig.subplots_adjust(left=0.06, right=0.98, bottom=0.13, top=0.88, wspace=0.32)
-    t_snap = float(ds.attrs.get("t_snap_v", np.nan))
+    t_snap = float(ds.attrs.get("t_snap_v", np.nan)) if int(ds.attrs.get("snap_reached", 1)) else np.nan
     im = strain_panel(ds, a0, t_snap)
     fig.colorbar(im, ax=a0, label="strain")
     energy_panels(ds, a1, a2, t_snap)
+    for ax, k in zip((a0, a1, a2), "abc"):  # (the overview's panel letters, renamed)
+        ax.set_title(f"({k})" + ax.get_title(loc="left")[3:], loc="left", fontsize=10)
     if path is not None:
         fig.savefig(path, dpi=110)
     return fig
