@@ -291,8 +291,7 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         pts = np.column_stack([X[i], H[i]])
         return np.stack([pts[:-1], pts[1:]], axis=1)
 
-    cmap = plt.get_cmap("viridis").copy()
-    cmap.set_bad("0.72")  # (a slack link of the extensible line)
+    cmap = plt.get_cmap("viridis").with_extremes(bad="0.72")  # (bad: a slack link of the extensible line)
 
     def values(i):
         return np.ma.masked_invalid(np.maximum(seg_speed[i], vmin)) if strain else np.maximum(seg_speed[i], vmin)

@@ -15,7 +15,7 @@ Example
 ...                 coords={"t_snapshot": ("snapshot", [0.5, 0.0]), "s_link": ("link", [0.75, 0.25])})
 >>> t, s, e = strain_history(ds)
 >>> t.tolist(), s.tolist(), e.tolist()
-([0.0, 0.5], [0.25, 0.75], [[-0.1, 0.0], [0.2, 0.1]])
+([0.0, 0.5], [0.25, 0.75], [[-0.1, 0.2], [0.0, 0.1]])
 """
 
 from __future__ import annotations
@@ -67,8 +67,7 @@ def strain_panel(ds, ax, t_snap=np.nan):
 
     t, s, e = strain_history(ds)
     taut = np.ma.masked_less_equal(e, 0.0)
-    cmap = plt.get_cmap("magma").copy()
-    cmap.set_bad("0.8")  # slack
+    cmap = plt.get_cmap("magma").with_extremes(bad="0.8")  # (bad: slack)
     from matplotlib.colors import LogNorm
 
     top = float(np.nanmax(e)) if np.any(e > 0) else 1.0
