@@ -173,7 +173,8 @@ def jerk_taut(*, mass: float, speed: float, slack: float, ea: float, length: flo
     line at its rest length: a loop of slack at the top, carrying nothing), all at rest; at t = 0 the held end starts upward at constant ``speed`` (m/s),
     gravity ``g`` (m/s^2, 0: none, a tow line on the level) pulling the mass and the line
     down. The run is made in units of the length, the tether's mass and ``length/speed``
-    (so g = 0 is allowed), and ends half a period of the mass on the spring after the peak.
+    (so g = 0 is allowed), and ends half a period of the mass on the spring after the formula's
+    peak, or two round trips of the longitudinal wave (4 L/c) after the line goes taut if later.
     With ``N = 1`` the model is the formula's (one node: the mass and half the tether's); with
     more links the tether's own mass adds a longitudinal wave, measured here to raise the peak
     by about ``speed sqrt(EA mass_per_length)`` (the line's impedance times the jerk's speed:
@@ -222,7 +223,8 @@ def jerk_taut(*, mass: float, speed: float, slack: float, ea: float, length: flo
     links = Links.uniform(N, tip_mass=m / Mr, lumping="shared")
     m0 = float(links.m[0]) * Mr  # the free-end node: the mass and its share of the tether
     ref = jerk_peak_force(m0, v, ea / L, slack=d, g=g)
-    t_end = (ref["t_peak"] + 0.5 * math.pi / ref["omega"]) / tau
+    # past the formula's peak by half a period, and past two round trips of the longitudinal wave
+    t_end = max(ref["t_peak"] + 0.5 * math.pi / ref["omega"], ref["t_taut"] + 4.0 * L / math.sqrt(ea / lam)) / tau
     ts = np.linspace(0.0, 2.0 * t_end, 5)
     pin = PinMotion.from_table(ts, 0.0 * ts, -ts)  # upward (y points down) at speed 1
     y = np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]])
