@@ -113,6 +113,9 @@ def reference(chi: float, N: int, c: float, recompute: bool = False) -> Result:
     if key in cache and not recompute and "t_end" in cache[key]:
         return Result(**cache[key])
     r = run_project(chi, N, c, REF_TOL, REF_METHOD)
+    if os.path.exists(REF_FILE):  # (another run may have added entries meanwhile)
+        with open(REF_FILE) as fh:
+            cache = json.load(fh)
     cache[key] = asdict(r)
     with open(REF_FILE, "w") as fh:
         json.dump(cache, fh, indent=1, sort_keys=True)
