@@ -341,7 +341,7 @@ def _rows(stdout, code):
     out = []
     for ln in stdout.splitlines():
         f = ln.split()
-        if f and f[0] == code and len(f) >= 12:
+        if f and f[0] == code and len(f) >= 12 and f[1].isdigit():
             out.append((float(f[-6]), float(f[-2])))
     return out
 
@@ -441,8 +441,10 @@ def test_pyelastica_rod_is_at_the_start():
 @needs_elastica
 def test_pyelastica_elastic_quick_run(tmp_path):
     """--quick (N = 20, c = 10; seconds): PyElastica's rod, as soft in bending as its step allows
-    (B = 1.7e-4 and 4.3e-5), gives the peak speed within 6e-2 of this project's line (measured 4.5e-2
-    at B = 1.7e-4): the rod carries compression where the line goes slack, and bends."""
+    (B = 6.8e-4 and 1.7e-4), gives the peak speed within 6e-2 of this project's line (measured 4.1e-2
+    at B = 1.7e-4): the rod carries compression (0.5 M g) where the line goes slack, and bends. (At
+    N = 20, c = 10 the undamped line's peak speed is itself uncertain by about 5e-3: a change of
+    1e-12 in the start moves it by 2e-3 to 5e-3.)"""
     env = _env()
     env["SNAPPING_PEERS_REFERENCE"] = str(tmp_path / "ref.json")
     out = subprocess.run([sys.executable, str(PE_SCRIPT), "--quick"], capture_output=True, text=True, env=env,
@@ -451,4 +453,5 @@ def test_pyelastica_elastic_quick_run(tmp_path):
     pe = _rows(out.stdout, "PyElastica")
     assert len(pe) == 2
     assert min(e for _, e in pe) < 6e-2
+    assert all(3.3 < v < 4.5 for v, _ in pe)
     assert "largest compression" in out.stdout

@@ -6,7 +6,8 @@ sqrt(L/g), force M g): the level catenary of end separation ``chi``, N equal lin
 length 1/N, node masses ``Links.uniform(N, lumping="shared")`` (1/N, half at the free end),
 every link a tension-only spring of axial stiffness EA = c^2 (c the longitudinal wave speed
 in units of sqrt(g L)), no damping. Start: the stretched static equilibrium of the line
-hanging between its two ends (:meth:`ElasticLine.start`, ``"stretched"``), at rest; at t = 0
+hanging between its two ends (:func:`start_nodes`: what :meth:`ElasticLine.start` with
+``"stretched"`` computes, found here by shooting), at rest; at t = 0
 the free end (node 0) is let go, the held end (node N, the origin) stays. y points down.
 
 Peaks: the largest speed of any node (``v``; it is the free end's at the snap, checked in
@@ -62,10 +63,46 @@ def line(chi: float, N: int, c: float):
 
 def start_nodes(chi: float, N: int, c: float):
     """(x, y) of the N + 1 nodes at t = 0 (node 0 the free end, node N the held end at the
-    origin): the stretched equilibrium, the start every code is given."""
-    ln = line(chi, N, c)
-    x, y, vx, vy = ln.unpack(ln.start("stretched"), 0.0)
-    assert not vx.any() and not vy.any()
+    origin): the stretched static equilibrium between the problem's end nodes, the start every
+    code is given.
+
+    Found by shooting, not by ``ElasticLine.start("stretched")`` (whose Newton iteration does
+    not converge at N = 400: see RESULTS.md): the tension of link j (from node j to j + 1) is
+    the vector (H, V - sum of the weights of nodes 1 .. j), its length h_j (1 + |T_j|/EA_j)
+    along it; the two unknowns (H, V) put node N at the held end (``scipy.optimize.root``, from
+    the inextensible catenary's end tension). Every link is taut (the hanging line's tension
+    is positive), so the linear law holds throughout."""
+    from scipy.optimize import root
+
+    p = problem(chi, N)
+    h, m, ea = p.links.h, p.links.m, np.full(N, c * c)
+    g = float(p.gravity)
+    wsum = np.concatenate([[0.0], np.cumsum(m[1:N] * g)])  # weights of nodes 1 .. j, j = 0 .. N-1
+    target = np.array([p.x[N] - p.x[0], p.y[N] - p.y[0]])
+
+    def chords(hv):
+        tx = np.full(N, hv[0])
+        ty = hv[1] - wsum
+        tn = np.hypot(tx, ty)
+        f = h * (1.0 + tn / ea) / tn
+        return tx * f, ty * f
+
+    def miss(hv):
+        dx, dy = chords(hv)
+        return np.array([dx.sum(), dy.sum()]) - target
+
+    d0 = np.array([p.x[1] - p.x[0], p.y[1] - p.y[0]]) / h[0]  # the catenary's first link
+    a = 1.0  # the catenary's horizontal tension lambda g a, 2 a sinh(chi/(2a)) = 1
+    for _ in range(100):
+        a = 0.5 * chi / np.arcsinh(0.5 / a)
+    guess = d0 * (a * g * float(m.sum() + m[0]) / abs(d0[0]))
+    sol = root(miss, guess, method="hybr", options={"xtol": 1e-15})
+    if np.abs(miss(sol.x)).max() > 1e-13:
+        raise RuntimeError(f"start: shooting did not converge ({sol.message}; miss {np.abs(miss(sol.x)).max():.2e})")
+    dx, dy = chords(sol.x)
+    x = p.x[0] + np.concatenate([[0.0], np.cumsum(dx)])
+    y = p.y[0] + np.concatenate([[0.0], np.cumsum(dy)])
+    x[N], y[N] = p.x[N], p.y[N]
     return x, y
 
 
@@ -91,7 +128,9 @@ def run_project(chi: float, N: int, c: float, tol: float, method: str = "radau")
     from snapping.simulate.elastic import solve
 
     w = time.process_time()
-    r = solve(problem(chi, N), elastic(c), tol=tol, method=method)
+    x, y = start_nodes(chi, N, c)
+    z = np.zeros(N + 1)
+    r = solve(problem(chi, N), elastic(c), tol=tol, method=method, initial=(x, y, z, z))
     w = time.process_time() - w
     a = r.dataset.attrs
     pk = r.peaks
