@@ -149,22 +149,25 @@ def axial_dt(N: int, c: float) -> float:
     return AXIAL_SAFETY / (N * c)
 
 
-def compare(chi, N, c, dts, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0):
-    ref = E.reference(chi, N, c)
-    E.header(ref, chi)
-    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget)
+def compare(chi, N, c, dts, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True):
+    ref = E.reference(chi, N, c) if with_ref else None
+    if ref:
+        E.header(ref, chi)
+    else:
+        print(f"chi = {chi:g}, N = {N}, c/sqrt(gL) = {c:g}: no reference (--no-reference); PyElastica runs to its snap")
+    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget) if ref else []
     spent = 0.0
     for dt in dts:
         if spent > budget:
             print(f"  (PyElastica dt={dt:.3g} skipped: the budget of {budget:g} s is spent)")
             continue
         try:
-            r = run_pyelastica(chi, N, c, dt, t_end=ref.t_end)
+            r = run_pyelastica(chi, N, c, dt, t_end=ref.t_end if ref else None)
         except FloatingPointError as e:
             print(f"  ({e})")
             continue
         spent += r.cpu
-        rows.append(E.score(r, ref))
+        rows.append(E.score(r, ref) if ref else r)
         if r.err <= min(E.LEVELS):
             break
     E.table(rows)
@@ -190,6 +193,8 @@ def main(argv=None) -> int:
     ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
                     help="this project's tolerances, loosest first (stops once the finest level is reached)")
     ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for PyElastica per point (default 300)")
+    ap.add_argument("--no-reference", action="store_true",
+                    help="the peer's runs only (no reference, no runs of this project; the peer stops at its snap)")
     ap.add_argument("--quick", action="store_true", help="N = 20, c = 10, two steps (h/(20 c), h/(40 c)): seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
@@ -216,7 +221,7 @@ def main(argv=None) -> int:
         for c in cs:
             dts = quick_dts or [float(x) for x in a.dt.split(",") if x] or \
                 [axial_dt(N, c) / 2 ** k for k in range(a.halvings + 1)]
-            compare(a.chi, N, c, dts, a.method.lower(), a.budget, tols)
+            compare(a.chi, N, c, dts, a.method.lower(), a.budget, tols, with_ref=not a.no_reference)
     print(f"uptime: {os.popen('uptime').read().strip()}")
     return 0
 
