@@ -193,11 +193,14 @@ def main(argv=None) -> int:
     ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
                     help="this project's tolerances, loosest first (stops once the finest level is reached)")
     ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for PyElastica per point (default 300)")
+    ap.add_argument("--ref-tol", type=float, default=E.REF_TOL,
+                    help=f"tolerance of the reference run (default {E.REF_TOL:g}; cached per tolerance)")
     ap.add_argument("--no-reference", action="store_true",
                     help="the peer's runs only (no reference, no runs of this project; the peer stops at its snap)")
     ap.add_argument("--quick", action="store_true", help="N = 20, c = 10, two steps (h/(20 c), h/(40 c)): seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
+    E.REF_TOL = a.ref_tol
     Ns = [int(x) for x in a.N.split(",") if x]
     cs = [float(x) for x in a.c.split(",") if x]
     tols = [float(x) for x in a.tols.split(",") if x]
