@@ -19,6 +19,7 @@ Usage::
     python benchmarks/bench_regimes.py --study end-mass --workers 1
     python benchmarks/bench_regimes.py --cost end-mass
     python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
+    python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
 """
 
 from __future__ import annotations
@@ -38,6 +39,8 @@ STUDIES = {
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
                 "levels": 3},
+    # stretching: not shipped; the elastic line (scipy Radau) took > 70 s of CPU for one run of 284 links at
+    # chi = 0.3, c = 30 (not finished): a 4 x 8 scan is beyond this machine
     "stretching": {"chis": [0.3], "numbers": [1 / 300, 1 / 100, 1 / 30, 1 / 10], "accuracy": "coarse", "levels": 2},
 }
 
@@ -87,6 +90,61 @@ def cost(mech: str, path=None) -> dict:
     return {"cpu": float(np.nansum(cpu) + np.nansum(ic)), "worst": worst}
 
 
+def estimates(mech: str, ds, a) -> list[str]:
+    """The issue's order-of-magnitude starting points against the measured crossovers (per chi):
+
+    * bending: the rod's fold radius sqrt(B/T) reaches the ideal fold's radius 1/kappa at the
+      ideal's tension T = sigma: beta_c ~ sigma_ideal / kappa_ideal^2;
+    * end mass: the fold's length (~ its radius 1/kappa_ideal) reaches M/lambda: M_c ~ 1/kappa_ideal;
+    * drag: the drag length 2 lambda/(rho C_n d) = 1/d (chain lengths; d the normal drag number)
+      reaches the fold's length 1/kappa_ideal: d_c ~ kappa_ideal (an upper estimate: the drag acts
+      over the whole fast part of the line, longer than the fold).
+    """
+    out = []
+    for chi, r in a["chi"].items():
+        c = ds.sel(chi=chi)
+        kap, sig = float(c["kappa_peak_ideal"]), float(c["sigma_peak_ideal"])
+        est = {"bending": sig / kap**2, "end-mass": 1.0 / kap, "drag": kap}.get(mech, float("nan"))
+        x = r["crossover"]
+        meas = f"{x['number']:.3g} ({x['lo']:.3g}..{x['hi']:.3g})" if x["bracketed"] else x["statement"]
+        ratio = x["number"] / est if x["bracketed"] else float("nan")
+        out.append(f"  chi {chi:g}: measured crossover {meas}; estimate {est:.3g} (ideal kappa {kap:.4g}, "
+                   f"sigma {sig:.4g}); measured/estimate {ratio:.3g}")
+    return out
+
+
+def report(mechs, figdir=None) -> None:
+    """Each shipped study's analysis (v_peak and sigma_peak): the capped regime's power law per chi,
+    the crossovers and their law in chi, the estimates against them, and the regime maps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from snapping.regimes import bundled_study
+    from snapping.regimes_analysis import analyze, regime_map
+
+    for mech in mechs:
+        ds = bundled_study(mech)
+        print(f"== {mech}: status {ds.attrs['status']}, numbers {', '.join(f'{x:g}' for x in ds.number.values)}")
+        for q in ("v_peak", "sigma_peak"):
+            a = analyze(ds, q)
+            print(f" {q}: ideal " + ", ".join(f"chi {c:g}: {r['ideal']:.5g} +- {r['ideal_error']:.2g}"
+                                             for c, r in a["chi"].items()))
+            for chi, r in a["chi"].items():
+                c = ds.sel(chi=chi)
+                cells = " ".join(f"{float(v):.3f}" for v in c[f"{q}_ratio"].values)
+                print(f"  chi {chi:g}: ratios {cells}")
+                print(f"    {r['fit']['statement']}; {r['crossover']['statement']}")
+            print(f"  {a['crossover_law']['statement']}")
+            if q == "v_peak":
+                print("\n".join(estimates(mech, ds, a)))
+        if figdir:
+            path = os.path.join(figdir, f"regimes_{mech}.png")
+            plt.close(regime_map(ds, path))
+            print(f"  map: {path}")
+
+
 def damping_check(chi: float, beta: float, zetas=(0.5, 1.0, 2.0), levels: int = 3) -> None:
     from snapping.regimes import regimes
 
@@ -105,6 +163,8 @@ def main(argv=None) -> None:
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
     ap.add_argument("--damping-check", action="store_true")
+    ap.add_argument("--report", action="store_true", help="analyse the shipped studies (and --figures DIR)")
+    ap.add_argument("--figures", default=None, help="write the regime maps there (regimes_MECH.png)")
     ap.add_argument("--chi", type=float, default=0.3)
     ap.add_argument("--beta", type=float, default=1e-4)
     ap.add_argument("--workers", type=int, default=1)
@@ -116,6 +176,10 @@ def main(argv=None) -> None:
         cost(a.cost, a.file)
     if a.damping_check:
         damping_check(a.chi, a.beta)
+    if a.report:
+        from snapping.regimes import BUNDLED
+
+        report(BUNDLED, a.figures)
 
 
 if __name__ == "__main__":

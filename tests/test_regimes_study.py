@@ -5,7 +5,7 @@
 * bending cells: the grid damping gives every node's shortest wave the damping ratio asked
   for (checked against :func:`snapping.simulate.stiffness.shortest_wave`, computed from the
   model independently), and the free end's links are floored at the bending scale;
-* stretching: a stiff elastic line (c = 300 sqrt(gL)) on a small chain snaps as the
+* stretching: a stiff elastic line (c = 100 sqrt(gL)) on a small chain snaps as the
   inextensible chain of the same links (its number -> 0 limit);
 * the shipped studies load and hold what the guide says.
 """
@@ -100,12 +100,12 @@ def test_bending_grid_damping_ratio_and_floor():
 
 # ------------------------------------------------------------------ stretching: c -> infinity is the chain
 def test_stiff_elastic_cell_is_the_inextensible_chain():
-    level = {"n_links": 12, "frac": 1.0 / 12}
-    stiff = R._run_task(0.5, "stretching", 1.0 / 300.0, level, 1e-6)
+    level = {"n_links": 6, "frac": 1.0 / 6}  # (c = 100: 2.4442 against the chain's 2.4452; c = 3: 2.092)
+    stiff = R._run_task(0.5, "stretching", 1.0 / 100.0, level, 1e-5)
     chain = R._run_task(0.5, None, 0.0, level, 1e-6)
-    assert stiff["v_peak"] == pytest.approx(chain["v_peak"], rel=0.02)
-    soft = R._run_task(0.5, "stretching", 1.0 / 3.0, level, 1e-6)
-    assert soft["v_peak"] < 0.95 * chain["v_peak"]  # a soft line is capped
+    assert stiff["v_peak"] == pytest.approx(chain["v_peak"], rel=2e-3)
+    soft = R._run_task(0.5, "stretching", 1.0 / 3.0, level, 1e-5)
+    assert soft["v_peak"] < 0.9 * chain["v_peak"]  # a soft line is capped
 
 
 def test_bundled_studies():
