@@ -363,7 +363,14 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             for j in range(len(numbers)):
                 if not np.isfinite(ds["v_peak_level"].values[i, j, k]):
                     todo.append((i, j, k))
-    todo.sort(key=lambda t: (t[2], t[0], -1 if t[1] is None else t[1]))  # coarse levels first
+    def prev_cost(t):  # the cell's CPU time at the level before (done): cheap cells first within a level
+        i, j, k = t
+        if k == 0:
+            return 0.0
+        c = ds["cpu_time_ideal_level"].values[i, k - 1] if j is None else ds["cpu_time_level"].values[i, j, k - 1]
+        return float(c) if np.isfinite(c) else math.inf
+
+    todo.sort(key=lambda t: (t[2], prev_cost(t), t[0], -1 if t[1] is None else t[1]))  # coarse levels first
     calls = {}
     for t in todo:
         i, j, k = t
