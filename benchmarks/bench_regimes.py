@@ -86,7 +86,7 @@ def cost(mech: str, path=None) -> dict:
         rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
         worst[q] = float(np.nanmax(np.where(ok, rel, np.nan))) if ok.any() else float("nan")
         print(f"  {q}: {int(ok.sum())}/{ok.size} cells resolved; largest error bar of those {worst[q]:.2%}; "
-              f"median {np.nanmedian(np.where(ok, rel, np.nan)):.2%}")
+              f"median {np.nanmedian(np.where(ok, rel, np.nan)):.2%}; {int(np.sum(ok & (rel <= 0.01)))} cells within 1%")
     return {"cpu": float(np.nansum(cpu) + np.nansum(ic)), "worst": worst}
 
 
@@ -108,8 +108,14 @@ def estimates(mech: str, ds, a) -> list[str]:
         x = r["crossover"]
         meas = f"{x['number']:.3g} ({x['lo']:.3g}..{x['hi']:.3g})" if x["bracketed"] else x["statement"]
         ratio = x["number"] / est if x["bracketed"] else float("nan")
+        extra = ""
+        if mech == "drag" and x["bracketed"]:
+            extra = f"; drag length at the crossover 1/d_c = {1 / x['number']:.3g} chain lengths"
+        if mech == "bending" and x["bracketed"]:
+            extra = (f"; bending length sqrt(beta_c/sigma) = {(x['number'] / sig) ** 0.5:.3g} against the ideal fold's "
+                     f"radius {1 / kap:.3g}")
         out.append(f"  chi {chi:g}: measured crossover {meas}; estimate {est:.3g} (ideal kappa {kap:.4g}, "
-                   f"sigma {sig:.4g}); measured/estimate {ratio:.3g}")
+                   f"sigma {sig:.4g}); measured/estimate {ratio:.3g}{extra}")
     return out
 
 
