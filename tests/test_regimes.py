@@ -163,7 +163,7 @@ def test_refuses_another_study_and_foreign_files(study, tmp_path):
         R.regimes("end-mass", [CHI], [1e-2], out=foreign, progress=False)
 
 
-@pytest.mark.parametrize("kw, match", [({"mechanism": "stretching"}, "mechanism"), ({"numbers": [0.0]}, "numbers"),
+@pytest.mark.parametrize("kw, match", [({"mechanism": "twisting"}, "mechanism"), ({"numbers": [0.0]}, "numbers"),
                                        ({"numbers": [1e-3, 1e-3]}, "distinct"), ({"chis": [1.5]}, "chi"),
                                        ({"accuracy": "best"}, "accuracy")])
 def test_bad_input(kw, match):

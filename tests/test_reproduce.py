@@ -11,7 +11,7 @@ from snapping.reproduce import PLANS, Plan, expected_seconds, reproduce
 TINY = Plan(name="tiny", shapes_chi=(0.5, 0.25), shapes_N=40, speed_chi=(0.25,), speed_N=(20, 40),
             scaling_chi=(0.25, 0.4), scaling_N=40, tol_chi=0.25, tol_N=40, tols=(1e-7, 1e-8),
             continuum_chi=(0.25,), continuum_levels=3, continuum_first=-3,
-            stability_chi=(0.25,), stability_N=(20, 40, 80), stability_lin=(0.25, 20))
+            stability_chi=(0.25,), stability_N=(20, 40, 80), stability_lin=(0.25, 20), caps_N=20, caps_live="tiny")
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +67,17 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     assert lin_row.endswith(f"| {'linear' if lin['spread'] <= S.LINEAR_RTOL else 'not linear'} (spread "
                             f"{'<=' if lin['spread'] <= S.LINEAR_RTOL else '>'} {S.LINEAR_RTOL:g}) |")
     assert lin["linear"]
+    # beyond the paper: what caps the snap -- the catalogue's answers (saved) in the table, with their verdicts
+    from snapping import caps_report
+
+    assert "## Beyond the paper: what caps the snap" in text
+    answers = json.loads((tmp_path / "caps" / "answers.json").read_text())["answers"]
+    assert [a["line"] for a in answers] == __import__("snapping.lines").lines.names()
+    for a in answers:
+        assert f"| {a['line']} | 0.25 | {a['N']} | {a['ideal']['sigma_peak']:.4g} | {a['real']['sigma_peak']:.4g} | " \
+               f"{a['factor']['sigma_peak']:.3f} | {a['cap']} | {caps_report.resolved_words(a)} |" in text
+    assert "### Regime study: end-mass" in text and "**Verdict (computed, v_peak): chi=0.5:" in text
+    assert (tmp_path / "figures" / "fig7_regime_map_end-mass.png").stat().st_size > 5000
     # every claim row has four cells and a verdict
     rows = [l for l in text.splitlines() if l.startswith("| ") and not l.startswith("| claim") and "seconds" not in l]
     assert len(rows) >= 15

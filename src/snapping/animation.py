@@ -18,7 +18,9 @@ A run with bending stiffness (a :class:`snapping.simulate.Body`) is coloured ins
 magnitude of the bending moment at each link (the mean of its nodes': :func:`bending_moments`,
 ``B (turning angle - natural) / l`` at a node, zero at a free end), and its ends are marked:
 the tip body (a tip mass or a tip drag) as a circle, a clamped held end as a short thick
-handle along the clamp's direction (it turns with a prescribed clamp motion).
+handle along the clamp's direction (it turns with a prescribed clamp motion). A run of the
+extensible line (:mod:`snapping.simulate.elastic`: its file has ``strain``) is coloured by each
+link's strain, slack links (strain <= 0) in grey.
 
 A 3D run (:mod:`snapping.spatial.dataset3d`: its file has ``z``) gets a second panel: the
 chain seen along gravity, ``z`` (out of the start's plane) against ``x``, its scale fitted to
@@ -248,7 +250,12 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     T = np.asarray(ds["t_snapshot"].values, dtype=float)[frames]
     body, h = _body_of(ds)
     bending = body is not None and body.has_bending
-    if bending:  # the colour: the bending moment (its mean over each link's two nodes)
+    strain = "strain" in ds.variables and "elastic_energy" in ds.variables  # the extensible line
+    if strain:  # the colour: each link's strain; slack links (strain <= 0) grey
+        E = np.asarray(ds["strain"].values, dtype=float)[frames]
+        seg_speed = np.where(E > 0.0, E, np.nan)
+        n_slack = np.sum(E <= 0.0, axis=1)
+    elif bending:  # the colour: the bending moment (its mean over each link's two nodes)
         mom = np.array([bending_moments(X[i], -H[i], body, h, T[i]) for i in range(len(frames))])
         seg_speed = 0.5 * (mom[:, 1:] + mom[:, :-1])
     else:
@@ -284,8 +291,13 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         pts = np.column_stack([X[i], H[i]])
         return np.stack([pts[:-1], pts[1:]], axis=1)
 
-    chain = LineCollection(segments(0), cmap="viridis", norm=norm, linewidths=2.0, capstyle="round")
-    chain.set_array(np.maximum(seg_speed[0], vmin))
+    cmap = plt.get_cmap("viridis").with_extremes(bad="0.72")  # (bad: a slack link of the extensible line)
+
+    def values(i):
+        return np.ma.masked_invalid(np.maximum(seg_speed[i], vmin)) if strain else np.maximum(seg_speed[i], vmin)
+
+    chain = LineCollection(segments(0), cmap=cmap, norm=norm, linewidths=2.0, capstyle="round")
+    chain.set_array(values(0))
     ax.add_collection(chain)
     pin, = ax.plot([X[0, -1]], [H[0, -1]], "ks", ms=6, zorder=3)
     side = None
@@ -324,7 +336,8 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
     if clamped or tip_body:
         ax.legend(loc="lower left", fontsize=8)
     cb = fig.colorbar(chain, ax=[ax, az] if spatial else ax, shrink=0.85, pad=0.02)
-    cb.set_label(r"bending moment $|M|$  [$M g \ell$]  (log scale)" if bending
+    cb.set_label("strain $l/h - 1$  (log scale; grey: slack)" if strain
+                 else r"bending moment $|M|$  [$M g \ell$]  (log scale)" if bending
                  else r"speed $|v|$  [$\sqrt{g\ell}$]  (log scale)")
     t_snap = float(ds.attrs.get("t_snap_v", np.nan))
     text = ax.set_title("", fontsize=9, family="monospace", loc="left")
@@ -340,7 +353,7 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
         if math.isfinite(t_snap):
             tau = t_snap - T[i]
             s += f"\nt_snap - t = {tau:+.2e}" if abs(tau) < 1e-2 else f"\nt_snap - t = {tau:+.4f}"
-        return s + f"\nmax |v| = {np.nanmax(S[i]):.3g}"
+        return s + f"\nmax |v| = {np.nanmax(S[i]):.3g}" + (f", slack links {int(n_slack[i])}" if strain else "")
 
     text.set_text(label(0))
     fig.canvas.draw()  # lay out once (the longest label is the first frame's), then freeze the positions:
@@ -348,7 +361,7 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
 
     def update(i):
         chain.set_segments(segments(i))
-        chain.set_array(np.maximum(seg_speed[i], vmin))
+        chain.set_array(values(i))
         pin.set_data([X[i, -1]], [H[i, -1]])
         if handle is not None:
             handle.set_data(*handle_xy(i))
@@ -362,7 +375,7 @@ def build(ds, *, max_frames: int | None = None, vmin_fraction: float = 1e-4):
 
     anim = A.FuncAnimation(fig, update, frames=len(frames), blit=False, repeat=False)
     return fig, anim, {"chain": chain, "norm": norm, "frames": frames, "text": text, "update": update,
-                       "segment_speed": seg_speed, "colour": "bending moment" if bending else "speed",
+                       "segment_speed": seg_speed, "colour": "strain" if strain else "bending moment" if bending else "speed",
                        "tip": tip, "handle": handle, "side": side}
 
 

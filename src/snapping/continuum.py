@@ -152,6 +152,7 @@ class Convergence:
         lines = [f"continuum limit, chi = {ds.attrs['chi']:g} ({ds.attrs['lumping']} lumping, "
                  f"free end {ds.attrs['free_end']}"
                  + (f"; uniform chains with the body {self.summary()['body']}" if ds.attrs.get("body") else "")
+                 + (f"; uniform extensible lines {ds.attrs['elastic']}" if ds.attrs.get("elastic") else "")
                  + "):",
                  f"{'level':>5} {'links':>7} {'frac':>8} {'h_min':>8} " + " ".join(f"{q:>13}" for q in QUANTITIES)
                  + f" {'wall s':>7} {'CPU s':>7}"]
@@ -202,10 +203,14 @@ def _uniform_levels(levels: int, ratio: float, n0: int, first: int) -> list[dict
 
 def _run_level(args):
     """One level's run (in a worker process): the graded chain, its peaks and cost."""
-    chi, params, lumping, free_end, tol, path, body = args
+    chi, params, lumping, free_end, tol, path, body, *elastic = args
     from .simulate import Body, Links, Problem, load_run, run
 
     h = _level_links(chi, params)
+    if elastic and elastic[0] is not None:  # the extensible line (snapping.sweep_elastic)
+        from .sweep_elastic import level_row
+
+        return level_row(chi, h, lumping, free_end, tol, path, elastic[0]), path
     problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact",
                                body=None if body is None else Body.from_describe(body))
     if path is not None and os.path.isfile(path):
@@ -235,7 +240,8 @@ def _level_row(ds, h, cpu_time) -> dict:
 def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0, lumping: str = "shared",
              free_end: str | None = None, tol: float = 1e-7, output=None, workers: int = 1,
              progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
-             h_max0: float = H_MAX0, overwrite: bool = False, body=None, n0: int = 50) -> Convergence:
+             h_max0: float = H_MAX0, overwrite: bool = False, body=None, n0: int = 50,
+             elastic=None) -> Convergence:
     """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
     peaks to the continuum (the string).
 
@@ -286,6 +292,11 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         resolution ``frac`` is then the link length 1/N.
     n0 : int
         Links of level 0 with a body (default 50).
+    elastic : Elastic, optional
+        The extensible line's links (:class:`snapping.simulate.elastic.Elastic` with numbers): the
+        levels are uniform chains of ``n0 / ratio**k`` links as with a body, each run through
+        :func:`snapping.simulate.elastic.solve` (:mod:`snapping.sweep_elastic`); ``kappa_peak``
+        is not measured (NaN).
 
     Returns
     -------
@@ -313,7 +324,14 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         body_d = _body_description(body, "body")
         if not Body.from_describe(body_d).active:  # (a body that changes nothing: the string's study)
             body_d = None
-    if body_d is not None:
+    elastic_d = None
+    if elastic is not None:
+        from .sweep_elastic import description
+
+        elastic_d = description(elastic, "elastic")
+        if body_d is not None:
+            raise V.SnappingInputError("body: bending and drag are not built for the extensible line (elastic) yet")
+    if body_d is not None or elastic_d is not None:
         params = _uniform_levels(levels, ratio, n0, first)
     else:
         params = level_parameters(levels, ratio, frac0=frac0, h_min0=h_min0, h_max0=h_max0, first=first)
@@ -324,7 +342,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
 
     opts = RunOptions(tol=tol)
     for k, p in enumerate(params):
-        h = _level_links(chi, p) if body_d is not None else grading.fold_following(chi, **p)
+        h = _level_links(chi, p)
         Links.graded(h, lumping=lumping, free_end=free_end)
         try:  # (what simulate refuses: a level that would not fit in memory, e.g. at chi = 1e-100)
             check_memory(h.size, opts, chi=chi, method="fast")
@@ -339,7 +357,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             out = stack.enter_context(output_dir(output, name="output"))
             paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
             check_own_files(paths + [os.path.join(out, "convergence.nc")], name="output", overwrite=overwrite)
-        jobs = [(chi, p, lumping, free_end, tol, path, body_d) for p, path in zip(params, paths)]
+        jobs = [(chi, p, lumping, free_end, tol, path, body_d, elastic_d) for p, path in zip(params, paths)]
         t0 = time.perf_counter()
         rows = [None] * len(jobs)
         if workers == 1 or len(jobs) == 1:
@@ -360,9 +378,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             # (workers leave with this process)
             _workers.run_all(min(workers, len(jobs)), _run_level, [(job,) for job in jobs], collect)
         ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
-        if body_d is not None:
+        if body_d is not None or elastic_d is not None:
             ds.attrs["grading"] = "uniform"
-            ds.attrs["body"] = json.dumps(body_d, sort_keys=True)
+            ds.attrs["body" if elastic_d is None else "elastic"] = json.dumps(body_d or elastic_d, sort_keys=True)
         if output is not None:
             from .simulate import save
 
@@ -394,6 +412,9 @@ def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Datas
              "grading": "fold", "ratio": ratio, "tol": tol, "wall_time_total": wall}
     verdicts = []
     for q in QUANTITIES:
+        if np.all(np.isnan(data[q][1])):  # not measured (the extensible line's curvature)
+            attrs.update({f"{q}_limit": np.nan, f"{q}_error": np.nan, f"{q}_order": np.nan, f"{q}_digits": 0})
+            continue
         e = extrapolate(data["frac"][1], data[q][1]) if len(rows) >= 2 else \
             {"limit": float(data[q][1][-1]), "error": float("nan"), "order": float("nan"), "converging": False,
              "digits": 0}

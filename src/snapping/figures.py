@@ -256,12 +256,18 @@ def overview(ds, n: int = 7):
     along the chain at the same snapshots; (d) the maxima over the chain (speed,
     acceleration, tension) against time, with the snapping time; a run with a body
     (bending, drag: :class:`snapping.simulate.Body`) adds (e) its energy terms and (f) the
-    residual of their balance (:func:`energy_terms`). Nondimensional. Returns the Figure."""
+    residual of their balance (:func:`energy_terms`); a run of the extensible line adds (e) the
+    strain along the line against time and (f) its energy terms with their balance (inset)
+    (:mod:`snapping.figures_elastic`). Nondimensional. Returns the Figure."""
     plt = _plt()
     u = _U["nondimensional"]
     idx = _snapshots_before(ds, n)
-    body = "dissipated" in ds and "bending_energy" in ds
-    fig, axes = plt.subplots(2, 3 if body else 2, figsize=(16.5 if body else 11, 8.4), squeeze=False)
+    from . import figures_elastic
+
+    elastic = figures_elastic.is_elastic_run(ds)
+    body = "dissipated" in ds and "bending_energy" in ds or elastic
+    ncol = 4 if elastic else 3 if body else 2
+    fig, axes = plt.subplots(2, ncol, figsize=(5.5 * ncol, 8.4), squeeze=False)
     fig.subplots_adjust(left=0.06 if body else 0.08, right=0.97, bottom=0.07, top=0.9, wspace=0.3, hspace=0.3)
     (a_shape, a_speed, *a_e), (a_tension, a_max, *a_b) = axes
     colors = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(idx), 2)))
@@ -302,7 +308,12 @@ def overview(ds, n: int = 7):
     a_max.legend(fontsize=7, loc="upper left")
     for a in (a_speed, a_tension, a_max):
         a.grid(alpha=0.3)
-    if body:
+    if elastic:  # (e) strain against time and arclength, (f) energy terms, (g) strain profiles, (h) the balance
+        im = figures_elastic.strain_panel(ds, a_e[0], t_snap)
+        fig.colorbar(im, ax=a_e[0], label="strain")
+        figures_elastic.energy_panels(ds, a_e[1], a_b[1], t_snap)
+        figures_elastic.strain_profiles(ds, a_b[0], idx, colors)
+    elif body:
         _energy_panels(ds, a_e[0], a_b[0], t_snap)
     fig.suptitle(f"{run_label(ds)}: {ds.attrs.get('status', '')}, {ds.attrs.get('method', '')} "
                  f"(nondimensional)")

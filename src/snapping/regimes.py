@@ -10,17 +10,24 @@ fold-following graded chains: the limit the paper quotes) and each peak's ratio 
 
 Mechanisms (:data:`MECHANISMS`) and their resolutions:
 
-* ``bending``: ``Body(bending=beta)``; uniform chains of ``n0 / ratio**k`` links (a bending
-  wave's explicit step cannot afford the fold-following grading's smallest links). A fold
-  thinner than the finest link (small beta) is not resolved: the error bars say so, and
-  the cell does not reach the ideal limit as beta -> 0.
+* ``bending``: ``Body(bending=beta)`` from the rest start (the bent line's equilibrium), on
+  the ideal's fold-following levels with the free end's links floored at
+  ``BEND_FLOOR * frac * sqrt(beta)`` (the rod's fold cannot be thinner than its bending length
+  ``sqrt(B/T)``, so links below a fraction of it buy nothing) and a grid damping: Kelvin-Voigt
+  ``eta_i = zeta sqrt(B) hn_i^2 / 2`` per node (``hn_i`` its shorter link), which gives the
+  shortest wave at every node the damping ratio ``zeta`` (``damping``, default 1) and vanishes
+  as h^2 with the links, so the continuum extrapolation removes it (checked: the limits at
+  zeta 0.5, 1 and 2 agree within their error bars, ``benchmarks/bench_regimes.py``). Run with
+  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps).
 * ``drag`` (normal number d, tangential ``d * pi C_t / C_n`` with the default coefficients
   of :mod:`snapping.units`), ``drag-normal``, ``drag-tangential``: ``Body(drag_...)``;
   fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
 * ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``);
   fold-following graded chains.
-* ``stretching`` (the elastic model) is not scanned yet: it is too slow for a scan; the
-  hook is :data:`MECHANISMS` (add an entry whose ``problem`` builds the elastic problem).
+* ``stretching``: the extensible line (:func:`snapping.simulate.elastic.solve`, Radau,
+  undamped, released stretched at rest) of wave speed c; the number scanned is the
+  *inverse* stretching number ``sqrt(g L)/c`` (so that number -> 0 is the inextensible
+  ideal, as for the other mechanisms); fold-following graded levels.
 
 The work is one task per (cell, level) run, on the sweep's workers: local processes
 (:func:`snapping._workers.run_all`) or a Dask cluster (``scheduler``). The study file
@@ -48,7 +55,25 @@ from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX
 
-__all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem"]
+__all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
+           "GRID_DAMPING"]
+
+#: bending: the free end's links are at least this times the level's fold fraction times sqrt(beta)
+BEND_FLOOR = 0.25
+#: bending: the damping ratio of the shortest wave at every node (the grid damping, vanishing as h^2)
+GRID_DAMPING = 1.0
+
+
+def eta_grid(h, beta: float, zeta: float) -> np.ndarray:
+    """Per-node Kelvin-Voigt damping giving each node's shortest bending wave the damping
+    ratio ``zeta``: ``omega_i ~ 4 sqrt(B) / hn_i^2`` and ``zeta_i = 2 eta_i / (hn_i^2 sqrt(B))``
+    (:mod:`snapping.simulate.stiffness`), so ``eta_i = zeta sqrt(B) hn_i^2 / 2`` (``hn_i`` the
+    node's shorter link; index 0 the free end, N + 1 values)."""
+    h = np.asarray(h, dtype=float)
+    hn = np.empty(h.size + 1)
+    hn[0], hn[-1] = h[0], h[-1]
+    hn[1:-1] = np.minimum(h[:-1], h[1:])
+    return 0.5 * zeta * math.sqrt(beta) * hn**2
 
 # the mechanisms, accuracy presets and NUMBER_MAX live in snapping.regimes_spec (light: the CLI
 # builds its parser from them without importing xarray)
@@ -60,19 +85,25 @@ def _drag_ratio() -> float:
     return math.pi * units.CD_TANGENTIAL / units.CD_NORMAL
 
 
-def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping: str = "shared"):
+def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping: str = "shared",
+                 damping: float = GRID_DAMPING):
     """The problem of one run: the catenary of separation ``chi`` with the mechanism at
     ``number`` (0 or ``mechanism=None``: the ideal chain, fold-graded) at the resolution
-    ``level`` (``n_links``: a uniform chain; else the fold-following grading)."""
+    ``level`` (``n_links``: a uniform chain; else the fold-following grading; bending: its
+    free end's links floored at ``BEND_FLOOR frac sqrt(beta)``, grid damping ratio ``damping``).
+    Stretching: the (inextensible) problem whose links the elastic line takes."""
     from .simulate import Body, Links, Problem, grading
 
     if "n_links" in level:
         h = np.full(int(level["n_links"]), 1.0 / int(level["n_links"]))
     else:
-        h = grading.fold_following(chi, frac=level["frac"], h_min=level["h_min"], h_max=level["h_max"])
+        h_min = level["h_min"]
+        if mechanism == "bending" and number > 0:
+            h_min = max(h_min, BEND_FLOOR * level["frac"] * math.sqrt(number))
+        h = grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
     body, tip = None, 0.0
     if mechanism == "bending" and number > 0:
-        body = Body(bending=number)
+        body = Body(bending=number, damping=eta_grid(h, number, damping) if damping > 0 else 0.0)
     elif mechanism == "drag" and number > 0:
         body = Body(drag_normal=number, drag_tangential=number * _drag_ratio())
     elif mechanism == "drag-normal" and number > 0:
@@ -84,18 +115,24 @@ def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping
     return Problem.catenary(chi, links=Links.graded(h, lumping=lumping, tip_mass=tip), chords="exact", body=body)
 
 
-def _run_task(chi, mechanism, number, level, tol):
+def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING):
     """Worker: one run of one cell at one level; its peaks and cost (no file: the study keeps them)."""
     from .simulate import run
 
-    problem = cell_problem(chi, mechanism, number, level)
+    problem = cell_problem(chi, mechanism, number, level, damping=damping)
     cpu = time.process_time()
-    ds = run(problem, method="fast", tol=tol, progress=False).dataset
+    if mechanism == "stretching" and number > 0:
+        from .simulate.elastic import Elastic, solve
+
+        ds = solve(problem, Elastic.from_wave_speed(1.0 / number), tol=tol).dataset
+    else:
+        method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
+        ds = run(problem, method=method, tol=tol, progress=False).dataset
     a = ds.attrs
     if a.get("status") != "completed":
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
                            f"{a.get('stop_reason', '')}")
-    row = {q: float(a[q]) for q in QUANTITIES}
+    row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -141,6 +178,31 @@ def load_study(path) -> xr.Dataset:
     if "regimes_study" not in ds.attrs:
         raise V.SnappingInputError(f"path={p!r} is not a regime study (snapping regimes)")
     return ds
+
+
+#: the studies shipped with the package (``snapping/data/regimes/<mechanism>.nc``, made by
+#: ``benchmarks/bench_regimes.py --study``): 4 chi x 8 numbers each (stretching: none, the elastic line's
+#: runs at a study's resolution are too slow for this machine)
+BUNDLED = ("bending", "drag", "end-mass")
+
+
+def bundled_study(mechanism: str) -> xr.Dataset:
+    """The regime study of ``mechanism`` shipped with the package (see the guide page
+    "What caps the snap" for how it was computed: its attributes say the levels, tolerance
+    and grid damping), loaded into memory.
+
+    >>> ds = bundled_study("end-mass")  # doctest: +SKIP
+    >>> ds.v_peak_ratio.sel(chi=0.2)  # doctest: +SKIP
+    """
+    from importlib import resources
+
+    if not isinstance(mechanism, str) or mechanism not in BUNDLED:
+        raise V.SnappingInputError(f"mechanism={mechanism!r} is not one of the shipped studies {BUNDLED}")
+    path = resources.files("snapping") / "data" / "regimes" / f"{mechanism}.nc"
+    if not path.is_file():
+        raise V.SnappingInputError(f"the {mechanism} study is not shipped in this installation ({path})")
+    with resources.as_file(path) as p:
+        return load_study(str(p))
 
 
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
@@ -197,7 +259,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 
 def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
             first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
-            workers: int = 1, scheduler=None, out=None, progress: bool = True) -> xr.Dataset:
+            damping: float = GRID_DAMPING, workers: int = 1, scheduler=None, out=None, progress: bool = True) -> xr.Dataset:
     """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
 
     Parameters
@@ -217,6 +279,9 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         fast method's tolerance.
     ratio : float
         Resolution ratio from one level to the next.
+    damping : float
+        Bending only: the grid damping ratio of every node's shortest wave (vanishing as h^2,
+        see the module; 0: none, the fast method's choice instead of RODAS4).
     workers : int
         Local worker processes (the sweep's, :mod:`snapping._workers`).
     scheduler : str or dask.distributed.Client, optional
@@ -243,8 +308,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     from .estimates import check_chi
 
     if mechanism not in MECHANISMS:
-        raise V.SnappingInputError(f"mechanism={mechanism!r} is not one of {sorted(MECHANISMS)} (stretching: the "
-                                   f"elastic model is not scanned yet)")
+        raise V.SnappingInputError(f"mechanism={mechanism!r} is not one of {sorted(MECHANISMS)}")
     if not isinstance(accuracy, str) or accuracy not in ACCURACY:
         raise V.SnappingInputError(f"accuracy={accuracy!r} is not one of {sorted(ACCURACY)}")
     acc = dict(ACCURACY[accuracy])
@@ -256,6 +320,11 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     acc["n0"] = V.integer("n0", acc["n0"], 2, 10**6)
     acc["tol"] = V.open_interval("tol", acc["tol"], 0.0, 1e-2)
     ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
+    damping = V.real("damping", damping)
+    if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
+        raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
+    if mechanism == "bending":
+        acc["damping"] = damping
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
@@ -294,16 +363,23 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             for j in range(len(numbers)):
                 if not np.isfinite(ds["v_peak_level"].values[i, j, k]):
                     todo.append((i, j, k))
-    todo.sort(key=lambda t: (t[2], t[0], -1 if t[1] is None else t[1]))  # coarse levels first
+    def prev_cost(t):  # the cell's CPU time at the level before (done): cheap cells first within a level
+        i, j, k = t
+        if k == 0:
+            return 0.0
+        c = ds["cpu_time_ideal_level"].values[i, k - 1] if j is None else ds["cpu_time_level"].values[i, j, k - 1]
+        return float(c) if np.isfinite(c) else math.inf
+
+    todo.sort(key=lambda t: (t[2], prev_cost(t), t[0], -1 if t[1] is None else t[1]))  # coarse levels first
     calls = {}
     for t in todo:
         i, j, k = t
         if j is None:
             calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
         else:
-            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"])
+            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping)
     for args in calls.values():  # every run's problem is checked before any starts
-        cell_problem(*args[:4])
+        cell_problem(*args[:4], damping=damping)
 
     bar = tqdm(total=len(ds.chi) * (len(numbers) + 1) * len(levels_p), initial=0, desc=f"regimes {mechanism}",
                unit="run", disable=not progress)

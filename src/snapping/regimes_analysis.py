@@ -31,7 +31,7 @@ import numpy as np
 
 from . import _validate as V
 
-__all__ = ["power_law", "crossover", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR"]
+__all__ = ["power_law", "crossover", "crossover_law", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR"]
 
 #: the crossover: the peak 10% below the ideal's
 LEVEL = 0.9
@@ -171,6 +171,64 @@ def crossover(numbers, ratio, ratio_err=None, *, level: float = LEVEL) -> dict:
             "statement": f"crossover at {c:.3g}" + (f" (interval {lo:.3g}..{hi:.3g})" if e is not None else "")}
 
 
+def crossover_law(chis, crossovers, lo=None, hi=None) -> dict:
+    """Fit ``crossover = A chi^q`` through the crossovers of several chi (least squares in log).
+
+    Parameters
+    ----------
+    chis, crossovers : array_like
+        Positive values (others dropped).
+    lo, hi : array_like, optional
+        Each crossover's interval (:func:`crossover`); the log half-width ``log(hi/lo)/2`` is
+        its standard error (weights its inverse square). Without them, or where an interval
+        is not finite, the points weigh equally and the error comes from the scatter.
+
+    Returns
+    -------
+    dict
+        ``exponent`` q, ``exponent_err`` (the weighted fit's standard error, scaled up by
+        sqrt(chi^2/dof) when the points scatter more than their intervals), ``prefactor`` A,
+        ``n_points``, ``statement``. Two points: the exponent through them, error from their
+        intervals (nan without). Fewer: nan and a statement saying so.
+    """
+    c = np.asarray(V.float_array("chis", chis), dtype=float).ravel()
+    n = np.asarray(V.float_array("crossovers", crossovers), dtype=float).ravel()
+    if c.size != n.size:
+        raise V.SnappingInputError(f"chis and crossovers must have one length; got {c.size} and {n.size}")
+    if lo is not None and hi is not None:
+        lo = np.asarray(V.float_array("lo", lo), dtype=float).ravel()
+        hi = np.asarray(V.float_array("hi", hi), dtype=float).ravel()
+        if lo.size != c.size or hi.size != c.size:
+            raise V.SnappingInputError(f"lo and hi must have the length of chis ({c.size})")
+        with np.errstate(invalid="ignore", divide="ignore"):
+            sig = 0.5 * np.abs(np.log(hi / lo))
+    else:
+        sig = np.full(c.size, np.nan)
+    ok = np.isfinite(c) & np.isfinite(n) & (c > 0) & (n > 0)
+    c, n, sig = c[ok], n[ok], sig[ok]
+    nan = float("nan")
+    if c.size < 2 or np.unique(c).size < 2:
+        return {"exponent": nan, "exponent_err": nan, "prefactor": nan, "n_points": int(c.size),
+                "statement": f"crossover against chi: {c.size} chi with a bracketed crossover (a law needs 2 or more)"}
+    X, Y = np.log(c), np.log(n)
+    weighted = bool(np.all(np.isfinite(sig) & (sig > 0)))
+    w = 1.0 / sig**2 if weighted else np.ones_like(X)
+    W = w.sum()
+    xm, ym = (w @ X) / W, (w @ Y) / W
+    sxx = float(w @ (X - xm) ** 2)
+    q = float((w @ ((X - xm) * (Y - ym))) / sxx)
+    a = float(ym - q * xm)
+    dof = c.size - 2
+    chi2 = float(w @ (Y - a - q * X) ** 2)
+    if weighted:
+        err = math.sqrt(1.0 / sxx) * (max(1.0, math.sqrt(chi2 / dof)) if dof > 0 else 1.0)
+    else:
+        err = math.sqrt(chi2 / dof / sxx) if dof > 0 else nan
+    how = "weighted by the crossovers' intervals" if weighted else "equal weights"
+    return {"exponent": q, "exponent_err": err, "prefactor": math.exp(a), "n_points": int(c.size),
+            "statement": f"crossover ~ {math.exp(a):.3g} chi^{q:.3f} +- {err:.2g} ({c.size} chi, {how})"}
+
+
 #: a cell is resolved when its extrapolation converged with an error bar at most this fraction of its value
 MAX_REL_ERROR = 0.05
 
@@ -210,18 +268,13 @@ def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_err
             fit["statement"] += note
         rows[float(chi)] = {"fit": fit, "crossover": cross, "ideal": float(c[f"{quantity}_ideal"]),
                             "ideal_error": float(c[f"{quantity}_ideal_error"]), "unresolved": bad}
-    pts = [(chi, r["crossover"]["number"]) for chi, r in rows.items() if r["crossover"]["bracketed"]]
-    law = {"statement": f"crossover against chi: {len(pts)} chi with a bracketed crossover (a law needs 2 or more)"}
-    if len(pts) >= 2:
-        cx, nx = np.array(pts).T
-        if len(pts) == 2:
-            p = math.log(nx[1] / nx[0]) / math.log(cx[1] / cx[0])
-            law = {"exponent": p, "exponent_err": float("nan"), "prefactor": nx[0] / cx[0] ** p,
-                   "statement": f"crossover ~ chi^{p:.3f} (two chi: no uncertainty)"}
-        else:
-            f = power_law(cx, nx, slope_tol=1e300)  # (one law through every chi)
-            law = {**f, "statement": f"crossover ~ {f['prefactor']:.3g} chi^{f['exponent']:.3f} +- "
-                                     f"{f['exponent_err']:.2g}"}
+    pts = [(chi, r["crossover"]["number"], r["crossover"]["lo"], r["crossover"]["hi"]) for chi, r in rows.items()
+           if r["crossover"]["bracketed"]]
+    if pts:
+        cx, nx, lo, hi = np.array(pts).T
+        law = crossover_law(cx, nx, lo, hi)
+    else:
+        law = crossover_law([], [])
     return {"quantity": quantity, "mechanism": ds.attrs["mechanism"], "number_name": ds.attrs["number_name"],
             "chi": rows, "crossover_law": law}
 

@@ -10,11 +10,13 @@ __all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
-    "bending": ("beta", "uniform", "bending stiffness B/(lambda g L^3)"),
+    "bending": ("beta", "fold", "bending stiffness B/(lambda g L^3) (rest start; grid damping vanishing as h^2)"),
     "drag": ("drag_normal", "fold", "air drag: normal number d, tangential d*pi*C_t/C_n (default coefficients)"),
     "drag-normal": ("drag_normal", "fold", "normal (cross-flow) air drag alone"),
     "drag-tangential": ("drag_tangential", "fold", "tangential air drag (skin friction) alone"),
     "end-mass": ("end_mass", "fold", "a point mass M_end/(lambda L) at the free end"),
+    "stretching": ("inverse_stretching", "fold", "stretching: sqrt(g L)/c, c = sqrt(EA/lambda) the wave speed (the "
+                   "elastic line; 0 the inextensible ideal)"),
 }
 
 #: accuracy presets: levels, first level, links of level 0 of uniform chains (n0), tolerance. Measured

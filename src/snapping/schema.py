@@ -251,6 +251,15 @@ ELASTIC_LINK_VARS: dict[str, dict[str, str]] = {
     "axial_stiffness": _v("axial stiffness EA of the link (the table's initial slope for a tension-strain table)"),
 }
 
+#: Result attributes of the extensible line's runs (numbers; a combined sweep's variables over (chi, N)).
+ELASTIC_RESULT_ATTRS: dict[str, str] = {
+    "strain_peak": "largest link strain over the recorded steps",
+    "t_first_slack": "time of the first recorded step with a slack link (NaN: none)",
+    "n_slack_steps": "number of recorded steps with a slack link",
+    "dissipated_total": "energy dissipated by the axial damping over the run",
+    "wave_speed": "smallest longitudinal wave speed sqrt(EA/lambda) of the links",
+}
+
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,
             **BODY_STEP_VARS, **ELASTIC_STEP_VARS, **ELASTIC_LINK_VARS}
 

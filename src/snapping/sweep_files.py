@@ -83,7 +83,8 @@ def check_combined(path, grid: Grid, *, overwrite: bool = False) -> Path:
 _RUN_DIMS = (schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_DIM)
 
 #: Global result attributes that become (chi, N) variables of a combined sweep.
-_SUMMARY_ATTRS = [k for k in schema.RESULT_ATTRS if k not in ("status", "stop_reason", "snapping_version")]
+_SUMMARY_ATTRS = [k for k in schema.RESULT_ATTRS if k not in ("status", "stop_reason", "snapping_version")] + \
+    [k for k in schema.ELASTIC_RESULT_ATTRS if k not in schema.RESULT_ATTRS]
 
 
 #: Inputs that must agree between the runs of one combined sweep (``dt0`` too for the
@@ -91,6 +92,10 @@ _SUMMARY_ATTRS = [k for k in schema.RESULT_ATTRS if k not in ("status", "stop_re
 #: compute their own per run). The combined Dataset keeps them as attributes.
 COMBINE_SAME_INPUTS = ("method", "tol", "t_end", "stop_fraction", "t_end_max", "record_thin", "chords", "initial",
                        "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
+
+
+#: Inputs of the extensible line's runs (snapping.sweep_elastic) that must agree too.
+_ELASTIC_INPUTS = ("model", "elastic", "start")
 
 
 def _same(a, b) -> bool:
@@ -169,7 +174,7 @@ def combine(paths) -> "xr.Dataset":
     pieces, names, inputs = [], [], []
     for i, item in enumerate(items):
         name, ds = _run_piece(item, i)
-        keys = COMBINE_SAME_INPUTS + ("body",) + (
+        keys = COMBINE_SAME_INPUTS + ("body",) + _ELASTIC_INPUTS + (
             ("dt0",) if str(ds.attrs["method"]).startswith("euler-richardson") else ())
         inputs.append({k: (ds.attrs[k].item() if isinstance(ds.attrs[k], np.generic) else ds.attrs[k])
                        for k in keys if k in ds.attrs})
@@ -178,7 +183,8 @@ def combine(paths) -> "xr.Dataset":
         names.append(name)
         chi, N = float(ds.attrs["chi"]), int(ds.attrs["N"])
         summary = {
-            k: ((), float(ds.attrs[k]), {"long_name": schema.RESULT_ATTRS[k], "units": schema.result_units(k)})
+            k: ((), float(ds.attrs[k]), {"long_name": {**schema.ELASTIC_RESULT_ATTRS, **schema.RESULT_ATTRS}[k],
+                                         "units": schema.result_units(k)})
             for k in _SUMMARY_ATTRS
             if k in ds.attrs and np.isscalar(ds.attrs[k]) and not isinstance(ds.attrs[k], str)
         }
@@ -190,7 +196,7 @@ def combine(paths) -> "xr.Dataset":
         ds.attrs = {}
         pieces.append(ds)
     # the method first: it decides whether dt0 is compared; body: a line's body (its JSON)
-    for k in COMBINE_SAME_INPUTS + ("body", "dt0", "problem"):
+    for k in COMBINE_SAME_INPUTS + ("body",) + _ELASTIC_INPUTS + ("dt0", "problem"):
         ref = next((j for j, d in enumerate(inputs) if k in d), None)
         if ref is None:
             continue

@@ -42,6 +42,9 @@ class Grid:
     (:class:`snapping.simulate.Body` with numbers, not per-node profiles), the same at every
     point: each run is ``Problem.catenary(chi, N, chords=..., body=...)``; it is kept as its
     description (:meth:`~snapping.simulate.Body.describe`), which names the run files.
+    ``options["elastic"]``: the extensible line's links (:class:`snapping.simulate.elastic.Elastic`
+    with numbers), each run through :func:`snapping.simulate.elastic.solve`
+    (:mod:`snapping.sweep_elastic`, whose options it takes).
     """
 
     chi: list
@@ -62,6 +65,17 @@ class Grid:
             raise V.SnappingInputError("options must not contain 'output': the sweep names each run's file")
         if "body" in self.options:  # a line's body, the same at every grid point: kept as its description
             self.options = {**self.options, "body": _body_description(self.options["body"])}
+        if "elastic" in self.options:  # the extensible line (snapping.sweep_elastic): its links' description
+            from . import sweep_elastic
+
+            if "body" in self.options:
+                raise V.SnappingInputError("options: a body (bending, drag) is not built for the extensible line "
+                                           "(elastic) yet; give one of them")
+            self.options = {**self.options, "elastic": sweep_elastic.description(self.options["elastic"])}
+            for chi in self.chi:
+                for N in self.N:
+                    sweep_elastic.solve_kwargs(dict(chi=chi, N=N, **self.options))
+            return
 
         for chi in self.chi:  # every run's inputs, checked before any starts
             for N in self.N:

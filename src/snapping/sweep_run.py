@@ -25,6 +25,10 @@ def _run_one(params: dict, path: str) -> str:
     """
     from . import simulate
 
+    if "elastic" in params:  # the extensible line: its own solver, not checkpointed
+        from .sweep_elastic import run_point
+
+        return run_point(params, path)
     if simulate.is_resumable(path, **{k: v for k, v in params.items() if k != "body"}):
         simulate.resume(path, **{k: params[k] for k in ("checkpoint_every",) if k in params})
     else:
@@ -48,6 +52,8 @@ def _check_ensemble(grid: Grid, ensemble) -> int:
 
     from .simulate.driver import DEFAULT_METHOD
 
+    if "elastic" in grid.options:
+        raise V.SnappingInputError(f"ensemble={size}: the extensible line (elastic) runs one run a task")
     method = grid.options.get("method", DEFAULT_METHOD)
     if method not in HIGH_ORDER_METHODS:
         raise V.SnappingInputError(f"ensemble={size} needs an angle-form method {HIGH_ORDER_METHODS} in the grid "
@@ -123,7 +129,9 @@ def _check_room(out: Path, todo: list) -> None:
     from ._files import _size
     from .simulate.driver import check_inputs
 
-    need = sum(check_inputs(**_run_kwargs(p))["file_bytes"] for p, _ in todo)
+    from .sweep_elastic import file_bytes
+
+    need = sum(file_bytes(p) if "elastic" in p else check_inputs(**_run_kwargs(p))["file_bytes"] for p, _ in todo)
     free = shutil.disk_usage(out).free
     if need > free:
         raise V.SnappingInputError(f"out_dir={str(out)!r}: the {len(todo)} run files to write need about "

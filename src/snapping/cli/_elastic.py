@@ -19,10 +19,15 @@ NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
                "start": "--start (the bending line's start; the extensible line starts at its stretched equilibrium)"}
 
 
+#: the elastic solver's method for each --method (fast: Radau, the elastic line's default)
+ELASTIC_METHOD = {"dop853": "dop853", "rodas4": "rodas4", "stiff": "rodas4", "radau": "radau"}
+
+
 def add_elastic_options(p) -> None:
     g = p.add_argument_group(
         "the extensible line (tension-only links: snapping.simulate.elastic; any of these runs it, with scipy's "
-        "Radau on the banded Jacobian, or --method dop853; released from its stretched equilibrium)",
+        "Radau on the banded Jacobian, or --method rodas4 (compiled) or dop853; released from its stretched "
+        "equilibrium)",
         "SI with --length METERS --mass KG [--g]; or nondimensional: EA in M g, c = sqrt(EA/lambda) in sqrt(g L)")
     g.add_argument("--ea", type=float, default=None, metavar="N", help="axial stiffness EA in N (SI)")
     g.add_argument("--stretching", type=float, default=None, metavar="C",
@@ -100,17 +105,22 @@ def elastic_from_args(args, scales):
     given = _given(args)
     if not given:
         return None
-    if args.method in ("euler-richardson", "euler-richardson-fixed"):
+    if getattr(args, "method", None) in ("euler-richardson", "euler-richardson-fixed"):
         opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
         raise SnappingInputError(f"{opt} (the extensible line) with --method {args.method}: the paper's method steps "
                                  f"rigid links only; use --method fast (Radau) or dop853")
     for dest, why in NOT_ELASTIC.items():
         if dest in getattr(args, "_explicit", ()) and getattr(args, dest, None) not in (None, False):
             raise SnappingInputError(f"{why} cannot be given with the extensible line (--ea/--stretching/...)")
+    if getattr(args, "method", None) not in (None, "fast", "dop853", "radau", "rodas4", "stiff", "euler-richardson",
+                                             "euler-richardson-fixed"):
+        opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
+        raise SnappingInputError(f"--method {args.method} with {opt} (the extensible line): its methods are fast "
+                                 f"(Radau on the banded Jacobian), rodas4 (or stiff: the compiled RODAS4) and dop853")
     from ._body import body_from_args
     from .simulate3d import wants_3d
 
-    if wants_3d(args):
+    if hasattr(args, "dims") and wants_3d(args):
         raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
                                  "--perturb or --whirl")
     if body_from_args(args) is not None:
@@ -158,7 +168,7 @@ def run_elastic(args, problem, elastic, times):
     if args.output is not None:
         out = _files.check_output(args.output, overwrite=args.overwrite)
     r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
-              method="dop853" if args.method == "dop853" else "radau", stop_fraction=args.stop_fraction,
+              method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
               snapshot_times=times)
     if out is not None:
         ds = r.dataset

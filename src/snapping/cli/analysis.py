@@ -255,7 +255,13 @@ def _cmd_plot(args) -> int:
 
         plt.close(fig)
     print(f"wrote {args.output}: {figures.run_label(ds).replace('$', '').replace(chr(92), '')}")
-    if "dissipated" in ds and "bending_energy" in ds:
+    from .. import figures_elastic
+
+    if figures_elastic.is_elastic_run(ds):
+        r = figures_elastic.energy_terms(ds)["residual"]
+        print(f"energy balance: max |kinetic + gravity + elastic - pin work + dissipated - E0| / E0 = "
+              f"{float(r.max()):.3g} (panel f); strain along the line against time: panel e")
+    elif "dissipated" in ds and "bending_energy" in ds:
         r = figures.energy_terms(ds)["residual"]
         print(f"energy balance: max |kinetic + gravity + bending - pin work + dissipated - E0| / E0 = "
               f"{float(r.max()):.3g} (panel f)")

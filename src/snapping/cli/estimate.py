@@ -3,7 +3,8 @@ the peaks of a chain's snap (computed and estimated) and the inverse design."""
 
 from __future__ import annotations
 
-from ._common import PLOT_BYTES, _add_g_option, _dimensionless, _formatter, _print_dimensionless, print_json
+from ._caps import add_real_options, cmd_real_design, cmd_real_estimate, wants_real
+from ._common import PLOT_BYTES, _floats, _add_g_option, _dimensionless, _formatter, _print_dimensionless, print_json
 
 
 # --------------------------------------------------------------------------- ideal
@@ -55,7 +56,9 @@ def _add_estimate(sub) -> None:
             "  snapping estimate --separation 0.3 --links 100 --length 2 --mass 0.05 --tip-mass 0.1\n"
             "  snapping estimate --chi 0.03 --links 229 --simulate           # outside the table: run it\n"
             "  snapping estimate --chi 0.3 --links 20 --table                # the table alone, never a run\n"
-            "  snapping estimate --curvature 20 --length 1.022 --mass 0.0208 --json   # estimators only"
+            "  snapping estimate --curvature 20 --length 1.022 --mass 0.0208 --json   # estimators only\n"
+            "  snapping estimate --chi 0.25 --line bungee-cord --links 200   # a real line: what caps its snap\n"
+            "  snapping estimate --chi 0.25 --length 2 --mass 0.1 --ei 1e-3 --diameter 5e-3 --end-mass 0.01"
         ),
     )
     g = p.add_mutually_exclusive_group(required=True)
@@ -84,6 +87,7 @@ def _add_estimate(sub) -> None:
     p.add_argument("--N", type=int, default=None, help="number of links for the delta_N = 1/N estimator only "
                                                        "(no computed peaks; use --links)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_real_options(p)
     p.set_defaults(func=_cmd_estimate)
 
 
@@ -111,6 +115,8 @@ def _cmd_estimate(args) -> int:
     from .. import estimates, table
     from .._validate import SnappingInputError
 
+    if wants_real(args):
+        return cmd_real_estimate(args)
     chain = _chain_of(args)
     where = {k: getattr(args, k) for k in ("chi", "separation", "curvature") if getattr(args, k) is not None}
     if args.simulate and args.links is None:
@@ -169,22 +175,29 @@ def _add_design(sub) -> None:
             "examples:\n"
             "  snapping design --max-tension 20 --length 2 --mass 0.05 --links 100\n"
             "  snapping design --max-tension 20 --max-speed 30 --length 2 --mass 0.05 --links 100 --tip-mass 0\n"
-            "  snapping design --max-acceleration 5e4 --length 1.022 --mass 0.0208 --links 229 --plot design.png"
+            "  snapping design --max-acceleration 5e4 --length 1.022 --mass 0.0208 --links 229 --plot design.png\n"
+            "  snapping design --max-tension 5 --line bungee-cord --links 100   # a real line: runs of the real model"
         ),
     )
     p.add_argument("--max-tension", type=float, default=None, metavar="NEWTONS", help="limit of the peak tension in N")
     p.add_argument("--max-speed", type=float, default=None, metavar="M_PER_S", help="limit of the peak speed in m/s")
     p.add_argument("--max-acceleration", type=float, default=None, metavar="M_PER_S2",
                    help="limit of the peak acceleration in m/s^2")
-    p.add_argument("--length", type=float, required=True, metavar="METERS", help="the chain's length in m")
-    p.add_argument("--mass", type=float, required=True, metavar="KG", help="the chain's mass in kg")
+    p.add_argument("--length", type=float, default=None, metavar="METERS",
+                   help="the chain's length in m (required, but for a --line)")
+    p.add_argument("--mass", type=float, default=None, metavar="KG", help="the chain's mass in kg (required, but for a "
+                                                                           "--line)")
     _add_g_option(p)
-    p.add_argument("--links", type=int, required=True, metavar="N", help="the chain's number of links (10 to 10000)")
+    p.add_argument("--links", type=int, default=None, metavar="N",
+                   help="the chain's number of links (10 to 10000; required, but for a real line: default 200)")
     p.add_argument("--tip-mass", type=float, default=None, metavar="RATIO",
                    help="tip mass / chain mass (default: scan the table's tip masses, 0 to 1)")
     p.add_argument("--plot", default=None, metavar="PNG", help="save the peaks against the separation here")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_real_options(p)
+    p.add_argument("--chis", type=_floats, default=None, metavar="C1,C2,...",
+                   help="a real line's end separations to run (default 0.05,0.1,0.15,0.2,0.25,0.3,0.4,0.5)")
     p.set_defaults(func=_cmd_design)
 
 
@@ -192,7 +205,15 @@ def _cmd_design(args) -> int:
     from .. import design
     from .._files import check_output as check_writable
     from .._files import figure_format
+    from .._validate import SnappingInputError
 
+    if wants_real(args):
+        return cmd_real_design(args)
+    if args.chis is not None:
+        raise SnappingInputError("--chis is a real line's option (--line or the physical parameters)")
+    for opt, v in (("--length", args.length), ("--mass", args.mass), ("--links", args.links)):
+        if v is None:
+            raise SnappingInputError(f"the following arguments are required: {opt} (or --line NAME: a real line)")
     chain = _chain_of(args)
     if args.plot is not None:  # (an empty name is refused, not ignored)
         figure_format(args.plot, name="--plot")

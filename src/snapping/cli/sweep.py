@@ -31,7 +31,8 @@ def _add_sweep(sub) -> None:
             "  snapping sweep --chi 0.2,0.3,0.4,0.5 --N 1000 --ensemble 4 -o sweep_ensemble\n"
             "  snapping sweep --chi 0.25,0.5 --N 200 --method euler-richardson --chords arclength -o sweep_paper\n"
             "  snapping sweep --chi 0.1,0.25 --N 200,500 --scheduler tcp://scheduler.example.org:8786 -o sweep_cluster\n"
-            "  snapping sweep --chi 0.2,0.3 --N 100 --bending 1e-3 --drag-normal 0.5 -o sweep_body   # a line's body"
+            "  snapping sweep --chi 0.2,0.3 --N 100 --bending 1e-3 --drag-normal 0.5 -o sweep_body   # a line's body\n"
+            "  snapping sweep --chi 0.25 --N 30,60 --stretching 300 --grid-damping 1 -o sweep_elastic  # extensible"
         ),
     )
     p.add_argument("--chi", type=_floats, required=True, help="comma-separated end separations in (0, 1)")
@@ -55,6 +56,9 @@ def _add_sweep(sub) -> None:
     from ._body import add_body_options
 
     add_body_options(p)  # a line's body, the same at every (chi, N)
+    from ._elastic import add_elastic_options
+
+    add_elastic_options(p)  # the extensible line, the same links at every (chi, N)
     _add_si_options(p)
     p.set_defaults(func=_cmd_sweep)
 
@@ -70,9 +74,14 @@ def _cmd_sweep(args) -> int:
     from ._body import body_from_args, refuse_line_masses
 
     refuse_line_masses(args, "sweep")
+    from ._elastic import elastic_from_args
+
+    elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
     body = body_from_args(args)
     if body is not None and body.active:
         options["body"] = body
+    if elastic is not None:
+        options["elastic"] = elastic
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
     failed = None
@@ -96,7 +105,8 @@ def _cmd_sweep(args) -> int:
                 if "n_steps" in sel and not math.isfinite(float(sel["n_steps"])):
                     continue  # (chi, N) is no finished run (it failed): a hole of the grid
                 row = {"chi": float(chi), "N": int(N)}
-                row.update({k: float(sel[k]) for k in ("v_peak", "a_peak", "sigma_peak", "t_snap_v") if k in sel})
+                row.update({k: float(sel[k]) for k in ("v_peak", "a_peak", "sigma_peak", "t_snap_v", "strain_peak")
+                            if k in sel})
                 reached = float(sel["snap_reached"]) if "snap_reached" in sel else 1.0
                 row["snap_reached"] = bool(reached == 1.0)
                 if not row["snap_reached"]:
@@ -128,6 +138,9 @@ def _cmd_sweep(args) -> int:
                 from ..simulate.body import summarize
 
                 print(f"  body (every run): {summarize(grid.options['body'])}")
+            if "elastic" in grid.options:
+                print(f"  extensible line (every run): {grid.options['elastic']}; strain_peak: "
+                      + ", ".join(f"{r['strain_peak']:.4g}" for r in rows if "strain_peak" in r))
             print(f"  {'chi':>6} {'N':>7} {'v_peak':>10} {'a_peak':>11} {'sigma_peak':>11} {'t_snap_v':>10}")
             for r in rows:
                 t_snap = "no snap" if r["t_snap_v"] is None else f"{r['t_snap_v']:.6g}"
@@ -172,6 +185,7 @@ def _add_converge(sub) -> None:
             "  snapping converge --chi 0.25 --lumping paper      # the paper's lumping: first order\n"
             "  snapping converge --chi 0.25 --length 1.022 --mass 0.0208   # the limits in SI too\n"
             "  snapping converge --chi 0.25 --bending 1e-2 --n0 25         # the rod's limit: uniform chains\n"
+            "  snapping converge --chi 0.25 --stretching 300 --grid-damping 1 --n0 8 --levels 3  # extensible line\n"
             "\n"
             "With -o DIR every level's run file is kept there and a rerun reuses the finished levels."
         ),
@@ -195,10 +209,14 @@ def _add_converge(sub) -> None:
                         "write (default: refuse them)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--n0", type=int, default=50, metavar="N",
-                   help="with a body: links of level 0 (uniform chains of N/ratio^k links; default 50)")
+                   help="with a body or the extensible line: links of level 0 (uniform chains of N/ratio^k links; "
+                        "default 50)")
     from ._body import add_body_options
 
     add_body_options(p)
+    from ._elastic import add_elastic_options
+
+    add_elastic_options(p)
     _add_si_options(p)
     p.set_defaults(func=_cmd_converge)
 
@@ -230,14 +248,20 @@ def _cmd_converge(args) -> int:
     from ._body import body_from_args, refuse_line_masses
 
     refuse_line_masses(args, "converge")
+    from ._elastic import elastic_from_args
+
+    elastic = elastic_from_args(args, scales)
     body = body_from_args(args)
-    if "n0" in getattr(args, "_explicit", ()) and body is None:
-        raise SnappingInputError(f"--n0 {args.n0} needs a body (--bending, --drag-normal, ...): without one the "
-                                 f"levels are fold-following chains (--first, --ratio)")
+    if "n0" in getattr(args, "_explicit", ()) and body is None and elastic is None:
+        raise SnappingInputError(f"--n0 {args.n0} needs a body (--bending, --drag-normal, ...) or the extensible line "
+                                 f"(--stretching, --ea): without them the levels are fold-following chains (--first, "
+                                 f"--ratio)")
+    extra = {} if body is None or not body.active else {"body": body, "n0": args.n0}
+    if elastic is not None:
+        extra = {"elastic": elastic, "n0": args.n0}
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
                              free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
-                             progress=None if not args.json else False, overwrite=args.overwrite,
-                             **({} if body is None or not body.active else {"body": body, "n0": args.n0}))
+                             progress=None if not args.json else False, overwrite=args.overwrite, **extra)
     if args.plot is not None:
         res.plot(args.plot)
     if args.json:

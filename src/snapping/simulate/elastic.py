@@ -6,7 +6,8 @@
 * :mod:`~snapping.simulate.elastic_kernels`: the compiled forces, banded Jacobian, measures;
 * :mod:`~snapping.simulate.elastic_solve`: the stepping (:func:`solve`) and the run Dataset;
 * :mod:`~snapping.simulate.elastic_rodas`: the compiled RODAS4 (``method="rodas4"``);
-* :mod:`~snapping.simulate.elastic_loads`: snap loads in SI (:func:`climbing_fall`).
+* :mod:`~snapping.simulate.elastic_loads`: snap loads in SI (:func:`climbing_fall`, :func:`jerk_taut`: a
+  slack tether jerked taut by its moving end, beside :func:`jerk_peak_force`).
 
 Example
 -------
@@ -18,9 +19,9 @@ Example
 'completed'
 """
 
-from .elastic_loads import EN892_LIMIT, climbing_fall, massless_peak_force
+from .elastic_loads import EN892_LIMIT, climbing_fall, jerk_peak_force, jerk_taut, massless_peak_force
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_solve import METHODS, ElasticRun, solve
 
 __all__ = ["Elastic", "ElasticLine", "ElasticRun", "solve", "STARTS", "METHODS", "climbing_fall", "massless_peak_force",
-           "EN892_LIMIT"]
+           "EN892_LIMIT", "jerk_peak_force", "jerk_taut"]

@@ -121,6 +121,27 @@ class Elastic:
         lam = V.positive("lam", lam)
         return cls(ea=lam * c * c, damping=damping, grid_damping=grid_damping)
 
+    @classmethod
+    def from_describe(cls, d) -> "Elastic":
+        """The :class:`Elastic` of a :meth:`describe` dict (or its JSON text).
+
+        >>> Elastic.from_describe(Elastic(ea=100.0, damping=0.5).describe()).describe()["damping"]
+        0.5
+        """
+        import json
+
+        if isinstance(d, str):
+            try:
+                d = json.loads(d)
+            except ValueError:
+                raise V.SnappingInputError(f"elastic={V._short(d)} is not the JSON of Elastic.describe()") from None
+        if not isinstance(d, dict) or not set(d) <= {"ea", "damping", "table", "grid_damping"}:
+            raise V.SnappingInputError(f"elastic={V._short(d)} is not an Elastic's description (keys ea, damping, "
+                                       f"table, grid_damping)")
+        tab = d.get("table")
+        return cls(ea=d.get("ea"), damping=d.get("damping", 0.0), table=None if tab is None else tuple(tab),
+                   grid_damping=d.get("grid_damping", 0.0))
+
     def describe(self) -> dict:
         def j(v):
             return v if np.ndim(v) == 0 else np.asarray(v).tolist()

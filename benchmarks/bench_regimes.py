@@ -1,0 +1,192 @@
+"""The regime studies shipped with the package, their cost, and the bending damping check (issue 24).
+
+``--study MECH`` runs (or resumes) one mechanism's 4 chi x 8 numbers scan with the settings
+of :data:`STUDIES` into ``src/snapping/data/regimes/MECH.nc`` (the file
+:func:`snapping.regimes.bundled_study` loads): a study is resumable, so an interrupted
+run loses nothing. ``--cost MECH`` reads a finished (or partial) study file and prints
+what its scan cost: the CPU time and right-hand-side evaluations of every run (recorded
+by each worker with ``time.process_time``), by level and by chi, and the error bars it
+reached (the largest relative error bar of v_peak, a_peak and sigma_peak over the
+resolved cells). ``--damping-check`` runs one bending cell at grid damping ratios 0.5, 1
+and 2 and prints the three continuum limits with their error bars: the physics of the
+study must not depend on the grid damping (it vanishes as h^2 with the links).
+
+Timings are CPU seconds of the runs themselves (not the ~35 s of one-off compilation per
+worker process); the machine is shared, so wall times mean little (load printed).
+
+Usage::
+
+    python benchmarks/bench_regimes.py --study end-mass --workers 1
+    python benchmarks/bench_regimes.py --cost end-mass
+    python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
+    python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(HERE, "..", "src", "snapping", "data", "regimes")
+
+#: the shipped studies: chi, numbers, and the regimes() settings
+STUDIES = {
+    "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-5, 1.0, 8), "accuracy": "medium"},
+    "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
+    "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
+                "levels": 3},
+    # stretching: not shipped; the elastic line (scipy Radau) took > 70 s of CPU for one run of 284 links at
+    # chi = 0.3, c = 30 (not finished): a 4 x 8 scan is beyond this machine
+    "stretching": {"chis": [0.3], "numbers": [1 / 300, 1 / 100, 1 / 30, 1 / 10], "accuracy": "coarse", "levels": 2},
+}
+
+
+def _numbers(v):
+    return [float(f"{x:.3g}") for x in v]  # as the command line passes them (3 digits)
+
+
+def study(mech: str, workers: int) -> None:
+    from snapping.regimes import regimes
+
+    s = dict(STUDIES[mech])
+    os.makedirs(DATA, exist_ok=True)
+    out = os.path.join(DATA, f"{mech}.nc")
+    t = time.time()
+    regimes(mech, s.pop("chis"), _numbers(s.pop("numbers")), out=out, workers=workers, progress=True, **s)
+    print(f"{mech}: {out} ({time.time() - t:.0f} s wall, load {os.getloadavg()[0]:.1f})")
+
+
+def cost(mech: str, path=None) -> dict:
+    """What a study file's scan cost (CPU s, evaluations), by level and chi, and its error bars."""
+    from snapping.regimes import load_study
+    from snapping.regimes_analysis import resolved
+
+    ds = load_study(path or os.path.join(DATA, f"{mech}.nc"))
+    cpu, ic = ds.cpu_time_level.values, ds.cpu_time_ideal_level.values
+    rhs, ir = ds.n_rhs_level.values, ds.n_rhs_ideal_level.values
+    done = int(np.isfinite(cpu).sum() + np.isfinite(ic).sum())
+    total = int(cpu.size + ic.size)
+    print(f"{mech}: status {ds.attrs['status']}, {done}/{total} runs; CPU {np.nansum(cpu) + np.nansum(ic):.0f} s "
+          f"({np.nansum(ic):.0f} s the ideal's), {np.nansum(rhs) + np.nansum(ir):.3g} evaluations")
+    for k in range(ds.sizes["level"]):
+        print(f"  level {k}: CPU {np.nansum(cpu[:, :, k]) + np.nansum(ic[:, k]):7.1f} s, links "
+              f"{np.nanmin(ds.n_links_level.values[:, :, k]):.0f}..{np.nanmax(ds.n_links_level.values[:, :, k]):.0f}")
+    for i, chi in enumerate(ds.chi.values):
+        print(f"  chi {chi:g}: CPU {np.nansum(cpu[i]) + np.nansum(ic[i]):7.1f} s; per number "
+              + " ".join(f"{x:.0f}" for x in np.nansum(cpu[i], axis=-1)))
+    worst = {}
+    for q in ("v_peak", "a_peak", "sigma_peak"):
+        if q not in ds:
+            continue
+        ok = resolved(ds[q].values, ds[f"{q}_error"].values, ds[f"{q}_order"].values)
+        rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
+        worst[q] = float(np.nanmax(np.where(ok, rel, np.nan))) if ok.any() else float("nan")
+        print(f"  {q}: {int(ok.sum())}/{ok.size} cells resolved; largest error bar of those {worst[q]:.2%}; "
+              f"median {np.nanmedian(np.where(ok, rel, np.nan)):.2%}; {int(np.sum(ok & (rel <= 0.01)))} cells within 1%")
+    return {"cpu": float(np.nansum(cpu) + np.nansum(ic)), "worst": worst}
+
+
+def estimates(mech: str, ds, a) -> list[str]:
+    """The issue's order-of-magnitude starting points against the measured crossovers (per chi):
+
+    * bending: the rod's fold radius sqrt(B/T) reaches the ideal fold's radius 1/kappa at the
+      ideal's tension T = sigma: beta_c ~ sigma_ideal / kappa_ideal^2;
+    * end mass: the fold's length (~ its radius 1/kappa_ideal) reaches M/lambda: M_c ~ 1/kappa_ideal;
+    * drag: the drag length 2 lambda/(rho C_n d) = 1/d (chain lengths; d the normal drag number)
+      reaches the fold's length 1/kappa_ideal: d_c ~ kappa_ideal (an upper estimate: the drag acts
+      over the whole fast part of the line, longer than the fold).
+    """
+    out = []
+    for chi, r in a["chi"].items():
+        c = ds.sel(chi=chi)
+        kap, sig = float(c["kappa_peak_ideal"]), float(c["sigma_peak_ideal"])
+        est = {"bending": sig / kap**2, "end-mass": 1.0 / kap, "drag": kap}.get(mech, float("nan"))
+        x = r["crossover"]
+        meas = f"{x['number']:.3g} ({x['lo']:.3g}..{x['hi']:.3g})" if x["bracketed"] else x["statement"]
+        ratio = x["number"] / est if x["bracketed"] else float("nan")
+        extra = ""
+        if mech == "drag" and x["bracketed"]:
+            extra = f"; drag length at the crossover 1/d_c = {1 / x['number']:.3g} chain lengths"
+        if mech == "bending" and x["bracketed"]:
+            extra = (f"; bending length sqrt(beta_c/sigma) = {(x['number'] / sig) ** 0.5:.3g} against the ideal fold's "
+                     f"radius {1 / kap:.3g}")
+        out.append(f"  chi {chi:g}: measured crossover {meas}; estimate {est:.3g} (ideal kappa {kap:.4g}, "
+                   f"sigma {sig:.4g}); measured/estimate {ratio:.3g}{extra}")
+    return out
+
+
+def report(mechs, figdir=None) -> None:
+    """Each shipped study's analysis (v_peak and sigma_peak): the capped regime's power law per chi,
+    the crossovers and their law in chi, the estimates against them, and the regime maps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from snapping.regimes import bundled_study
+    from snapping.regimes_analysis import analyze, regime_map
+
+    for mech in mechs:
+        ds = bundled_study(mech)
+        print(f"== {mech}: status {ds.attrs['status']}, numbers {', '.join(f'{x:g}' for x in ds.number.values)}")
+        for q in ("v_peak", "sigma_peak"):
+            a = analyze(ds, q)
+            print(f" {q}: ideal " + ", ".join(f"chi {c:g}: {r['ideal']:.5g} +- {r['ideal_error']:.2g}"
+                                             for c, r in a["chi"].items()))
+            for chi, r in a["chi"].items():
+                c = ds.sel(chi=chi)
+                cells = " ".join(f"{float(v):.3f}" for v in c[f"{q}_ratio"].values)
+                print(f"  chi {chi:g}: ratios {cells}")
+                print(f"    {r['fit']['statement']}; {r['crossover']['statement']}")
+            print(f"  {a['crossover_law']['statement']}")
+            if q == "v_peak":
+                print("\n".join(estimates(mech, ds, a)))
+        if figdir:
+            path = os.path.join(figdir, f"regimes_{mech}.png")
+            plt.close(regime_map(ds, path))
+            print(f"  map: {path}")
+
+
+def damping_check(chi: float, beta: float, zetas=(0.5, 1.0, 2.0), levels: int = 3) -> None:
+    from snapping.regimes import regimes
+
+    for z in zetas:
+        ds = regimes("bending", [chi], [beta], accuracy="medium", levels=levels, damping=z, progress=False)
+        c = ds.sel(chi=chi, number=beta)
+        row = " ".join(f"{q} {float(c[q]):.5g} +- {float(c[q + '_error']):.2g} (levels "
+                       + ", ".join(f"{v:.5g}" for v in c[q + "_level"].values) + ")" for q in ("v_peak", "sigma_peak"))
+        print(f"chi {chi:g} beta {beta:g} grid damping ratio {z:g}: {row}; CPU "
+              f"{float(np.nansum(c.cpu_time_level)):.1f} s", flush=True)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--study", choices=sorted(STUDIES))
+    ap.add_argument("--cost", choices=sorted(STUDIES))
+    ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
+    ap.add_argument("--damping-check", action="store_true")
+    ap.add_argument("--report", action="store_true", help="analyse the shipped studies (and --figures DIR)")
+    ap.add_argument("--figures", default=None, help="write the regime maps there (regimes_MECH.png)")
+    ap.add_argument("--chi", type=float, default=0.3)
+    ap.add_argument("--beta", type=float, default=1e-4)
+    ap.add_argument("--workers", type=int, default=1)
+    a = ap.parse_args(argv)
+    print(f"load {os.getloadavg()[0]:.1f}")
+    if a.study:
+        study(a.study, a.workers)
+    if a.cost:
+        cost(a.cost, a.file)
+    if a.damping_check:
+        damping_check(a.chi, a.beta)
+    if a.report:
+        from snapping.regimes import BUNDLED
+
+        report(BUNDLED, a.figures)
+
+
+if __name__ == "__main__":
+    main()

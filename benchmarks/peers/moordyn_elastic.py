@@ -1,0 +1,288 @@
+"""The elastic falling catenary (issue 22), solved by MoorDyn and by this project, side by side.
+
+The problem (``elastic_common.py``; nondimensional L = lambda = g = 1): the level catenary
+chi = 0.25 of N links of rest length 1/N, node masses 1/N (half at the free end), axial
+stiffness EA = c^2, tension-only, no damping; released from the stretched static equilibrium
+(this project's ``ElasticLine.start("stretched")``), the held end fixed.
+
+MoorDyn (PyPI ``moordyn``, MoorDyn-C v2): one line of N segments, unstretched length 1,
+mass 1 per length, EA = c^2, between a Fixed point (the held end, the origin) and a Free
+point of no mass of its own (the free end); no internal damping (BA = 0), no drag and no
+added mass (Cd = Ca = 0), water density 0 (no buoyancy), deep water (no seabed), gravity
+``g = 1`` (MoorDyn's option), z = -y. MoorDyn's line is the same discrete model as this
+project's: lumped node masses (half a segment's at each end: the free point's mass is its
+node's, 1/(2N)), segments that carry EA (l/h - 1) when stretched and nothing when slack.
+
+The start: MoorDyn's own initial condition (its catenary) is replaced by this project's
+stretched equilibrium: ``Init_NoIC``, then its state (saved with ``SaveState``: the free
+point's and the line's inner nodes' positions and velocities) is rewritten with the start's
+nodes and loaded back with ``LoadState``; the script checks the positions MoorDyn then
+reports against the start (round-off).
+
+Time stepping: MoorDyn's fixed-step explicit schemes (``--scheme``: ``rk2``, its default,
+or ``rk4``, ...), one ``Step`` call per step (the step ``dtM`` in the input file is the same),
+sampling the free point's speed and the line's largest tension (``GetLineMaxTen``) after
+every step; peaks: the vertex of the parabola through the three samples around the largest,
+up to the reference's end (this project's stop at the snap). The per-step
+sampling costs Python calls (about a third of MoorDyn's own time at N = 100).
+
+Usage::
+
+    python benchmarks/peers/moordyn_elastic.py --quick                 # N = 20, c = 30: seconds
+    python benchmarks/peers/moordyn_elastic.py --N 100 --c 30          # one point
+    python benchmarks/peers/moordyn_elastic.py --N 400 --c 300 --dt 1e-6 --method dop853
+    python benchmarks/peers/moordyn_elastic.py --help
+
+Needs the optional ``peers`` extra (``pip install moordyn``) for the MoorDyn side.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import math
+import os
+import struct
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import elastic_common as E  # noqa: E402
+
+INPUT = """--------------------- MoorDyn Input File ------------------------------------
+Elastic falling catenary (snapping benchmarks/peers/moordyn_elastic.py)
+----------------------- LINE TYPES ------------------------------------------
+TypeName   Diam    Mass/m     EA     BA/-zeta    EI    Cd     Ca     CdAx    CaAx
+(name)     (m)     (kg/m)     (N)    (N-s/-)     (N-m^2) (-)   (-)    (-)     (-)
+elastic    1e-3    1.0    {ea!r}   0    0     0      0      0       0
+---------------------- POINTS --------------------------------
+ID    Attachment  X       Y     Z      M      V      CdA   CA
+(#)   (-)         (m)     (m)   (m)    (kg)   (m^3)  (m^2) (-)
+1     Fixed       0       0     0      0      0      0     0
+2     Free        {x0!r}    0     {z0!r}      0      0      0     0
+---------------------- LINES --------------------------------------
+ID   LineType  AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
+(#)  (name)    (#)      (#)      (m)       (-)      (-)
+1    elastic   1        2        1.0       {N}       -
+---------------------- OPTIONS -----------------------------------------
+{dt!r}     dtM
+{scheme}   tScheme
+1.0      g
+1000     WtrDpth
+0.0      WtrDnsty
+0        dtIC
+---------------------- OUTPUTS -----------------------------------------
+END
+------------------------- need this line --------------------------------------
+"""
+
+#: the first step as a fraction of h/c (omega_max = 2 c/h, the segments' fastest mode: RK2 goes unstable at 0.5 h/c)
+AXIAL_SAFETY = 0.25
+
+
+@contextlib.contextmanager
+def quiet_stdout():
+    """MoorDyn-C prints its banner and progress (``t = ...``) on the C stdout: send it to /dev/null."""
+    sys.stdout.flush()
+    fd = os.dup(1)
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    try:
+        yield
+    finally:
+        os.dup2(fd, 1)
+        os.close(fd)
+        os.close(null)
+
+
+def _blocks(buf: bytes, offset: int):
+    """The (start, rows, cols) of each instance in a MoorDyn state file (MoorDyn-C 2.x:
+    'MoorDyn' + 2 version bytes, u64 size, u64 instances, then per instance u64 rows, u64
+    cols and rows x cols doubles: a point (1 x 6: position, velocity), a line (inner nodes x 6))."""
+    a = np.frombuffer(buf, dtype="<u8", offset=offset)
+    out, k = [], 0
+    while k < a.size:
+        r, c = int(a[k]), int(a[k + 1])
+        out.append((k + 2, r, c))
+        k += 2 + r * c
+    return out
+
+
+def build_moordyn(chi: float, N: int, c: float, dt: float, scheme: str, workdir: str):
+    """(system, point, line) of MoorDyn at the stretched start (see the module docstring)."""
+    import moordyn
+
+    x, y = E.start_nodes(chi, N, c)
+    path = os.path.join(workdir, "line.txt")
+    with open(path, "w") as fh:
+        fh.write(INPUT.format(ea=c * c, x0=float(x[0]), z0=float(-y[0]), N=N, dt=dt, scheme=scheme))
+    with quiet_stdout():
+        s = moordyn.Create(path)
+        moordyn.SetVerbosity(s, moordyn.LEVEL_ERR)
+        if moordyn.Init_NoIC(s, [], []) != 0:
+            raise RuntimeError("MoorDyn's Init_NoIC failed")
+        st = os.path.join(workdir, "state.bin")
+        moordyn.SaveState(s, st)
+    with open(st, "rb") as fh:
+        buf = bytearray(fh.read())
+    off = 9 + 16  # 'MoorDyn' + 2 version bytes, u64 size, u64 instances
+    f = np.frombuffer(buf, dtype="<f8", offset=off).copy()
+    blocks = _blocks(bytes(buf), off)
+    if len(blocks) != 3 or blocks[1][1:] != (1, 6) or blocks[2][1:] != (N - 1, 6):
+        raise RuntimeError(f"unexpected MoorDyn state layout {blocks}")
+    k1 = blocks[1][0]
+    f[k1:k1 + 6] = [x[0], 0.0, -y[0], 0.0, 0.0, 0.0]  # the free point
+    k2 = blocks[2][0]
+    for i in range(1, N):  # line node i (from the fixed end A) is this project's node N - i
+        j = N - i
+        f[k2 + 6 * (i - 1):k2 + 6 * i] = [x[j], 0.0, -y[j], 0.0, 0.0, 0.0]
+    buf[off:] = f.tobytes()
+    with open(st, "wb") as fh:
+        fh.write(bytes(buf))
+    with quiet_stdout():
+        moordyn.LoadState(s, st)
+    return s, moordyn.GetPoint(s, 2), moordyn.GetLine(s, 1)
+
+
+def start_check(chi: float, N: int, c: float, scheme: str = "rk2", dt: float = 1e-9):
+    """Largest |MoorDyn's node position - the start| after one step of ``dt`` (the positions it
+    reports are those of its last step), and MoorDyn's node masses (lumped)."""
+    import moordyn
+
+    x, y = E.start_nodes(chi, N, c)
+    with tempfile.TemporaryDirectory() as d:
+        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d)
+        with quiet_stdout():
+            moordyn.Step(s, [], [], 0.0, dt)
+            P = np.array([moordyn.GetLineNodePos(ln, i) for i in range(N + 1)])[::-1]
+            M = np.array([moordyn.GetLineNodeM(ln, i)[0][0] for i in range(N + 1)])[::-1]
+            moordyn.Close(s)
+    return float(max(np.abs(P[:, 0] - x).max(), np.abs(-P[:, 2] - y).max(), np.abs(P[:, 1]).max())), M
+
+
+def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_end: float | None = None,
+                stop_fraction: float = 0.5) -> E.Result:
+    """MoorDyn at the fixed step ``dt`` to ``t_end`` (the reference's end), or without it until
+    the free end's speed has fallen below ``stop_fraction`` of its running peak (after t = 0.8)."""
+    import moordyn
+
+    n_max = int(math.ceil((3.0 if t_end is None else t_end) / dt - 1e-9))
+    v = np.empty(n_max)
+    T = np.empty(n_max)
+    with tempfile.TemporaryDirectory() as d, quiet_stdout():
+        w = time.process_time()
+        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d)
+        step, vel, maxten = moordyn.Step, moordyn.GetPointVel, moordyn.GetLineMaxTen
+        peak, t, n, bad = 0.0, 0.0, 0, False
+        for n in range(1, n_max + 1):
+            step(s, [], [], t, dt)
+            t = n * dt
+            u = vel(pt)
+            sp = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+            v[n - 1] = sp
+            T[n - 1] = maxten(ln)
+            if not math.isfinite(sp) or sp > 1e3:
+                bad = True
+                break
+            peak = max(peak, sp)
+            if t_end is None and t > 0.8 and sp < stop_fraction * peak:
+                break
+        w = time.process_time() - w
+        moordyn.Close(s)
+    if bad:
+        raise FloatingPointError(f"MoorDyn went unstable at t = {t:.4g} (N={N}, c={c:g}, dt={dt:.3g}, {scheme})")
+    tt = dt * np.arange(1, n + 1)
+    vp, tp = E.vertex(tt, v[:n])
+    sp_, ts = E.vertex(tt, T[:n])
+    return E.Result("MoorDyn", N, c, f"{scheme} dt={dt:.3g}", n, w, vp, tp, sp_, ts)
+
+
+def axial_dt(N: int, c: float) -> float:
+    return AXIAL_SAFETY / (N * c)
+
+
+def compare(chi, N, c, dts, scheme, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True):
+    ref = E.reference(chi, N, c) if with_ref else None
+    if ref:
+        E.header(ref, chi)
+    else:
+        print(f"chi = {chi:g}, N = {N}, c/sqrt(gL) = {c:g}: no reference (--no-reference); MoorDyn runs to its snap")
+    err0, M = start_check(chi, N, c, scheme)
+    print(f"  MoorDyn's start: largest node position - this project's start {err0:.1e}; node masses "
+          f"{M[0]:.6g} (free end), {M[1]:.6g}, ..., total {M[:N].sum():.12g}")
+    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget) if ref else []
+    spent = 0.0
+    for dt in dts:
+        if spent > budget:
+            print(f"  (MoorDyn dt={dt:.3g} skipped: the budget of {budget:g} s is spent)")
+            continue
+        try:
+            r = run_moordyn(chi, N, c, dt, scheme, ref.t_end if ref else None)
+        except FloatingPointError as e:
+            print(f"  ({e})")
+            continue
+        spent += r.cpu
+        rows.append(E.score(r, ref) if ref else r)
+        if r.err <= min(E.LEVELS):
+            break
+    E.table(rows)
+    E.matched(rows, "MoorDyn")
+    print(flush=True)
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--chi", type=float, default=0.25, help="end separation / length (default 0.25)")
+    ap.add_argument("--N", default="100", help="links, comma-separated (default 100)")
+    ap.add_argument("--c", default="30", help="wave speeds c/sqrt(gL), comma-separated (default 30)")
+    ap.add_argument("--dt", default="",
+                    help="MoorDyn's steps, comma-separated (default: 0.25 h/c, then halved --halvings times)")
+    ap.add_argument("--halvings", type=int, default=3, help="default steps: 0.25 h/c halved this many times")
+    ap.add_argument("--scheme", default="rk2", help="MoorDyn's time scheme (its tScheme option; default rk2)")
+    ap.add_argument("--method", default="radau", help="this project's method (any name of elastic.METHODS)")
+    ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
+                    help="this project's tolerances, loosest first (stops once the finest level is reached)")
+    ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for MoorDyn per point (default 300)")
+    ap.add_argument("--ref-tol", type=float, default=E.REF_TOL,
+                    help=f"tolerance of the reference run (default {E.REF_TOL:g}; cached per tolerance)")
+    ap.add_argument("--no-reference", action="store_true",
+                    help="the peer's runs only (no reference, no runs of this project; the peer stops at its snap)")
+    ap.add_argument("--quick", action="store_true", help="N = 20, c = 30, two steps (h/(8 c), h/(16 c)): seconds")
+    a = ap.parse_args(argv)
+    sys.stdout.reconfigure(line_buffering=True)
+    E.REF_TOL = a.ref_tol
+    Ns = [int(x) for x in a.N.split(",") if x]
+    cs = [float(x) for x in a.c.split(",") if x]
+    tols = [float(x) for x in a.tols.split(",") if x]
+    quick_dts = []
+    if a.quick:
+        Ns, cs, tols = [20], [30.0], [1e-4, 1e-6]
+        quick_dts = [axial_dt(20, 30.0) / 2, axial_dt(20, 30.0) / 4]
+    from snapping.simulate.elastic import METHODS
+
+    if a.method.lower() not in METHODS:
+        print(f"--method {a.method!r} is not one of {tuple(METHODS)}", file=sys.stderr)
+        return 2
+    try:
+        import moordyn  # noqa: F401
+    except ImportError:
+        print("moordyn is not installed: pip install 'snapping[peers]' (or pip install moordyn)")
+        return 1
+    E.machine("moordyn")
+    for N in Ns:
+        for c in cs:
+            dts = quick_dts or [float(x) for x in a.dt.split(",") if x] or \
+                [axial_dt(N, c) / 2 ** k for k in range(a.halvings + 1)]
+            compare(a.chi, N, c, dts, a.scheme, a.method.lower(), a.budget, tols, with_ref=not a.no_reference)
+    print(f"uptime: {os.popen('uptime').read().strip()}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

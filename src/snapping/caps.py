@@ -1,0 +1,451 @@
+"""What caps the snap of a real line: design answers from runs of the real model (issue 24).
+
+:func:`cap` answers, for a line in SI (a catalogue line of :mod:`snapping.lines` by name, a
+:class:`snapping.lines.Line`, or the physical parameters alone) released from its catenary at
+end separation chi: the peak speed, acceleration and tension of its snap **from runs of the
+real model**, the ideal chain's answer beside them, the factor between them, and the
+mechanism that capped the snap, decided by computation.
+
+The runs (all on N links, the fast method of :func:`snapping.simulate.run`, tolerance ``tol``):
+
+* **ideal**: the paper's chain, N equal links of the line's length and mass, no body;
+* **full**: the real model with every mechanism at once, the inextensible line of
+  :class:`snapping.simulate.Body` (bending EI, normal and tangential drag, the tip body's
+  drag) with the line's masses (its taper, if any, and the end mass);
+* **each mechanism alone** (``bending``, ``drag``, ``end-mass``, ``taper``: those the line
+  has), the others switched off.
+
+**Stretching** is the elastic model (:func:`snapping.simulate.elastic.solve`), which has no
+bending or drag; it is run when EA is given and matters: when the ideal run's peak speed
+reaches ``STRETCH_MATTERS`` = 5% of the longitudinal wave speed c = sqrt(EA/lambda) (the
+elastic guide's measurements put the peaks' change at 0.1-0.3% for v/c of 1-3% and 4-11% for
+v/c of about 20%). Then it runs the elastic line and the rigid chain on the same
+``STRETCH_N`` = 30 uniform links (grid damping 1, DOP853: seconds) and takes their ratio as the
+stretching factor of each peak (at more links the elastic model's tension peak is not
+reliable: the elastic guide's +45% at N = 100, c = 300, unexplained). The stretching-alone
+answer is the ideal's times that factor; the **real answer** is the full run's times it (the
+two models cannot run together: the factors are taken as independent, and the answer says so).
+Below the threshold the answer says stretching was left out, and why.
+
+**The capping mechanism** (rule): if the real peak (of ``quantity``, default the tension) is
+within 10% of the ideal's (ratio >= :data:`snapping.regimes_analysis.LEVEL` = 0.9, the
+crossover of the regime studies) nothing caps it but the ideal chain's own cap (geometry, and
+the links); otherwise it is the mechanism whose run *alone* comes closest to the real answer,
+closeness measured as |log(alone / real)|.
+
+With ``check=True`` the full run is repeated on N/2 links: the relative change of each peak is
+the answer's resolution check (the peaks of a continuous line converge as the links shrink
+below the capping scale; the ideal chain's do not: its peaks grow with N).
+
+>>> sp = spec("bungee-cord")                      # 1 m of 10 mm shock cord (snapping.lines)
+>>> [m for m in MECHANISMS if sp.has(m)], round(sp.ea, 1)
+(['bending', 'drag', 'stretching'], 200.0)
+>>> r = cap(None, 0.3, N=16, check=False, length=2.0, mass=0.1)   # every mechanism off: the ideal chain
+>>> r["cap"], r["factor"]["sigma_peak"]
+('none', 1.0)
+>>> spec(None, length=2.0, mass=0.1, ei=-1.0)
+Traceback (most recent call last):
+...
+snapping._validate.SnappingInputError: ei=-1.0 is out of range: must be finite and >= 0 (N m2)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+from . import _validate as V
+
+__all__ = ["LineSpec", "spec", "cap", "design", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
+           "format_answer", "format_design"]
+
+#: the ideal run's peak speed over the wave speed above which the stretching is run
+STRETCH_MATTERS = 0.05
+#: links of the elastic and rigid runs that give the stretching factor
+STRETCH_N = 30
+#: the links tried by ``N="auto"``, doubling, and the change of a peak from one to the next that stops it
+AUTO_N = (100, 200, 400, 800, 1600)
+RESOLVED = 0.01
+#: the peaks answered: (name, SI units)
+QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
+#: the mechanisms, in the order they are tried
+MECHANISMS = ("bending", "drag", "end-mass", "taper", "stretching")
+
+
+@dataclass(frozen=True)
+class LineSpec:
+    """A line in SI, checked (:func:`spec`): what :func:`cap` runs. ``ei`` and ``diameter``
+    may be functions of the arclength s (m) from the held end (a catalogue line's taper)."""
+
+    name: str
+    length: float
+    mass: float
+    g: float
+    ei: object = 0.0
+    ea: float | None = None
+    diameter: object = None
+    cd_normal: float | None = None
+    cd_tangential: float | None = None
+    air_density: float | None = None
+    end_mass: float = 0.0
+    tip_drag_area: float = 0.0
+    line: object = None  # the snapping.lines.Line with a taper, or None
+
+    def has(self, mechanism: str) -> bool:
+        """Whether the line has this mechanism at all."""
+        if mechanism == "bending":
+            return callable(self.ei) or self.ei > 0.0
+        if mechanism == "drag":
+            return self.diameter is not None or self.tip_drag_area > 0.0
+        if mechanism == "end-mass":
+            return self.end_mass > 0.0
+        if mechanism == "taper":
+            return self.line is not None and self.line.taper is not None
+        return self.ea is not None  # stretching
+
+    def numbers(self, N: int | None = None) -> dict:
+        """The nondimensional numbers (:func:`snapping.dimensionless.line_numbers`; a taper's at the held end)."""
+        from .dimensionless import line_numbers
+
+        at0 = (lambda v: v(0.0) if callable(v) else v)  # noqa: E731
+        return line_numbers(self.length, self.mass, self.g, N=N, ei=at0(self.ei), ea=self.ea,
+                            diameter=at0(self.diameter), air_density=self.air_density, cd_normal=self.cd_normal,
+                            cd_tangential=self.cd_tangential, end_mass=self.end_mass)
+
+
+def _nonneg(name: str, v, unit: str) -> float:
+    x = V.real(name, v)
+    if not (math.isfinite(x) and x >= 0.0):
+        raise V.SnappingInputError(f"{name}={v!r} is out of range: must be finite and >= 0 ({unit})")
+    return x
+
+
+def _pos(name: str, v, unit: str) -> float:
+    x = V.real(name, v)
+    if not (math.isfinite(x) and x > 0.0):
+        raise V.SnappingInputError(f"{name}={v!r} is out of range: must be finite and > 0 ({unit})")
+    return x
+
+
+def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None, diameter=None, cd_normal=None,
+         cd_tangential=None, air_density=None, end_mass=None, tip_drag_area=None) -> LineSpec:
+    """The :class:`LineSpec` of ``line`` (a catalogue name, a :class:`snapping.lines.Line`, or
+    None: the parameters alone, then ``length`` and ``mass`` are needed), every value
+    overridable: ``length`` m, ``mass`` kg (the line's, without the end mass), ``g`` m/s^2,
+    ``ei`` N m^2, ``ea`` N, ``diameter`` m, ``cd_normal``, ``cd_tangential``, ``air_density``
+    kg/m^3, ``end_mass`` kg, ``tip_drag_area`` m^2. A bad value is refused naming it."""
+    from . import lines
+
+    g = _pos("g", g, "m s-2")
+    for k, v, u in (("ei", ei, "N m2"), ("end_mass", end_mass, "kg"), ("tip_drag_area", tip_drag_area, "m2"),
+                    ("cd_normal", cd_normal, "1"), ("cd_tangential", cd_tangential, "1")):
+        if v is not None:
+            _nonneg(k, v, u)
+    for k, v, u in (("length", length, "m"), ("mass", mass, "kg"), ("ea", ea, "N"), ("diameter", diameter, "m"),
+                    ("air_density", air_density, "kg m-3")):
+        if v is not None:
+            _pos(k, v, u)
+    if line is None:
+        if length is None or mass is None:
+            missing = "length" if length is None else "mass"
+            raise V.SnappingInputError(f"{missing}=None: without a catalogue line both length (m) and mass (kg) "
+                                       f"are needed")
+        if (cd_normal is not None or cd_tangential is not None) and diameter is None:
+            raise V.SnappingInputError("cd_normal/cd_tangential need diameter (m): the drag per length is "
+                                       "0.5 rho C d |v| v")
+        return LineSpec("custom", float(length), float(mass), g, float(ei or 0.0), None if ea is None else float(ea),
+                        None if diameter is None else float(diameter), cd_normal, cd_tangential, air_density,
+                        float(end_mass or 0.0), float(tip_drag_area or 0.0))
+    ln = lines.get(line) if isinstance(line, str) else line
+    if not isinstance(ln, lines.Line):
+        raise V.SnappingInputError(f"line={line!r} is neither a catalogue name ({', '.join(lines.names())}) nor a Line")
+    L = ln.length if length is None else float(length)
+    if mass is not None:
+        if ln.taper is not None:
+            raise V.SnappingInputError(f"mass={mass!r}: line {ln.name} is tapered, its mass follows from its "
+                                       f"profile (change the Line's mass_per_length instead)")
+        ln = ln.replace(mass_per_length=float(mass) / L)
+    si = ln.si(L)
+    return LineSpec(ln.name, L, float(si["mass"]), g, si["ei"] if ei is None else float(ei),
+                    ln.ea if ea is None else float(ea), si["diameter"] if diameter is None else float(diameter),
+                    ln.cd_normal if cd_normal is None else float(cd_normal),
+                    ln.cd_tangential if cd_tangential is None else float(cd_tangential), air_density,
+                    ln.tip_mass if end_mass is None else float(end_mass),
+                    ln.tip_drag_area if tip_drag_area is None else float(tip_drag_area),
+                    ln if ln.taper is not None else None)
+
+
+#: the largest end mass, as a ratio to the line's mass
+END_MASS_MAX = 1e4
+
+
+def _as_spec(line_or_spec, params: dict) -> LineSpec:
+    if isinstance(line_or_spec, LineSpec):
+        sp = replace(line_or_spec, **params) if params else line_or_spec
+    else:
+        sp = spec(line_or_spec, **params)
+    if sp.end_mass > END_MASS_MAX * sp.mass:
+        raise V.SnappingInputError(f"end_mass={sp.end_mass!r} is out of range: at most {END_MASS_MAX:g} times the "
+                                   f"line's mass ({sp.mass:g} kg)")
+    return sp
+
+
+def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper"):
+    """The catenary start of ``sp`` at ``chi`` on ``N`` links with the mechanisms ``on`` (the
+    inextensible model's: stretching is not part of it)."""
+    import numpy as np
+
+    from .simulate import Body, Links, Problem
+
+    tip = sp.end_mass / sp.mass if "end-mass" in on else 0.0
+    if "taper" in on and sp.has("taper"):
+        ln, L = sp.line, sp.length
+        lam = sp.mass / L
+        links = Links.from_density(np.full(N, 1.0 / N), lambda u: ln.mass_per_length * ln.ratio(L * (1.0 - u), L) ** 2
+                                   / lam, tip_mass=tip, kind="line", params={"line": ln.name})
+    else:
+        links = Links.uniform(N, tip_mass=tip, lumping=lumping)
+    kw = {}
+    if "bending" in on and sp.has("bending"):
+        kw["ei"] = sp.ei
+    if "drag" in on and sp.has("drag"):
+        kw.update(diameter=sp.diameter, cd_normal=sp.cd_normal if sp.diameter is not None else None,
+                  cd_tangential=sp.cd_tangential if sp.diameter is not None else None, air_density=sp.air_density,
+                  tip_drag_area=sp.tip_drag_area)
+    body = Body.from_si(sp.length, sp.mass, sp.g, **kw) if kw else None
+    return Problem.catenary(chi, links=links, body=body if body is not None and body.active else None)
+
+
+def _si(sp: LineSpec, nd: dict) -> dict:
+    """Nondimensional peaks in SI: speed sqrt(g L), acceleration g, tension M g."""
+    u = {"v_peak": math.sqrt(sp.g * sp.length), "a_peak": sp.g, "sigma_peak": sp.mass * sp.g}
+    return {q: float(nd[q]) * u[q] for q in QUANTITIES}
+
+
+def _run(problem_, tol: float) -> dict:
+    from .simulate import run
+
+    t0 = time.perf_counter()
+    r = run(problem_, method="fast", tol=tol, progress=False)
+    a = r.dataset.attrs
+    if a.get("status") != "completed":
+        raise RuntimeError(f"a run of the real model did not complete ({a.get('status')}: {a.get('stop_reason', '')})")
+    return {**{q: float(a[q]) for q in QUANTITIES}, "n_rhs": int(a["n_rhs"]), "method": str(a["method"]),
+            "wall": time.perf_counter() - t0}
+
+
+def stretch_factor(sp: LineSpec, chi: float, tol: float = 1e-6, N: int = STRETCH_N) -> dict:
+    """The elastic line over the rigid chain on the same ``N`` uniform links (shared lumping),
+    peak by peak: the stretching factor of :func:`cap`."""
+    from .simulate import Links, Problem, run
+    from .simulate.elastic import Elastic, solve
+
+    t0 = time.perf_counter()
+    p = Problem.catenary(chi, links=Links.uniform(N, lumping="shared"))
+    rigid = run(p, method="fast", tol=tol, progress=False).dataset.attrs
+    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method="dop853").dataset.attrs
+    if el.get("status") != "completed":
+        raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')})")
+    return {**{q: float(el[q]) / float(rigid[q]) for q in QUANTITIES}, "N": N,
+            "n_rhs": int(el["n_rhs"]) + int(rigid["n_rhs"]), "wall": time.perf_counter() - t0,
+            "strain_peak": float(el["strain_peak"])}
+
+
+def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quantity: str = "sigma_peak",
+        check: bool = True, alone: bool = True, **params) -> dict:
+    """The snap of a real line from runs of the real model, the ideal chain's beside it, and
+    what caps it (the module's text says how).
+
+    Parameters
+    ----------
+    line : str, snapping.lines.Line, LineSpec or None
+        A catalogue line, a Line, a :class:`LineSpec`, or None (the ``params`` alone).
+    chi : float
+        End separation over the length, in (0, 1).
+    N : int or "auto"
+        Links of the runs (2 to 20000); ``"auto"``: doubled from 100 (:data:`AUTO_N`) until the
+        full run's ``quantity`` moves by at most 1% (:data:`RESOLVED`; then ``resolved`` True
+        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False).
+    tol : float
+        The fast method's tolerance.
+    quantity : str
+        The peak that decides the capping mechanism: ``v_peak``, ``a_peak`` or ``sigma_peak``.
+    check : bool
+        Repeat the full run on N/2 links (the resolution check).
+    alone : bool
+        Run each mechanism alone (False: only the ideal and full runs, no capping mechanism).
+    **params
+        :func:`spec`'s keywords (SI), overriding the line's.
+
+    Returns
+    -------
+    dict
+        ``line``, ``chi``, ``N``, ``numbers`` (nondimensional), ``ideal``, ``real``, ``full``
+        (the inextensible run with every mechanism), ``alone`` ({mechanism: peaks}), each
+        peaks in SI; ``factor`` (real / ideal per peak), ``cap`` (the capping mechanism or
+        ``"none"``), ``rule``, ``stretching`` (what was done and why), ``resolution``
+        (relative change N/2 -> N per peak), ``n_rhs``, ``wall`` and ``cpu`` (s).
+    """
+    from .estimates import check_chi
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    sp = _as_spec(line, params)
+    chi = check_chi(chi)
+    if isinstance(N, str) and N == "auto":
+        return _auto(sp, chi, tol, quantity, alone, t0, c0)
+    N = V.integer("N", N, 2, 20000)
+    tol = V.open_interval("tol", tol, 0.0, 1e-2)
+    if quantity not in QUANTITIES:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
+    present = [m for m in MECHANISMS[:-1] if sp.has(m)]
+    n_rhs = 0
+
+    def go(on, n=N):
+        nonlocal n_rhs
+        r = _run(problem(sp, chi, n, on), tol)
+        n_rhs += r["n_rhs"]
+        return r
+
+    ideal_nd = go(())
+    full_nd = go(tuple(present)) if present else dict(ideal_nd)
+    alone_nd = {}
+    if alone and len(present) > 1:
+        for m in present:
+            alone_nd[m] = go((m,))
+    elif alone and len(present) == 1:
+        alone_nd[present[0]] = full_nd
+    stretching = {"run": False}
+    factor_s = {q: 1.0 for q in QUANTITIES}
+    if sp.has("stretching"):
+        c = math.sqrt(sp.ea / (sp.mass / sp.length)) / math.sqrt(sp.g * sp.length)
+        ratio = ideal_nd["v_peak"] / c
+        stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio})
+        if ratio >= STRETCH_MATTERS:
+            f = stretch_factor(sp, chi, tol)
+            n_rhs += f["n_rhs"]
+            factor_s = {q: f[q] for q in QUANTITIES}
+            stretching.update({"run": True, "factor": factor_s, "N": f["N"], "strain_peak": f["strain_peak"],
+                               "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g}: run (elastic over rigid, "
+                                      f"{f['N']} links); the real answer is the full run times this factor"})
+            if alone:
+                alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
+        else:
+            stretching["why"] = f"v_peak/c = {ratio:.3g} < {STRETCH_MATTERS:g}: left out (the line is inextensible here)"
+    else:
+        stretching["why"] = "no EA given: inextensible"
+    real_nd = {q: full_nd[q] * factor_s[q] for q in QUANTITIES}
+    resolution = None
+    if check and N >= 4:
+        half = go(tuple(present), N // 2) if present else go((), N // 2)
+        ref = full_nd
+        resolution = {q: (ref[q] - half[q]) / ref[q] for q in QUANTITIES}
+    factor = {q: real_nd[q] / ideal_nd[q] for q in QUANTITIES}
+    from .regimes_analysis import LEVEL
+
+    if factor[quantity] >= LEVEL or not (present or stretching["run"]):
+        capped = "none"
+    elif alone_nd:
+        capped = min(alone_nd, key=lambda m: abs(math.log(alone_nd[m][quantity] / real_nd[quantity])))
+    else:
+        capped = "not decided (alone=False)"
+    rule = (f"{quantity}: real/ideal >= {LEVEL:g} -> none (the ideal chain's own cap: geometry and links); else the "
+            f"mechanism whose run alone is closest to the real answer in |log(alone/real)|")
+    return {"line": sp.name, "chi": chi, "N": N, "tol": tol, "quantity": quantity, "numbers": sp.numbers(N),
+            "mechanisms": present + (["stretching"] if stretching["run"] else []),
+            "ideal": _si(sp, ideal_nd), "full": _si(sp, full_nd), "real": _si(sp, real_nd),
+            "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
+            "stretching": stretching, "resolution": resolution, "methods": {"ideal": ideal_nd["method"],
+                                                                             "full": full_nd.get("method", "")},
+            "n_rhs": n_rhs, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
+
+
+def _auto(sp: LineSpec, chi: float, tol: float, quantity: str, alone: bool, t0: float, c0: float) -> dict:
+    """``N="auto"``: the full run on :data:`AUTO_N` links, doubling, until ``quantity`` moves by at
+    most :data:`RESOLVED` from one to the next (or the last); then :func:`cap` on those links,
+    its resolution the last two full runs'."""
+    if quantity not in QUANTITIES:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
+    on = tuple(m for m in MECHANISMS[:-1] if sp.has(m))
+    runs, n_rhs = [], 0
+    for n in AUTO_N:
+        runs.append(_run(problem(sp, chi, n, on), tol))
+        n_rhs += runs[-1]["n_rhs"]
+        if len(runs) > 1 and abs(runs[-1][quantity] - runs[-2][quantity]) <= RESOLVED * abs(runs[-1][quantity]):
+            break
+    prev, cur = runs[-2], runs[-1]
+    r = cap(sp, chi, N=n, tol=tol, quantity=quantity, check=False, alone=alone)
+    r["resolution"] = {q: (cur[q] - prev[q]) / cur[q] for q in QUANTITIES}
+    r["resolved"] = abs(r["resolution"][quantity]) <= RESOLVED
+    r["auto_N"] = [m for m in AUTO_N if m <= n]
+    r["n_rhs"] += n_rhs
+    r["wall"], r["cpu"] = time.perf_counter() - t0, time.process_time() - c0
+    return r
+
+
+def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int = 200, tol: float = 1e-6,
+           max_tension=None, max_speed=None, max_acceleration=None, **params) -> dict:
+    """Which end separations keep the real line's peaks under the limits: :func:`cap` (ideal
+    and real runs, no mechanism-alone runs) at each chi of ``chis``; ``rows`` per chi with
+    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it."""
+    sp = _as_spec(line, params)
+    limits = {}
+    for k, q, v in (("max_tension", "sigma_peak", max_tension), ("max_speed", "v_peak", max_speed),
+                    ("max_acceleration", "a_peak", max_acceleration)):
+        if v is not None:
+            limits[q] = _pos(k, v, QUANTITIES[q])
+    if not limits:
+        raise V.SnappingInputError("give at least one limit: max_tension (N), max_speed (m/s) or max_acceleration "
+                                   "(m/s^2)")
+    if isinstance(chis, (int, float)):
+        chis = [chis]
+    t0 = time.perf_counter()
+    rows = []
+    for chi in sorted(chis):
+        r = cap(sp, chi, N=N, tol=tol, check=False, alone=False)
+        rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"],
+                     "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
+                     "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
+    ok = [r["chi"] for r in rows if r["admissible"]]
+    return {"line": sp.name, "N": N, "limits": limits, "rows": rows, "admissible_chi": ok,
+            "numbers": sp.numbers(N), "wall": time.perf_counter() - t0}
+
+
+def format_answer(r: dict) -> list[str]:
+    """Text lines of a :func:`cap` answer."""
+    out = [f"What caps the snap: {r['line']} at chi = {r['chi']:g}, {r['N']} links (runs of the real model, tol "
+           f"{r['tol']:g})", f"  {'peak':<12}{'ideal chain':>14}{'real line':>14}{'factor':>9}   units"]
+    for q, u in QUANTITIES.items():
+        out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
+    if r["alone"]:
+        out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
+            f"{m} {v[r['quantity']]:.5g}" for m, v in r["alone"].items()))
+    out.append(f"  stretching: {r['stretching']['why']}")
+    if r.get("auto_N"):
+        out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
+                   f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
+    if r["resolution"]:
+        out.append("  resolution (full run, N/2 -> N): " + ", ".join(f"{q} {v:+.2%}" for q, v in r["resolution"].items()))
+    verdict = ("nothing but the ideal chain's own cap (real within 10% of ideal)" if r["cap"] == "none" else r["cap"])
+    out.append(f"  capped by: {verdict} -- {r['quantity']} {r['real'][r['quantity']]:.5g} "
+               f"{QUANTITIES[r['quantity']]} (ideal {r['ideal'][r['quantity']]:.5g})")
+    out.append(f"  rule: {r['rule']}")
+    out.append(f"  cost: {r['n_rhs']} right-hand-side evaluations, {r['wall']:.2f} s ({r['cpu']:.2f} s CPU)")
+    return out
+
+
+def format_design(d: dict) -> list[str]:
+    """Text lines of a :func:`design` answer."""
+    lim = ", ".join(f"{q} <= {v:g} {QUANTITIES[q]}" for q, v in d["limits"].items())
+    out = [f"Design from runs of the real model: {d['line']}, {d['N']} links; limits {lim}",
+           f"  {'chi':>6}{'ideal v':>11}{'real v':>11}{'ideal a':>11}{'real a':>11}{'ideal T':>11}{'real T':>11}"
+           f"{'T factor':>10}  real ok  ideal ok"]
+    for r in d["rows"]:
+        i, x = r["ideal"], r["real"]
+        out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
+                   f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
+                   f"{'yes' if r['admissible'] else 'no':>7}  {'yes' if r['ideal_admissible'] else 'no':>8}")
+    ok = d["admissible_chi"]
+    out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}"
+               f" ({d['wall']:.1f} s)")
+    return out
