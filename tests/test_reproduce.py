@@ -76,8 +76,12 @@ def test_tiny_reproduction_writes_report_and_figures(tiny):
     for a in answers:
         assert f"| {a['line']} | 0.25 | {a['N']} | {a['ideal']['sigma_peak']:.4g} | {a['real']['sigma_peak']:.4g} | " \
                f"{a['factor']['sigma_peak']:.3f} | {a['cap']} | {caps_report.resolved_words(a)} |" in text
-    assert "### Regime study: end-mass" in text and "**Verdict (computed, v_peak): chi=0.5:" in text
-    assert (tmp_path / "figures" / "fig7_regime_map_end-mass.png").stat().st_size > 5000
+    from snapping.regimes import BUNDLED
+
+    for mech in BUNDLED:  # the shipped studies, each with its computed verdict and its regime map
+        assert f"### Regime study: {mech} (shipped study file)" in text
+        assert (tmp_path / "figures" / f"fig7_regime_map_{mech}.png").stat().st_size > 5000
+    assert text.count("**Verdict (computed, v_peak): chi=0.1:") == len(BUNDLED)
     # every claim row has four cells and a verdict
     rows = [l for l in text.splitlines() if l.startswith("| ") and not l.startswith("| claim") and "seconds" not in l]
     assert len(rows) >= 15
