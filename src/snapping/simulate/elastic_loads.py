@@ -189,8 +189,8 @@ def jerk_taut(*, mass: float, speed: float, slack: float, ea: float, length: flo
         tension came), ``mass_ratio`` (tether mass over ``mass``), ``run`` (the
         :class:`ElasticRun`, nondimensional).
 
-    Example
-    -------
+    Examples
+    --------
     >>> r = jerk_taut(mass=5.0, speed=2.0, slack=0.5, ea=2e4, length=3.0, mass_per_length=1e-4, N=1)
     >>> abs(r["peak_force"] / r["formula_force"] - 1.0) < 1e-6
     True
