@@ -64,13 +64,92 @@ NREC = 3 + C.NMEAS
 RECORD_NAMES = ("t", "dt", "err") + C.MEAS_NAMES
 RECORD_CHUNK = 4096
 PEAK_XTOL = 1e-10
-#: error norm: per link (:func:`step_error3d`, True) or per component (:func:`snapping.simulate.rk.step_error`)
-NORM_LINK = True
+#: error norm: 2 the links' angle and angular-velocity errors (:func:`step_error3d`, the planar
+#: method's quantities), 1 per component scaled by the link's norms (:func:`step_error3d_components`,
+#: the norm before), 0 per component (:func:`snapping.simulate.rk.step_error`)
+NORM_MODE = 2
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
-    """The scaled error of a step (accept if <= 1): Hairer's DOP853 estimate of every
+    """The scaled error of a step (accept if <= 1), the planar method's quantity in 3D.
+
+    Hairer's DOP853 estimates (the 5th- and 3rd-order error vectors ``E5, E3`` of
+    :func:`snapping.simulate.rk.scaled_error`) of each link's direction ``e_j`` and rate
+    ``u_j``, taken as 3-vectors and projected onto the plane normal to ``e_j`` (at the step's
+    end): the parts along ``e_j`` (a drift of ``|e_j|`` off 1 and of ``e_j . u_j`` off 0) are
+    what :func:`snapping.spatial.chain3d.project` removes after the step, so they are not an
+    error of the solution. What is left is the error of the link's angle (``|P E5(e_j)|``, the
+    planar method's angle error) and of its angular velocity (``|P E5(u_j)|``: for a planar
+    motion ``u_j = omega_j n x e_j``, and the error of ``omega_j``), scaled as the planar norm
+    scales them: by ``tol (1 + |e_j|)`` and ``tol (1 + |u_j|)`` (the larger at the step's two
+    ends). Error per link ``|h| |E5|^2 / sqrt(|E5|^2 + 0.01 |E3|^2)`` (Hairer's combination with
+    the squares summed over the vector's components); ``W`` (and ``D`` with a body): per
+    component, their own size. The maximum over links and components; inf if not finite."""
+    n3 = 3 * N
+    ah = abs(h)
+    err = 0.0
+    for j in range(N):
+        ex = y1[j]
+        ey = y1[N + j]
+        ez = y1[2 * N + j]
+        a1 = ex * ex + ey * ey + ez * ez
+        a0 = y0[j] * y0[j] + y0[N + j] * y0[N + j] + y0[2 * N + j] * y0[2 * N + j]
+        b0 = 0.0
+        b1 = 0.0
+        for c in range(3):
+            i = n3 + c * N + j
+            b0 += y0[i] * y0[i]
+            b1 += y1[i] * y1[i]
+        inv = 1.0 / math.sqrt(a1)
+        ex *= inv
+        ey *= inv
+        ez *= inv
+        for part in range(2):
+            off = part * n3 + j
+            p5x, p3x = _e53(Kst, off)
+            p5y, p3y = _e53(Kst, off + N)
+            p5z, p3z = _e53(Kst, off + 2 * N)
+            d5 = p5x * ex + p5y * ey + p5z * ez
+            d3 = p3x * ex + p3y * ey + p3z * ez
+            p5x -= d5 * ex
+            p5y -= d5 * ey
+            p5z -= d5 * ez
+            p3x -= d3 * ex
+            p3y -= d3 * ey
+            p3z -= d3 * ez
+            sc = tol * (1.0 + math.sqrt(max(a0, a1) if part == 0 else max(b0, b1)))
+            s5 = (p5x * p5x + p5y * p5y + p5z * p5z) / (sc * sc)
+            s3 = (p3x * p3x + p3y * p3y + p3z * p3z) / (sc * sc)
+            d = s5 + 0.01 * s3
+            v = ah * s5 / math.sqrt(d) if d > 0.0 else (0.0 if d == 0.0 else np.inf)
+            if not (v <= err):
+                err = v
+    for i in range(2 * n3, y0.shape[0]):  # W (and D with a body): their own size
+        v = R.scaled_error(Kst, i, y0[i], y1[i], h, tol)
+        if not (v <= err):
+            err = v
+    return err if err - err == 0.0 else np.inf
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
+def _e53(Kst, i):
+    """Component i's DOP853 error estimates ``(E5, E3)`` (unscaled, as in
+    :func:`snapping.simulate.rk.scaled_error`)."""
+    e5 = 0.0
+    for jj in range(R._E5NZ.size):
+        j = R._E5NZ[jj]
+        e5 += R.E5_RK[j] * Kst[j, i]
+    e3 = 0.0
+    for jj in range(R._E3NZ.size):
+        j = R._E3NZ[jj]
+        e3 += R.E3_RK[j] * Kst[j, i]
+    return e5, e3
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def step_error3d_components(N, h, tol, y0, y1, Kst, ytmp):
+    """The former scaled error of a step (kept for comparison, ``NORM_MODE = 1``) (accept if <= 1): Hairer's DOP853 estimate of every
     component (as :func:`snapping.simulate.rk.scaled_error`), scaled per link by
     ``tol (1 + |e_j|)`` for the three components of ``e_j`` and ``tol (1 + |u_j|)`` for those
     of ``u_j`` (the larger at the step's two ends), maximum over the components. The norm of
@@ -115,8 +194,10 @@ def step3d(N, t, h, y0, y1, Kst, ytmp, T, cp, dp, tol, par, hh, invm):
         C.rhs3d(N, t + R.C_RK[st] * h, ytmp, Kst[st], T, cp, dp, par, hh, invm)
     R.end_state(n, h, y0, Kst, y1)
     C.rhs3d(N, t + h, y1, Kst[R.NS], T, cp, dp, par, hh, invm)
-    if NORM_LINK:
+    if NORM_MODE == 2:
         return step_error3d(N, h, tol, y0, y1, Kst, ytmp)
+    if NORM_MODE == 1:
+        return step_error3d_components(N, h, tol, y0, y1, Kst, ytmp)
     return R.step_error(n, h, tol, y0, y1, Kst, ytmp)
 
 
@@ -324,15 +405,22 @@ class Stepper3D:
         c[Q_NREC] = 1.0
 
     def _initial_step(self, y0, f0, t0) -> float:
-        """Hairer's starting step (Solving ODE I, II.4), in the run's max norm."""
-        sc = self.tol * (1.0 + np.abs(y0))
-        d0, d1 = np.max(np.abs(y0) / sc), np.max(np.abs(f0) / sc)
+        """Hairer's starting step (Solving ODE I, II.4), in the run's norm: each link's
+        ``e_j`` and ``u_j`` (and their rates) by their vector lengths, as :func:`step_error3d`
+        (so that a rotated problem starts with the same step), ``W`` (``D``) by their own."""
+        N = self.N
+
+        def size(y):
+            return np.concatenate([np.sqrt((y[:6 * N].reshape(2, 3, N) ** 2).sum(axis=1)).ravel(), np.abs(y[6 * N:])])
+
+        sc = self.tol * (1.0 + size(y0))
+        d0, d1 = np.max(size(y0) / sc), np.max(size(f0) / sc)
         h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
         f1 = np.empty_like(y0)
         par, h, invm = self.mdl
         C.rhs3d(self.N, t0 + h0, y0 + h0 * f0, f1, self.rw.T, self.rw.cp, self.rw.dp, par, h, invm)
         self.ctl[Q_NRHS] += 1.0
-        d2 = np.max(np.abs(f1 - f0) / sc) / h0
+        d2 = np.max(size(f1 - f0) / sc) / h0
         h1 = max(1e-6, h0 * 1e-3) if max(d1, d2) <= 1e-15 else (0.01 / max(d1, d2)) ** (1.0 / 8.0)
         return float(min(100.0 * h0, h1))
 
