@@ -85,47 +85,48 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
     scales them: by ``tol (1 + |e_j|)`` and ``tol (1 + |u_j|)`` (the larger at the step's two
     ends). Error per link ``|h| |E5|^2 / sqrt(|E5|^2 + 0.01 |E3|^2)`` (Hairer's combination with
     the squares summed over the vector's components); ``W`` (and ``D`` with a body): per
-    component, their own size. The maximum over links and components; inf if not finite."""
+    component, their own size. The maximum over links and components; inf if not finite.
+    Uses ``ytmp`` and ``Kst[NSX - 2:]`` (dense-output stages, free during a step) as scratch."""
     n3 = 3 * N
+    n6 = 2 * n3
     ah = abs(h)
-    err = 0.0
-    for j in range(N):
+    e5v = ytmp
+    e3v = Kst[R.NSX - 1]  # (scratch: the last dense-output stage, which dense_build3d fills afresh)
+    for i in range(n6):  # (the estimates of all e, u components first, stage by stage: vectorises)
+        e5v[i] = 0.0
+        e3v[i] = 0.0
+    for jj in range(R._E5NZ.size):
+        k = R._E5NZ[jj]
+        c = R.E5_RK[k]
+        Kk = Kst[k]
+        for i in range(n6):
+            e5v[i] += c * Kk[i]
+    for jj in range(R._E3NZ.size):
+        k = R._E3NZ[jj]
+        c = R.E3_RK[k]
+        Kk = Kst[k]
+        for i in range(n6):
+            e3v[i] += c * Kk[i]
+    out = Kst[R.NSX - 2]  # (scratch as e3v: each link's two terms, then their maximum)
+    for j in range(N):  # (branch-free: vectorises)
         ex = y1[j]
         ey = y1[N + j]
         ez = y1[2 * N + j]
         a1 = ex * ex + ey * ey + ez * ez
         a0 = y0[j] * y0[j] + y0[N + j] * y0[N + j] + y0[2 * N + j] * y0[2 * N + j]
-        b0 = 0.0
-        b1 = 0.0
-        for c in range(3):
-            i = n3 + c * N + j
-            b0 += y0[i] * y0[i]
-            b1 += y1[i] * y1[i]
+        b0 = y0[n3 + j] * y0[n3 + j] + y0[n3 + N + j] * y0[n3 + N + j] + y0[n3 + 2 * N + j] * y0[n3 + 2 * N + j]
+        b1 = y1[n3 + j] * y1[n3 + j] + y1[n3 + N + j] * y1[n3 + N + j] + y1[n3 + 2 * N + j] * y1[n3 + 2 * N + j]
         inv = 1.0 / math.sqrt(a1)
         ex *= inv
         ey *= inv
         ez *= inv
-        for part in range(2):
-            off = part * n3 + j
-            p5x, p3x = _e53(Kst, off)
-            p5y, p3y = _e53(Kst, off + N)
-            p5z, p3z = _e53(Kst, off + 2 * N)
-            d5 = p5x * ex + p5y * ey + p5z * ez
-            d3 = p3x * ex + p3y * ey + p3z * ez
-            p5x -= d5 * ex
-            p5y -= d5 * ey
-            p5z -= d5 * ez
-            p3x -= d3 * ex
-            p3y -= d3 * ey
-            p3z -= d3 * ez
-            sc = tol * (1.0 + math.sqrt(max(a0, a1) if part == 0 else max(b0, b1)))
-            s5 = (p5x * p5x + p5y * p5y + p5z * p5z) / (sc * sc)
-            s3 = (p3x * p3x + p3y * p3y + p3z * p3z) / (sc * sc)
-            d = s5 + 0.01 * s3
-            v = ah * s5 / math.sqrt(d) if d > 0.0 else (0.0 if d == 0.0 else np.inf)
-            if not (v <= err):
-                err = v
-    for i in range(2 * n3, y0.shape[0]):  # W (and D with a body): their own size
+        out[j] = _link_term(e5v, e3v, j, N, ex, ey, ez, tol * (1.0 + math.sqrt(max(a0, a1))), ah)
+        out[N + j] = _link_term(e5v, e3v, n3 + j, N, ex, ey, ez, tol * (1.0 + math.sqrt(max(b0, b1))), ah)
+    err = 0.0
+    for i in range(2 * N):
+        v = out[i]
+        err = v if not (v <= err) else err
+    for i in range(n6, y0.shape[0]):  # W (and D with a body): their own size
         v = R.scaled_error(Kst, i, y0[i], y1[i], h, tol)
         if not (v <= err):
             err = v
@@ -133,18 +134,36 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
-def _e53(Kst, i):
-    """Component i's DOP853 error estimates ``(E5, E3)`` (unscaled, as in
-    :func:`snapping.simulate.rk.scaled_error`)."""
-    e5 = 0.0
-    for jj in range(R._E5NZ.size):
-        j = R._E5NZ[jj]
-        e5 += R.E5_RK[j] * Kst[j, i]
-    e3 = 0.0
-    for jj in range(R._E3NZ.size):
-        j = R._E3NZ[jj]
-        e3 += R.E3_RK[j] * Kst[j, i]
-    return e5, e3
+def _link_term(e5v, e3v, off, N, ex, ey, ez, sc, ah):
+    """Hairer's term of one link's 3-vector (components at ``off, off + N, off + 2N`` of the
+    estimates ``e5v, e3v``), its part normal to the unit ``(ex, ey, ez)``, scaled by ``sc``:
+    0 where both vanish, inf where not finite (as :func:`snapping.simulate.rk.scaled_error`)."""
+    p5x = e5v[off]
+    p5y = e5v[off + N]
+    p5z = e5v[off + 2 * N]
+    p3x = e3v[off]
+    p3y = e3v[off + N]
+    p3z = e3v[off + 2 * N]
+    d5 = p5x * ex + p5y * ey + p5z * ez
+    d3 = p3x * ex + p3y * ey + p3z * ez
+    p5x -= d5 * ex
+    p5y -= d5 * ey
+    p5z -= d5 * ez
+    p3x -= d3 * ex
+    p3y -= d3 * ey
+    p3z -= d3 * ez
+    isc = 1.0 / sc
+    p5x *= isc
+    p5y *= isc
+    p5z *= isc
+    p3x *= isc
+    p3y *= isc
+    p3z *= isc
+    s5 = p5x * p5x + p5y * p5y + p5z * p5z
+    s3 = p3x * p3x + p3y * p3y + p3z * p3z
+    d = s5 + 0.01 * s3
+    v = ah * s5 / math.sqrt(d)
+    return v if d > 0.0 else (0.0 if d == 0.0 else np.inf)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
