@@ -271,13 +271,38 @@ def pin3d(t, par):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _pass3(N, y, f, T, h, invm, Ex, Ey, Ez):
+    """Pass 3 of :func:`rhs3d` without a body, the same expressions (bit for bit), one
+    component at a time over slices, each link's two node accelerations formed afresh rather
+    than carried over from the previous link (so that the loop vectorises)."""
+    U = 3 * N
+    for c in range(3):
+        fo = f[U + c * N:U + (c + 1) * N]
+        yo = y[c * N:(c + 1) * N]
+        E = Ex if c == 0 else (Ey if c == 1 else Ez)
+        if N == 1:
+            fo[0] = (E - T[0] * yo[0] * invm[0]) * (1.0 / h[0])
+            continue
+        fo[0] = ((T[1] * yo[1] - T[0] * yo[0]) * invm[1] - T[0] * yo[0] * invm[0]) * (1.0 / h[0])
+        for j in range(1, N - 1):
+            Tm = T[j - 1]
+            T0 = T[j]
+            T1 = T[j + 1]
+            fo[j] = ((T1 * yo[j + 1] - T0 * yo[j]) * invm[j + 1] - (T0 * yo[j] - Tm * yo[j - 1]) * invm[j]) * (1.0 / h[j])
+        j = N - 1
+        fo[j] = (E - (T[j] * yo[j] - T[j - 1] * yo[j - 1]) * invm[j]) * (1.0 / h[j])
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
     """Derivative ``f = [u, e'', W']`` of the state ``y`` (length 6N + 1) at time t; leaves the
     tensions in ``T``. Pass 1: the rows and Thomas's forward elimination; pass 2: back
     substitution; pass 3: node accelerations less gravity and ``e_j'' = d_j''/h_j``."""
     n3 = 3 * N
+    fo = f[:n3]  # (slices, here and in pass 3: the loops then vectorise)
+    yo = y[n3:2 * n3]
     for i in range(n3):
-        f[i] = y[n3 + i]
+        fo[i] = yo[i]
     px, py, pz, pvx, pvy, pvz, pax, pay, paz = pin3d(t, par)
     body = F3.has_body(par, int(par[P_BODY]))  # (a body: node forces F, their link accelerations a^F_j in the rows)
     pF = 0.0
@@ -338,6 +363,10 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
         Tn = dp[j] - cp[j] * Tn
         T[j] = Tn
     # ---- pass 3: a_j = (T_j e_j - T_{j-1} e_{j-1})/m_j; e_j'' = (a_{j+1} - a_j)/h_j, held link (E - a)/h
+    if not body:
+        _pass3(N, y, f, T, h, invm, Ex, Ey, Ez)
+        f[6 * N] = T[N - 1] * (y[X + N - 1] * pvx + y[Y + N - 1] * pvy + y[Z + N - 1] * pvz)
+        return
     Tl = T[0]
     im = invm[0]
     ajx = Tl * y[X] * im
