@@ -271,6 +271,28 @@ def pin3d(t, par):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _rows(N, y, h, invm, cp, dp, Ex, Ey, Ez):
+    """The tension rows of :func:`rhs3d` without a body, ahead of the elimination (a loop
+    that vectorises): ``cp_j`` the coupling ``(e_j . e_{j+1})/m_{j+1}`` (0 for the last
+    link), ``dp_j`` the right-hand side ``-h_j |u_j|^2`` (less ``E . e`` for the last link);
+    the same expressions as in :func:`rhs3d` (bit for bit)."""
+    n3 = 3 * N
+    ex = y[:N]
+    ey = y[N:2 * N]
+    ez = y[2 * N:n3]
+    ux = y[n3:n3 + N]
+    uy = y[n3 + N:n3 + 2 * N]
+    uz = y[n3 + 2 * N:2 * n3]
+    for j in range(N - 1):
+        cp[j] = (ex[j] * ex[j + 1] + ey[j] * ey[j + 1] + ez[j] * ez[j + 1]) * invm[j + 1]
+    for j in range(N):
+        dp[j] = -h[j] * (ux[j] * ux[j] + uy[j] * uy[j] + uz[j] * uz[j])
+    j = N - 1
+    cp[j] = 0.0
+    dp[j] -= Ex * ex[j] + Ey * ey[j] + Ez * ez[j]
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _pass3(N, y, f, T, h, invm, Ex, Ey, Ez):
     """Pass 3 of :func:`rhs3d` without a body, the same expressions (bit for bit), one
     component at a time over slices, each link's two node accelerations formed afresh rather
@@ -325,6 +347,27 @@ def rhs3d(N, t, y, f, T, cp, dp, par, h, invm):
     pmm = 0.0
     q = 0.0
     j0 = 0
+    if not body:
+        _rows(N, y, h, invm, cp, dp, Ex, Ey, Ez)
+        while j0 < N:
+            j1 = min(j0 + BLOCK, N)
+            for j in range(j0, j1):
+                e = cp[j]
+                r = dp[j]
+                b = -(invm[j] + invm[j + 1]) if j < N - 1 else -invm[j]
+                p = b * pm - (eprev * eprev) * pmm
+                q = r * pm - eprev * q
+                inv = 1.0 / p
+                cp[j] = e * pm * inv
+                dp[j] = q * inv
+                pmm = pm
+                pm = p
+                eprev = e
+            sc = 1.0 / _pow2_near(pm)
+            pm *= sc
+            pmm *= sc
+            q *= sc
+            j0 = j1
     while j0 < N:
         j1 = min(j0 + BLOCK, N)
         for j in range(j0, j1):
