@@ -138,20 +138,38 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
         for i in range(n6):
             e3v[i] += c * Kk[i]
     out = Kst[R.NSX - 2]  # (scratch as e3v: each link's two terms, then their maximum)
-    for j in range(N):  # (branch-free: vectorises)
-        ex = y1[j]
-        ey = y1[N + j]
-        ez = y1[2 * N + j]
-        a1 = ex * ex + ey * ey + ez * ez
-        a0 = y0[j] * y0[j] + y0[N + j] * y0[N + j] + y0[2 * N + j] * y0[2 * N + j]
-        b0 = y0[n3 + j] * y0[n3 + j] + y0[n3 + N + j] * y0[n3 + N + j] + y0[n3 + 2 * N + j] * y0[n3 + 2 * N + j]
-        b1 = y1[n3 + j] * y1[n3 + j] + y1[n3 + N + j] * y1[n3 + N + j] + y1[n3 + 2 * N + j] * y1[n3 + 2 * N + j]
-        inv = 1.0 / math.sqrt(a1)
-        ex *= inv
-        ey *= inv
-        ez *= inv
-        out[j] = _link_term(e5v, e3v, j, N, ex, ey, ez, tol * (1.0 + math.sqrt(max(a0, a1))), ah)
-        out[N + j] = _link_term(e5v, e3v, n3 + j, N, ex, ey, ez, tol * (1.0 + math.sqrt(max(b0, b1))), ah)
+    for part in range(2):  # (over slices, branch-free: vectorises)
+        o = part * n3
+        vx0, vy0, vz0 = y0[o:o + N], y0[o + N:o + 2 * N], y0[o + 2 * N:o + n3]
+        vx1, vy1, vz1 = y1[o:o + N], y1[o + N:o + 2 * N], y1[o + 2 * N:o + n3]
+        ex1, ey1, ez1 = y1[:N], y1[N:2 * N], y1[2 * N:n3]
+        p5x, p5y, p5z = e5v[o:o + N], e5v[o + N:o + 2 * N], e5v[o + 2 * N:o + n3]
+        p3x, p3y, p3z = e3v[o:o + N], e3v[o + N:o + 2 * N], e3v[o + 2 * N:o + n3]
+        ob = out[part * N:(part + 1) * N]
+        for j in range(N):
+            ex = ex1[j]
+            ey = ey1[j]
+            ez = ez1[j]
+            inv = 1.0 / math.sqrt(ex * ex + ey * ey + ez * ez)
+            ex *= inv
+            ey *= inv
+            ez *= inv
+            a0 = vx0[j] * vx0[j] + vy0[j] * vy0[j] + vz0[j] * vz0[j]
+            a1 = vx1[j] * vx1[j] + vy1[j] * vy1[j] + vz1[j] * vz1[j]
+            isc = 1.0 / (tol * (1.0 + math.sqrt(max(a0, a1))))
+            d5 = p5x[j] * ex + p5y[j] * ey + p5z[j] * ez
+            d3 = p3x[j] * ex + p3y[j] * ey + p3z[j] * ez
+            qx = (p5x[j] - d5 * ex) * isc
+            qy = (p5y[j] - d5 * ey) * isc
+            qz = (p5z[j] - d5 * ez) * isc
+            s5 = qx * qx + qy * qy + qz * qz
+            qx = (p3x[j] - d3 * ex) * isc
+            qy = (p3y[j] - d3 * ey) * isc
+            qz = (p3z[j] - d3 * ez) * isc
+            s3 = qx * qx + qy * qy + qz * qz
+            d = s5 + 0.01 * s3
+            v = ah * s5 / math.sqrt(d)
+            ob[j] = v if d > 0.0 else (0.0 if d == 0.0 else np.inf)
     err = 0.0
     for i in range(2 * N):
         v = out[i]
@@ -161,39 +179,6 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
         if not (v <= err):
             err = v
     return err if err - err == 0.0 else np.inf
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy", inline="always")
-def _link_term(e5v, e3v, off, N, ex, ey, ez, sc, ah):
-    """Hairer's term of one link's 3-vector (components at ``off, off + N, off + 2N`` of the
-    estimates ``e5v, e3v``), its part normal to the unit ``(ex, ey, ez)``, scaled by ``sc``:
-    0 where both vanish, inf where not finite (as :func:`snapping.simulate.rk.scaled_error`)."""
-    p5x = e5v[off]
-    p5y = e5v[off + N]
-    p5z = e5v[off + 2 * N]
-    p3x = e3v[off]
-    p3y = e3v[off + N]
-    p3z = e3v[off + 2 * N]
-    d5 = p5x * ex + p5y * ey + p5z * ez
-    d3 = p3x * ex + p3y * ey + p3z * ez
-    p5x -= d5 * ex
-    p5y -= d5 * ey
-    p5z -= d5 * ez
-    p3x -= d3 * ex
-    p3y -= d3 * ey
-    p3z -= d3 * ez
-    isc = 1.0 / sc
-    p5x *= isc
-    p5y *= isc
-    p5z *= isc
-    p3x *= isc
-    p3y *= isc
-    p3z *= isc
-    s5 = p5x * p5x + p5y * p5y + p5z * p5z
-    s3 = p3x * p3x + p3y * p3y + p3z * p3z
-    d = s5 + 0.01 * s3
-    v = ah * s5 / math.sqrt(d)
-    return v if d > 0.0 else (0.0 if d == 0.0 else np.inf)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
