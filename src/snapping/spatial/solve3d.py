@@ -122,21 +122,26 @@ def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
     ah = abs(h)
     e5v = ytmp
     e3v = Kst[R.NSX - 1]  # (scratch: the last dense-output stage, which dense_build3d fills afresh)
-    for i in range(n6):  # (the estimates of all e, u components first, stage by stage: vectorises)
-        e5v[i] = 0.0
-        e3v[i] = 0.0
-    for jj in range(R._E5NZ.size):
-        k = R._E5NZ[jj]
-        c = R.E5_RK[k]
-        Kk = Kst[k]
-        for i in range(n6):
-            e5v[i] += c * Kk[i]
-    for jj in range(R._E3NZ.size):
-        k = R._E3NZ[jj]
-        c = R.E3_RK[k]
-        Kk = Kst[k]
-        for i in range(n6):
-            e3v[i] += c * Kk[i]
+    for i0 in range(0, n6, STAGE_BLOCK):  # (the estimates of all e, u components first, in cache blocks)
+        i1 = min(i0 + STAGE_BLOCK, n6)
+        nb = i1 - i0
+        b5 = e5v[i0:i1]
+        b3 = e3v[i0:i1]
+        for i in range(nb):
+            b5[i] = 0.0
+            b3[i] = 0.0
+        for jj in range(R._E5NZ.size):
+            k = R._E5NZ[jj]
+            c = R.E5_RK[k]
+            Kk = Kst[k, i0:i1]
+            for i in range(nb):
+                b5[i] += c * Kk[i]
+        for jj in range(R._E3NZ.size):
+            k = R._E3NZ[jj]
+            c = R.E3_RK[k]
+            Kk = Kst[k, i0:i1]
+            for i in range(nb):
+                b3[i] += c * Kk[i]
     out = Kst[R.NSX - 2]  # (scratch as e3v: each link's two terms, then their maximum)
     for part in range(2):  # (over slices, branch-free: vectorises)
         o = part * n3
