@@ -69,7 +69,7 @@ def _time_calls(fns, n=300, rounds=20):
     return best
 
 
-def cost(N, chi, tol, eps=1e-4):
+def cost(N, chi, tol, eps=1e-4, repeat=3):
     from snapping.simulate import general as G
     from snapping.simulate import models as MD
     from snapping.simulate import angles as AG
@@ -97,17 +97,19 @@ def cost(N, chi, tol, eps=1e-4):
         "gen": lambda: G.general_rhs(N, 0.0, yg, fg, w.c, w.s, w.S, w.cp, w.dp, w.sig, *gm),
         "3d": lambda: C.rhs3d(N, 0.0, y3, f3, w3.T, w3.cp, w3.dp, *m3)})
     t_uni, t_gen, t_3d = best["uni"], best["gen"], best["3d"]
-    print(f"# cost at N={N}, chi={chi}, tol={tol:g} ({_load()})")
+    print(f"# cost at N={N}, chi={chi}, tol={tol:g}, least CPU time of {repeat} runs ({_load()})")
     print(f"one evaluation (least CPU time): planar uniform {t_uni * 1e6:.2f} us, planar general {t_gen * 1e6:.2f} us, "
           f"3D {t_3d * 1e6:.2f} us: 3D/uniform {t_3d / t_uni:.2f}x, 3D/general {t_3d / t_gen:.2f}x")
     run(problem=Problem.catenary(chi, 20), method="fast", tol=tol)  # (compiled, both)
     run3d(Problem3D.catenary(chi, 20), tol=tol)
-    c0 = time.process_time()
-    ds = run(problem=prob, method="fast", tol=tol).dataset
-    pc = time.process_time() - c0
-    c0 = time.process_time()
-    r = run3d(p3, tol=tol)
-    rc = time.process_time() - c0
+    pc = rc = np.inf
+    for _ in range(repeat):  # (least CPU time of `repeat` runs each, interleaved)
+        c0 = time.process_time()
+        ds = run(problem=prob, method="fast", tol=tol).dataset
+        pc = min(pc, time.process_time() - c0)
+        c0 = time.process_time()
+        r = run3d(p3, tol=tol)
+        rc = min(rc, time.process_time() - c0)
     pw, pn, ps = float(ds.attrs["wall_time"]), int(ds.attrs["n_rhs"]), int(ds.attrs["n_steps"])
     print(f"planar run: v_peak {float(ds.attrs['v_peak']):.9f}, {pn} evaluations, {ps} steps, wall {pw:.3f} s, "
           f"CPU {pc:.3f} s ({pc / pn * 1e6:.2f} us CPU an evaluation incl. stepping)")
@@ -136,7 +138,7 @@ def profile(N, chi, tol, eps=1e-4):
 
     def stages():
         for st in range(1, R.NS):
-            R._stage_state(n, st, 0.01, y0, K, ytmp)
+            S._stage_state3d(n, st, 0.01, y0, K, ytmp)
 
     best = _time_calls({
         "12 evaluations": lambda: [C.rhs3d(N, 0.0, y0, K[1], w.T, w.cp, w.dp, par, h, invm) for _ in range(R.NS)],
@@ -179,13 +181,14 @@ def main(argv=None):
     ap.add_argument("--cost-tol", type=float, default=1e-8)
     ap.add_argument("--cost-N", type=int, default=1000)
     ap.add_argument("--big-N", type=int, default=10000)
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each in the cost part (least CPU time)")
     a = ap.parse_args(argv)
     parts = a.parts.split(",")
     if "growth" in parts:
         growth([float(c) for c in a.chi.split(",")], [int(n) for n in a.N.split(",")],
                [float(e) for e in a.eps.split(",")], a.tol, a.mode, a.seed)
     if "cost" in parts:
-        cost(a.cost_N, 0.25, a.cost_tol)
+        cost(a.cost_N, 0.25, a.cost_tol, repeat=a.repeat)
     if "profile" in parts:
         profile(a.cost_N, 0.25, a.cost_tol)
     if "big" in parts:
