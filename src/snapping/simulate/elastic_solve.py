@@ -41,7 +41,7 @@ from .. import schema
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
 
-__all__ = ["solve", "ElasticRun", "METHODS"]
+__all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
 METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
 #: points per step at which the dense output is sampled around each peak
@@ -112,6 +112,24 @@ class _Peaks:
         return out
 
 
+def speed_floor(elastic_energy: float, energy_error: float, m_min: float, stop_fraction: float) -> float:
+    """The running peak of v_max above which the stop rule may judge the snap.
+
+    The release (and the integration's error) put energy ``E_r = elastic_energy +
+    energy_error`` into motion the inextensible fall does not have (the longitudinal ringing);
+    it can give a node of mass >= ``m_min`` at most ``v_r = sqrt(2 E_r / m_min)``. With the
+    fall's own largest speed V(t) nondecreasing before the snap (the rigid chain's stop rule
+    rests on that) and ``V - v_r <= v_max <= V + v_r``, a peak ``P >= 2 v_r / (1 - f)``
+    (``f = stop_fraction``) gives ``V >= P - v_r >= v_r (1 + f)/(1 - f)`` from then on, hence
+    ``v_max >= V - v_r >= f (V + v_r) >= f P`` until the fall's own speed drops: only the
+    snap can take v_max below ``f P``.
+
+    >>> round(speed_floor(0.005, 0.0, 0.01, 0.5), 6)
+    4.0
+    """
+    return 2.0 * np.sqrt(2.0 * (elastic_energy + energy_error) / m_min) / (1.0 - stop_fraction)
+
+
 def _initial(line, start, initial):
     if initial is None:
         return line.start(start)
@@ -145,7 +163,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         Axial stiffness or table, Kelvin-Voigt damping.
     t_end : float, optional
         End time; by default the run stops at the snap, once v_max has fallen below
-        ``stop_fraction`` of its running peak (or at ``t_end_max``).
+        ``stop_fraction`` of its running peak, that peak being above the noise floor of
+        :func:`speed_floor` (or at ``t_end_max``; or, status 'failed', once the energy error
+        exceeds the energy the line holds).
     tol : float
         Relative and absolute tolerance of the error control (rtol = atol).
     method : {"radau", "dop853", "rodas4"}
@@ -207,6 +227,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     peaks.update(0.0, mm0, None)
     running, stop_reason, status = 0.0, "t_end" if t_end is not None else "t_end_max", "completed"
     first_slack = np.nan
+    i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
+    U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
+    err, t_armed, floor = 0.0, np.nan, speed_floor(U0, 0.0, m_min, stop_fraction)
     peak_state = (0.0, z0.copy())
     while solver.status == "running":
         msg = solver.step()
@@ -235,8 +258,18 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         if max(count[0], solver.nfev) > max_rhs:
             status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
             break
-        if t_end is None and mm[0] < stop_fraction * running:
+        row = rows[-1]
+        err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
+        if np.isnan(t_armed):
+            floor = speed_floor(U0, err, m_min, stop_fraction)
+            if running >= floor:
+                t_armed = t
+        if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
             stop_reason = "snap"
+            break
+        if t_end is None and err > abs(E0) + abs(row[i_w]) + U0:
+            status, stop_reason = "failed", ("energy error above the line's energy (the steps do not resolve "
+                                             "the motion: tighten tol)")
             break
     t_final = times[-1]
     zf = solver.y.copy()
@@ -263,7 +296,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
         "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
         "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
-        "wall_time": wall, "wave_speed": line.wave_speed,
+        "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
+        "t_stop_armed": float(t_armed),
     }
     inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
               "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
