@@ -53,7 +53,7 @@ def test_an_energy_error_is_not_a_snap():
     assert ds.attrs["snap_reached"] == 0 and ds.attrs["status"] == "failed"
     assert "energy error" in ds.attrs["stop_reason"]
     assert ds.attrs["t_final"] < 0.5
-    assert ds.attrs["energy_drift"] > abs(ds.attrs["energy_initial"])
+    assert ds.attrs["energy_drift"] > 0.1 * abs(ds.attrs["energy_initial"])
 
 
 def test_stop_time_unchanged_where_the_old_rule_was_right():
