@@ -70,5 +70,5 @@ def test_stop_time_unchanged_where_the_old_rule_was_right():
 
 def test_speed_floor_is_the_derived_bound():
     """2 v_r / (1 - f) with v_r = sqrt(2 E / m): E = 0.02, m = 0.01 gives v_r = 2."""
-    assert speed_floor(0.015, 0.005, 0.01, 0.5) == pytest.approx(8.0, rel=1e-15)
-    assert speed_floor(0.02, 0.0, 0.01, 0.75) == pytest.approx(16.0, rel=1e-15)
+    assert speed_floor(0.02, 0.01, 0.5) == pytest.approx(8.0, rel=1e-15)
+    assert speed_floor(0.02, 0.01, 0.75) == pytest.approx(16.0, rel=1e-15)
