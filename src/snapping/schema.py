@@ -258,6 +258,9 @@ ELASTIC_RESULT_ATTRS: dict[str, str] = {
     "n_slack_steps": "number of recorded steps with a slack link",
     "dissipated_total": "energy dissipated by the axial damping over the run",
     "wave_speed": "smallest longitudinal wave speed sqrt(EA/lambda) of the links",
+    "stop_speed_floor": ("running peak of v_max above which the stop rule judges the snap, 2 sqrt(2 U0 / m_min) / "
+                         "(1 - stop_fraction) (U0 the elastic energy at t = 0, m_min the smallest node mass)"),
+    "t_stop_armed": "time from which the stop rule judged the snap (NaN: never; then no snap is reported)",
 }
 
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,

@@ -41,11 +41,17 @@ from .. import schema
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
 
-__all__ = ["solve", "ElasticRun", "METHODS"]
+__all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
 METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
 #: points per step at which the dense output is sampled around each peak
 PEAK_SAMPLES = 24
+#: an automatic run (no t_end) fails once its energy error exceeds this fraction of the line's
+#: energy |E(0)| + |W| + U(0) (0.255 for chi = 0.25): the snap can no longer be told from the
+#: error (measured, chi = 0.25, N = 30 and 60, c = 30-300, tol 1e-2 and 3e-3: Radau/RODAS4 runs
+#: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
+#: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
+ENERGY_ERROR_FAIL = 0.1
 #: the per-step record's columns (the Dataset's step variables, in this order)
 STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
               "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
@@ -112,6 +118,25 @@ class _Peaks:
         return out
 
 
+def speed_floor(elastic_energy: float, m_min: float, stop_fraction: float) -> float:
+    """The running peak of v_max above which the stop rule may judge the snap.
+
+    The release puts the start's elastic energy ``E_r`` into motion the inextensible fall does
+    not have (the longitudinal ringing); it can give a node of mass >= ``m_min`` at most
+    ``v_r = sqrt(2 E_r / m_min)``. With the
+    fall's own largest speed V(t) nondecreasing before the snap (the rigid chain's stop rule
+    rests on that) and ``V - v_r <= v_max <= V + v_r``, a peak ``P >= 2 v_r / (1 - f)``
+    (``f = stop_fraction``) gives ``V >= P - v_r >= v_r (1 + f)/(1 - f)`` from then on, hence
+    ``v_max >= V - v_r >= f (V + v_r) >= f P`` until the fall's own speed drops: only the
+    snap can take v_max below ``f P``. (The integration's energy error is judged apart: see
+    ``ENERGY_ERROR_FAIL``.)
+
+    >>> float(round(speed_floor(0.005, 0.01, 0.5), 6))
+    4.0
+    """
+    return 2.0 * np.sqrt(2.0 * elastic_energy / m_min) / (1.0 - stop_fraction)
+
+
 def _initial(line, start, initial):
     if initial is None:
         return line.start(start)
@@ -145,7 +170,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         Axial stiffness or table, Kelvin-Voigt damping.
     t_end : float, optional
         End time; by default the run stops at the snap, once v_max has fallen below
-        ``stop_fraction`` of its running peak (or at ``t_end_max``).
+        ``stop_fraction`` of its running peak, that peak being above the noise floor of
+        :func:`speed_floor` (or at ``t_end_max``; or, status 'failed', once the energy error
+        exceeds 0.1 of the energy the line holds).
     tol : float
         Relative and absolute tolerance of the error control (rtol = atol).
     method : {"radau", "dop853", "rodas4"}
@@ -207,6 +234,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     peaks.update(0.0, mm0, None)
     running, stop_reason, status = 0.0, "t_end" if t_end is not None else "t_end_max", "completed"
     first_slack = np.nan
+    i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
+    U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
+    err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction)
     peak_state = (0.0, z0.copy())
     while solver.status == "running":
         msg = solver.step()
@@ -235,8 +265,16 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         if max(count[0], solver.nfev) > max_rhs:
             status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
             break
-        if t_end is None and mm[0] < stop_fraction * running:
+        row = rows[-1]
+        err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
+        if np.isnan(t_armed) and running >= floor:
+            t_armed = t
+        if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
             stop_reason = "snap"
+            break
+        if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
+            status, stop_reason = "failed", (f"energy error above {ENERGY_ERROR_FAIL:g} of the line's energy (the "
+                                             "steps do not resolve the motion: tighten tol)")
             break
     t_final = times[-1]
     zf = solver.y.copy()
@@ -263,7 +301,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
         "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
         "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
-        "wall_time": wall, "wave_speed": line.wave_speed,
+        "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
+        "t_stop_armed": float(t_armed),
     }
     inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
               "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
