@@ -126,22 +126,7 @@ class PinMotion:
         >>> round(p.position(0.5)[0], 9) == round(0.1 * math.sin(0.5), 9)
         True
         """
-        if not callable(r):
-            raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y))")
-        t_max = V.positive("t_max", t_max)
-        if not MIN_DURATION <= t_max <= T_MAX:
-            raise V.SnappingInputError(f"t_max={t_max!r} is out of range: must lie in [{MIN_DURATION:g}, {T_MAX:g}]")
-        n = V.integer("samples", samples, 4)
-        if n > MAX_SAMPLES:
-            raise V.SnappingInputError(f"samples={n} is out of range: at most {MAX_SAMPLES}")
-        t = np.linspace(0.0, t_max, n)
-        try:
-            xy = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
-        except Exception as exc:  # noqa: BLE001 - the user's function failed
-            raise V.SnappingInputError(f"r(t) failed or did not return two numbers (x, y) "
-                                       f"({type(exc).__name__}: {str(exc)[:120]})") from None
-        if xy.ndim != 2 or xy.shape[1] != 2:
-            raise V.SnappingInputError(f"r(t) must return two numbers (x, y); got shape {xy.shape[1:]}")
+        t, xy = sample_function(r, t_max, samples, ("x", "y"))
         return cls.from_table(t, xy[:, 0], xy[:, 1])
 
     @classmethod
@@ -270,3 +255,28 @@ def parse_pin_motion(spec: str | None) -> PinMotion:
         return PinMotion.flick(vals[:2], vals[2], *(vals[3:4] or [0.0]))
     raise V.SnappingInputError(f"pin_motion={spec!r} is not one of 'fixed', 'pull:AX,AY[,DURATION[,T0]]', "
                                f"'flick:AX,AY,PERIOD[,T0]'")
+
+
+def sample_function(r, t_max: float, samples: int, names=("x", "y")):
+    """``(t, r(t))``: the user's motion ``r(t) -> (names...)`` sampled at ``samples`` equal
+    times on [0, t_max], every input checked (SnappingInputError naming it); shared by the
+    planar :meth:`PinMotion.from_function` and the 3D ``Pin3D.from_function``."""
+    d = len(names)
+    what = f"{('two', 'three')[d - 2]} numbers ({', '.join(names)})"
+    if not callable(r):
+        raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> ({', '.join(names)}))")
+    t_max = V.positive("t_max", t_max)
+    if not MIN_DURATION <= t_max <= T_MAX:
+        raise V.SnappingInputError(f"t_max={t_max!r} is out of range: must lie in [{MIN_DURATION:g}, {T_MAX:g}]")
+    n = V.integer("samples", samples, 4)
+    if n > MAX_SAMPLES:
+        raise V.SnappingInputError(f"samples={n} is out of range: at most {MAX_SAMPLES}")
+    t = np.linspace(0.0, t_max, n)
+    try:
+        pts = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
+    except Exception as exc:  # noqa: BLE001 - the user's function failed
+        raise V.SnappingInputError(f"r(t) failed or did not return {what} "
+                                   f"({type(exc).__name__}: {str(exc)[:120]})") from None
+    if pts.ndim != 2 or pts.shape[1] != d:
+        raise V.SnappingInputError(f"r(t) must return {what}; got shape {pts.shape[1:]}")
+    return t, pts

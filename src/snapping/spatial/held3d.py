@@ -42,7 +42,7 @@ import numpy as np
 
 from .. import _validate as V
 from .._validate import _short
-from ..simulate.pin import ACCEL_MAX, MIN_DURATION, POSITION_MAX, T_MAX, MAX_SAMPLES
+from ..simulate.pin import ACCEL_MAX, MIN_DURATION, POSITION_MAX, T_MAX, sample_function
 from . import chain3d as C
 
 __all__ = ["Pin3D", "parse_pin3d", "read_pin_table", "PIN3D_KINDS"]
@@ -178,22 +178,7 @@ class Pin3D:
     @classmethod
     def from_function(cls, r, t_max: float, samples: int = 2001) -> "Pin3D":
         """The motion ``r(t) -> (x, y, z)`` on [0, t_max] sampled at ``samples`` equal times."""
-        if not callable(r):
-            raise V.SnappingInputError(f"r={r!r} is not callable (expected a function t -> (x, y, z))")
-        t_max = V.positive("t_max", t_max)
-        if not MIN_DURATION <= t_max <= T_MAX:
-            raise V.SnappingInputError(f"t_max={t_max!r} is out of range: must lie in [{MIN_DURATION:g}, {T_MAX:g}]")
-        n = V.integer("samples", samples, 4)
-        if n > MAX_SAMPLES:
-            raise V.SnappingInputError(f"samples={n} is out of range: at most {MAX_SAMPLES}")
-        t = np.linspace(0.0, t_max, n)
-        try:
-            xyz = np.array([np.asarray(r(float(v)), dtype=float).ravel() for v in t])
-        except Exception as exc:  # noqa: BLE001 - the user's function failed
-            raise V.SnappingInputError(f"r(t) failed or did not return three numbers (x, y, z) "
-                                       f"({type(exc).__name__}: {str(exc)[:120]})") from None
-        if xyz.ndim != 2 or xyz.shape[1] != 3:
-            raise V.SnappingInputError(f"r(t) must return three numbers (x, y, z); got shape {xyz.shape[1:]}")
+        t, xyz = sample_function(r, t_max, samples, ("x", "y", "z"))
         return cls.from_table(t, *xyz.T)
 
     @classmethod
