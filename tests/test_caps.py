@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 import pytest
 
 from snapping import caps, caps_report, lines
@@ -181,3 +183,64 @@ def test_auto_links_not_resolved_says_so(monkeypatch):
     assert abs(change) > 0.01  # (this chain is not resolved at 20 links)
     assert r["N"] == 20 and r["auto_N"] == [10, 20] and r["resolved"] is False
     assert r["resolution"]["sigma_peak"] == pytest.approx(change, rel=1e-9)
+
+
+def test_stiff_runs_are_rodas4_on_grid_damped_waves_as_a_direct_run():
+    """A bending-dominated line (beta = 1 on 24 links: its bending waves would hold DOP853 to
+    more than STIFF_RATIO times its accuracy-limited steps): the answer's runs with bending are
+    RODAS4's at STIFF_TOL on the line with Kelvin-Voigt damping (1/2) h^2 sqrt(beta) at the inner
+    nodes, built here by hand; the ideal run stays DOP853's."""
+    n, beta = 24, 1.0
+    ei = beta * (M / L) * G * L**3
+    r = caps.cap(None, 0.3, N=n, check=False, alone=False, length=L, mass=M, ei=ei)
+    h = 1.0 / n
+    body = Body(bending=beta, damping=0.5 * h * h * math.sqrt(beta))
+    direct = _si(run(Problem.catenary(0.3, n, body=body), method="rodas4", tol=caps.STIFF_TOL,
+                     progress=False).dataset, L, M)
+    for q in caps.QUANTITIES:
+        assert r["real"][q] == pytest.approx(direct[q], rel=1e-9)
+    assert [(x["run"], x["method"], x["tol"]) for x in r["runs"]] == [("ideal", "dop853", 1e-6),
+                                                                     ("bending", "rodas4", caps.STIFF_TOL)]
+    # a line whose waves DOP853 steps anyway (beta 1e-4) is the fast method's, undamped, as before
+    assert caps.method_for(Problem.catenary(0.3, n, body=Body(bending=1e-4)), 1e-6) == ("fast", 1e-6, 0.0)
+
+
+def test_grid_damping_gives_the_shortest_wave_its_damping_ratio():
+    from snapping.simulate import stiffness
+
+    links = Links.uniform(30)
+    for zeta in (0.5, 1.0, 2.0):
+        eta = stiffness.grid_damping(links.h, links.m, np.full(31, 10.0), zeta)
+        om, z = stiffness.shortest_wave(Problem.catenary(0.3, links=links, body=Body(bending=10.0, damping=eta)).model())
+        assert z == pytest.approx(zeta, rel=1e-3)  # (bending dominates: the tension's part of omega is 1e-5)
+    eta = stiffness.grid_damping(links.h, links.m, np.full(31, 10.0), 1.0, omega_min=2.0 * om)
+    assert not eta.any()  # no wave is faster than omega_min: nothing damped
+
+
+def test_design_names_the_capping_mechanism_per_chi(capsys):
+    """Each row's cap is the mechanism whose direct run alone is nearest the direct full run."""
+    kw = {"ei": 1e-9, "diameter": 0.05}
+    d = caps.design(None, (0.25, 0.45), N=N, length=L, mass=M, max_tension=1e9, **kw)
+    for row in d["rows"]:
+        chi = row["chi"]
+        full = _si(run(Problem.catenary(chi, N, body=Body.from_si(L, M, G, **kw)), method="fast", tol=1e-6,
+                       progress=False).dataset, L, M)["sigma_peak"]
+        ideal = _si(run(Problem.catenary(chi, N), method="fast", tol=1e-6, progress=False).dataset, L, M)["sigma_peak"]
+        alone = {"bending": Body.from_si(L, M, G, ei=1e-9), "drag": Body.from_si(L, M, G, diameter=0.05)}
+        t = {m: _si(run(Problem.catenary(chi, N, body=b), method="fast", tol=1e-6, progress=False).dataset, L,
+                    M)["sigma_peak"] for m, b in alone.items()}
+        want = "none" if full / ideal >= 0.9 else min(t, key=lambda m: abs(math.log(t[m] / full)))
+        assert row["factor"]["sigma_peak"] == pytest.approx(full / ideal, rel=1e-9)
+        assert row["cap"] == want and row["alone"]["drag"]["sigma_peak"] == pytest.approx(t["drag"], rel=1e-9)
+    assert [row["cap"] for row in d["rows"]] == ["drag", "drag"]
+    assert main(["design", "--max-tension", "1e9", "--length", "2", "--mass", "0.1", "--ei", "1e-9", "--diameter",
+                 "0.05", "--links", str(N), "--chis", "0.25"]) == 0
+    out = capsys.readouterr().out
+    assert "capped by" in out.splitlines()[1] and " drag " in out.splitlines()[2]
+
+
+def test_auto_links_make_each_run_once():
+    r = caps.cap(None, 0.3, N="auto", length=L, mass=M, diameter=0.05)
+    keys = [(x["run"], x["N"]) for x in r["runs"]]
+    assert len(keys) == len(set(keys))
+    assert ("drag", r["N"]) in keys and r["n_rhs"] == sum(x["n_rhs"] for x in r["runs"])

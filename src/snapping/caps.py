@@ -67,6 +67,14 @@ STRETCH_N = 30
 #: the links tried by ``N="auto"``, doubling, and the change of a peak from one to the next that stops it
 AUTO_N = (100, 200, 400, 800, 1600)
 RESOLVED = 0.01
+#: RODAS4's tolerance in the runs it takes (:func:`method_for`): the peaks within 2e-3 of RODAS4 at
+#: 1e-6 and of DOP853 at 1e-8 on every catalogue line, N 100-1000 (``benchmarks/bench_caps.py``)
+STIFF_TOL = 1e-4
+#: RODAS4 is taken when DOP853's stability limit needs this many times its accuracy-limited steps
+STIFF_RATIO = 10.0
+#: the grid damping ratio of a bending line's shortest waves (:func:`snapping.simulate.stiffness.grid_damping`;
+#: the regime studies' ``snapping.regimes.GRID_DAMPING``)
+GRID_DAMPING = 1.0
 #: the peaks answered: (name, SI units)
 QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
 #: the mechanisms, in the order they are tried
@@ -191,9 +199,12 @@ def _as_spec(line_or_spec, params: dict) -> LineSpec:
     return sp
 
 
-def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper"):
+def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
+            damping: float = 0.0, omega_min: float = 0.0):
     """The catenary start of ``sp`` at ``chi`` on ``N`` links with the mechanisms ``on`` (the
-    inextensible model's: stretching is not part of it)."""
+    inextensible model's: stretching is not part of it); with bending, the grid damping of
+    ratio ``damping`` on the waves faster than ``omega_min``
+    (:func:`snapping.simulate.stiffness.grid_damping`; 0: none)."""
     import numpy as np
 
     from .simulate import Body, Links, Problem
@@ -214,6 +225,13 @@ def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "
                   cd_tangential=sp.cd_tangential if sp.diameter is not None else None, air_density=sp.air_density,
                   tip_drag_area=sp.tip_drag_area)
     body = Body.from_si(sp.length, sp.mass, sp.g, **kw) if kw else None
+    if damping > 0.0 and "ei" in kw:
+        from .simulate.stiffness import grid_damping
+
+        eta = grid_damping(links.h, links.m, body.node_values("bending", links.h), damping, omega_min)
+        body = Body(body.bending, damping=eta, wind=body.wind, tip_drag=body.tip_drag, clamp=body.clamp,
+                    **{k: getattr(body, k) for k in ("curvature", "drag_normal", "drag_tangential",
+                                                     "drag_linear_normal", "drag_linear_tangential")})
     return Problem.catenary(chi, links=links, body=body if body is not None and body.active else None)
 
 
@@ -223,16 +241,36 @@ def _si(sp: LineSpec, nd: dict) -> dict:
     return {q: float(nd[q]) * u[q] for q in QUANTITIES}
 
 
-def _run(problem_, tol: float) -> dict:
+def method_for(problem_, tol: float, stiff_tol: float = None) -> tuple[str, float, float]:
+    """``(method, tol, omega_min)`` of one run of :func:`cap`: a run whose bending waves would hold
+    DOP853 to more than :data:`STIFF_RATIO` times its accuracy-limited steps (the shortest wave
+    faster than ``omega_min = STIFF_RATIO R_DOP853 n_acc / T_SNAP``, with
+    :func:`snapping.simulate.stiffness.accuracy_steps` ``n_acc`` and DOP853's stability boundary
+    ``R_DOP853``) is stiff: RODAS4 (``"rodas4"``) at ``stiff_tol`` (default :data:`STIFF_TOL`),
+    the waves faster than ``omega_min`` grid-damped (:func:`problem`); any other run is the fast
+    method's (DOP853) at ``tol``, undamped, as without this rule (``omega_min`` 0)."""
+    from .simulate import stiffness as S
+
+    body = getattr(problem_, "body", None)
+    if body is None or not body.has_bending:
+        return "fast", tol, 0.0
+    om, _ = S.shortest_wave(problem_.model())
+    omega_min = STIFF_RATIO * S.R_DOP853 * S.accuracy_steps(problem_.N, tol) / S.T_SNAP
+    if om > omega_min:
+        return "rodas4", STIFF_TOL if stiff_tol is None else stiff_tol, omega_min
+    return "fast", tol, 0.0
+
+
+def _run(problem_, method: str, tol: float) -> dict:
     from .simulate import run
 
-    t0 = time.perf_counter()
-    r = run(problem_, method="fast", tol=tol, progress=False)
+    t0, c0 = time.perf_counter(), time.process_time()
+    r = run(problem_, method=method, tol=tol, progress=False)
     a = r.dataset.attrs
     if a.get("status") != "completed":
         raise RuntimeError(f"a run of the real model did not complete ({a.get('status')}: {a.get('stop_reason', '')})")
     return {**{q: float(a[q]) for q in QUANTITIES}, "n_rhs": int(a["n_rhs"]), "method": str(a["method"]),
-            "wall": time.perf_counter() - t0}
+            "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
 
 
 def stretch_factor(sp: LineSpec, chi: float, tol: float = 1e-6, N: int = STRETCH_N) -> dict:
@@ -241,7 +279,7 @@ def stretch_factor(sp: LineSpec, chi: float, tol: float = 1e-6, N: int = STRETCH
     from .simulate import Links, Problem, run
     from .simulate.elastic import Elastic, solve
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     p = Problem.catenary(chi, links=Links.uniform(N, lumping="shared"))
     rigid = run(p, method="fast", tol=tol, progress=False).dataset.attrs
     el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method="dop853").dataset.attrs
@@ -249,11 +287,13 @@ def stretch_factor(sp: LineSpec, chi: float, tol: float = 1e-6, N: int = STRETCH
         raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')})")
     return {**{q: float(el[q]) / float(rigid[q]) for q in QUANTITIES}, "N": N,
             "n_rhs": int(el["n_rhs"]) + int(rigid["n_rhs"]), "wall": time.perf_counter() - t0,
+            "cpu": time.process_time() - c0,
             "strain_peak": float(el["strain_peak"])}
 
 
 def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quantity: str = "sigma_peak",
-        check: bool = True, alone: bool = True, **params) -> dict:
+        check: bool = True, alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL,
+        **params) -> dict:
     """The snap of a real line from runs of the real model, the ideal chain's beside it, and
     what caps it (the module's text says how).
 
@@ -268,13 +308,18 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         full run's ``quantity`` moves by at most 1% (:data:`RESOLVED`; then ``resolved`` True
         and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False).
     tol : float
-        The fast method's tolerance.
+        The fast method's (DOP853's) tolerance.
     quantity : str
         The peak that decides the capping mechanism: ``v_peak``, ``a_peak`` or ``sigma_peak``.
     check : bool
         Repeat the full run on N/2 links (the resolution check).
     alone : bool
         Run each mechanism alone (False: only the ideal and full runs, no capping mechanism).
+    damping : float
+        The grid damping ratio of a bending line's shortest waves (:data:`GRID_DAMPING`; 0: none,
+        every run by the fast method as before).
+    stiff_tol : float
+        RODAS4's tolerance, in the runs it takes (:func:`method_for`).
     **params
         :func:`spec`'s keywords (SI), overriding the line's.
 
@@ -285,36 +330,63 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         (the inextensible run with every mechanism), ``alone`` ({mechanism: peaks}), each
         peaks in SI; ``factor`` (real / ideal per peak), ``cap`` (the capping mechanism or
         ``"none"``), ``rule``, ``stretching`` (what was done and why), ``resolution``
-        (relative change N/2 -> N per peak), ``n_rhs``, ``wall`` and ``cpu`` (s).
+        (relative change N/2 -> N per peak), ``runs`` (each run: what, links, method,
+        evaluations, CPU s), ``n_rhs``, ``wall`` and ``cpu`` (s).
     """
     from .estimates import check_chi
 
     t0, c0 = time.perf_counter(), time.process_time()
     sp = _as_spec(line, params)
     chi = check_chi(chi)
-    if isinstance(N, str) and N == "auto":
-        return _auto(sp, chi, tol, quantity, alone, t0, c0)
-    N = V.integer("N", N, 2, 20000)
-    tol = V.open_interval("tol", tol, 0.0, 1e-2)
     if quantity not in QUANTITIES:
         raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
+    tol = V.open_interval("tol", tol, 0.0, 1e-2)
+    stiff_tol = V.open_interval("stiff_tol", stiff_tol, 0.0, 1e-2)
+    damping = V.real("damping", damping)
+    if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
+        raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
+    runs = _Runs(sp, chi, tol, stiff_tol, damping)
+    if isinstance(N, str) and N == "auto":
+        r = _auto(runs, quantity, alone)
+    else:
+        N = V.integer("N", N, 2, 20000)
+        r = _answer(runs, N, quantity, check and N >= 4, alone)
+    r.update({"runs": runs.log, "n_rhs": sum(x["n_rhs"] for x in runs.log), "wall": time.perf_counter() - t0,
+              "cpu": time.process_time() - c0})
+    return r
+
+
+class _Runs:
+    """The runs of one answer, each made once: ``get(on, N)`` (``on`` the mechanisms, () the ideal)."""
+
+    def __init__(self, sp, chi, tol, stiff_tol, damping):
+        self.sp, self.chi, self.tol, self.stiff_tol, self.damping = sp, chi, tol, stiff_tol, damping
+        self.done, self.log = {}, []
+
+    def get(self, on, N: int) -> dict:
+        key = (tuple(on), int(N))
+        if key not in self.done:
+            p = problem(self.sp, self.chi, N, on)
+            method, tol, omega_min = method_for(p, self.tol, self.stiff_tol) if self.damping > 0 else ("fast", self.tol, 0)
+            if method == "rodas4":
+                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min)
+            r = _run(p, method, tol)
+            self.done[key] = r
+            self.log.append({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
+                             "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
+        return self.done[key]
+
+
+def _answer(runs: _Runs, N: int, quantity: str, check: bool, alone: bool) -> dict:
+    """One answer on ``N`` links (the runs of ``runs``, each made once)."""
+    sp, chi = runs.sp, runs.chi
     present = [m for m in MECHANISMS[:-1] if sp.has(m)]
-    n_rhs = 0
-
-    def go(on, n=N):
-        nonlocal n_rhs
-        r = _run(problem(sp, chi, n, on), tol)
-        n_rhs += r["n_rhs"]
-        return r
-
-    ideal_nd = go(())
-    full_nd = go(tuple(present)) if present else dict(ideal_nd)
+    ideal_nd = runs.get((), N)
+    full_nd = runs.get(tuple(present), N)
     alone_nd = {}
-    if alone and len(present) > 1:
+    if alone:
         for m in present:
-            alone_nd[m] = go((m,))
-    elif alone and len(present) == 1:
-        alone_nd[present[0]] = full_nd
+            alone_nd[m] = runs.get((m,), N)
     stretching = {"run": False}
     factor_s = {q: 1.0 for q in QUANTITIES}
     if sp.has("stretching"):
@@ -322,8 +394,9 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         ratio = ideal_nd["v_peak"] / c
         stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio})
         if ratio >= STRETCH_MATTERS:
-            f = stretch_factor(sp, chi, tol)
-            n_rhs += f["n_rhs"]
+            f = stretch_factor(sp, chi, runs.tol)
+            runs.log.append({"run": "stretching", "N": f["N"], "method": "dop853", "tol": runs.tol,
+                             "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
             factor_s = {q: f[q] for q in QUANTITIES}
             stretching.update({"run": True, "factor": factor_s, "N": f["N"], "strain_peak": f["strain_peak"],
                                "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g}: run (elastic over rigid, "
@@ -336,57 +409,67 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         stretching["why"] = "no EA given: inextensible"
     real_nd = {q: full_nd[q] * factor_s[q] for q in QUANTITIES}
     resolution = None
-    if check and N >= 4:
-        half = go(tuple(present), N // 2) if present else go((), N // 2)
-        ref = full_nd
-        resolution = {q: (ref[q] - half[q]) / ref[q] for q in QUANTITIES}
+    if check:
+        half = runs.get(tuple(present), N // 2)
+        resolution = {q: (full_nd[q] - half[q]) / full_nd[q] for q in QUANTITIES}
     factor = {q: real_nd[q] / ideal_nd[q] for q in QUANTITIES}
+    capped = decide(factor[quantity], real_nd[quantity], {m: v[quantity] for m, v in alone_nd.items()},
+                    bool(present or stretching["run"]), alone)
     from .regimes_analysis import LEVEL
 
-    if factor[quantity] >= LEVEL or not (present or stretching["run"]):
-        capped = "none"
-    elif alone_nd:
-        capped = min(alone_nd, key=lambda m: abs(math.log(alone_nd[m][quantity] / real_nd[quantity])))
-    else:
-        capped = "not decided (alone=False)"
     rule = (f"{quantity}: real/ideal >= {LEVEL:g} -> none (the ideal chain's own cap: geometry and links); else the "
             f"mechanism whose run alone is closest to the real answer in |log(alone/real)|")
-    return {"line": sp.name, "chi": chi, "N": N, "tol": tol, "quantity": quantity, "numbers": sp.numbers(N),
+    return {"line": sp.name, "chi": chi, "N": N, "tol": runs.tol, "quantity": quantity, "numbers": sp.numbers(N),
             "mechanisms": present + (["stretching"] if stretching["run"] else []),
             "ideal": _si(sp, ideal_nd), "full": _si(sp, full_nd), "real": _si(sp, real_nd),
             "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
-            "stretching": stretching, "resolution": resolution, "methods": {"ideal": ideal_nd["method"],
-                                                                             "full": full_nd.get("method", "")},
-            "n_rhs": n_rhs, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
+            "stretching": stretching, "resolution": resolution, "damping": runs.damping,
+            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}}
 
 
-def _auto(sp: LineSpec, chi: float, tol: float, quantity: str, alone: bool, t0: float, c0: float) -> dict:
+def decide(factor: float, real: float, alone: dict, acts: bool = True, tried: bool = True) -> str:
+    """The capping mechanism (the module's rule): ``"none"`` when the real/ideal ``factor`` is
+    at least :data:`snapping.regimes_analysis.LEVEL` (or nothing acts), else the mechanism of
+    ``alone`` ({mechanism: its peak alone}) nearest ``real`` in |log(alone/real)|."""
+    from .regimes_analysis import LEVEL
+
+    if factor >= LEVEL or not acts:
+        return "none"
+    if not (tried and alone):
+        return "not decided (alone=False)"
+    return min(alone, key=lambda m: abs(math.log(alone[m] / real)))
+
+
+def _auto(runs: _Runs, quantity: str, alone: bool) -> dict:
     """``N="auto"``: the full run on :data:`AUTO_N` links, doubling, until ``quantity`` moves by at
-    most :data:`RESOLVED` from one to the next (or the last); then :func:`cap` on those links,
-    its resolution the last two full runs'."""
-    if quantity not in QUANTITIES:
-        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
-    on = tuple(m for m in MECHANISMS[:-1] if sp.has(m))
-    runs, n_rhs = [], 0
+    most :data:`RESOLVED` from one to the next (or the last); then the answer on those links, its
+    resolution the last two full runs' (each run made once)."""
+    on = tuple(m for m in MECHANISMS[:-1] if runs.sp.has(m))
+    tried = []
     for n in AUTO_N:
-        runs.append(_run(problem(sp, chi, n, on), tol))
-        n_rhs += runs[-1]["n_rhs"]
-        if len(runs) > 1 and abs(runs[-1][quantity] - runs[-2][quantity]) <= RESOLVED * abs(runs[-1][quantity]):
-            break
-    prev, cur = runs[-2], runs[-1]
-    r = cap(sp, chi, N=n, tol=tol, quantity=quantity, check=False, alone=alone)
+        tried.append(n)
+        if len(tried) > 1:
+            cur, prev = runs.get(on, n), runs.get(on, tried[-2])
+            if abs(cur[quantity] - prev[quantity]) <= RESOLVED * abs(cur[quantity]):
+                break
+        else:
+            runs.get(on, n)
+    n = tried[-1]
+    r = _answer(runs, n, quantity, False, alone)
+    cur, prev = runs.get(on, n), runs.get(on, tried[-2])
     r["resolution"] = {q: (cur[q] - prev[q]) / cur[q] for q in QUANTITIES}
     r["resolved"] = abs(r["resolution"][quantity]) <= RESOLVED
-    r["auto_N"] = [m for m in AUTO_N if m <= n]
-    r["n_rhs"] += n_rhs
-    r["wall"], r["cpu"] = time.perf_counter() - t0, time.process_time() - c0
+    r["auto_N"] = tried
     return r
 
 
 def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int = 200, tol: float = 1e-6,
-           max_tension=None, max_speed=None, max_acceleration=None, **params) -> dict:
-    """Which end separations keep the real line's peaks under the limits: :func:`cap` (ideal
-    and real runs, no mechanism-alone runs) at each chi of ``chis``; ``rows`` per chi with
+           max_tension=None, max_speed=None, max_acceleration=None, quantity: str = "sigma_peak",
+           alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL, **params) -> dict:
+    """Which end separations keep the real line's peaks under the limits: :func:`cap` at each chi
+    of ``chis`` (the ideal, full and, with ``alone``, each-mechanism-alone runs; no N/2 check).
+    ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
+    (the mechanism that capped the snap at that chi, decided on ``quantity``: :func:`cap`'s rule),
     ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it."""
     sp = _as_spec(line, params)
     limits = {}
@@ -399,16 +482,20 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
                                    "(m/s^2)")
     if isinstance(chis, (int, float)):
         chis = [chis]
-    t0 = time.perf_counter()
-    rows = []
+    t0, c0 = time.perf_counter(), time.process_time()
+    rows, n_rhs = [], 0
     for chi in sorted(chis):
-        r = cap(sp, chi, N=N, tol=tol, check=False, alone=False)
-        rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"],
+        r = cap(sp, chi, N=N, tol=tol, check=False, alone=alone, quantity=quantity, damping=damping,
+                stiff_tol=stiff_tol)
+        n_rhs += r["n_rhs"]
+        rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
+                     "alone": r["alone"], "mechanisms": r["mechanisms"],
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
     ok = [r["chi"] for r in rows if r["admissible"]]
-    return {"line": sp.name, "N": N, "limits": limits, "rows": rows, "admissible_chi": ok,
-            "numbers": sp.numbers(N), "wall": time.perf_counter() - t0}
+    return {"line": sp.name, "N": N, "limits": limits, "quantity": quantity, "rows": rows, "admissible_chi": ok,
+            "numbers": sp.numbers(N), "n_rhs": n_rhs, "wall": time.perf_counter() - t0,
+            "cpu": time.process_time() - c0}
 
 
 def format_answer(r: dict) -> list[str]:
@@ -437,15 +524,24 @@ def format_answer(r: dict) -> list[str]:
 def format_design(d: dict) -> list[str]:
     """Text lines of a :func:`design` answer."""
     lim = ", ".join(f"{q} <= {v:g} {QUANTITIES[q]}" for q, v in d["limits"].items())
+    q = d.get("quantity", "sigma_peak")
     out = [f"Design from runs of the real model: {d['line']}, {d['N']} links; limits {lim}",
            f"  {'chi':>6}{'ideal v':>11}{'real v':>11}{'ideal a':>11}{'real a':>11}{'ideal T':>11}{'real T':>11}"
-           f"{'T factor':>10}  real ok  ideal ok"]
+           f"{'T factor':>10}  {'capped by':<12}  real ok  ideal ok"]
     for r in d["rows"]:
         i, x = r["ideal"], r["real"]
         out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
-                   f"{'yes' if r['admissible'] else 'no':>7}  {'yes' if r['ideal_admissible'] else 'no':>8}")
+                   f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
+                   f"{'yes' if r['ideal_admissible'] else 'no':>8}")
     ok = d["admissible_chi"]
-    out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}"
-               f" ({d['wall']:.1f} s)")
+    out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")
+    out.append(f"  capped by: the mechanism whose run alone comes nearest the real {q} (none: real/ideal >= 0.9, "
+               f"the ideal chain's own cap)")
+    out.append(f"  cost: {d.get('n_rhs', 0)} right-hand-side evaluations, {d['wall']:.1f} s "
+               f"({d.get('cpu', d['wall']):.1f} s CPU)")
     return out
+
+
+def _cap_word(c: str) -> str:
+    return "-" if c.startswith("not decided") else c

@@ -94,7 +94,8 @@ def cmd_real_design(args) -> int:
     sp = _spec(args)
     kw = {} if args.chis is None else {"chis": args.chis}
     d = caps.design(sp, N=200 if args.links is None else args.links, max_tension=args.max_tension,
-                    max_speed=args.max_speed, max_acceleration=args.max_acceleration, **kw)
+                    max_speed=args.max_speed, max_acceleration=args.max_acceleration,
+                    quantity=getattr(args, "quantity", "sigma_peak"), **kw)
     if args.json:
         print_json({**d, "dimensionless_numbers": d["numbers"]})
     else:
