@@ -211,7 +211,8 @@ def test_grid_damping_gives_the_shortest_wave_its_damping_ratio():
     links = Links.uniform(30)
     for zeta in (0.5, 1.0, 2.0):
         eta = stiffness.grid_damping(links.h, links.m, np.full(31, 10.0), zeta)
-        om, z = stiffness.shortest_wave(Problem.catenary(0.3, links=links, body=Body(bending=10.0, damping=eta)).model())
+        p = Problem.catenary(0.3, links=links, body=Body(bending=10.0, damping=eta))
+        om, z = stiffness.shortest_wave(p.model())
         assert z == pytest.approx(zeta, rel=1e-3)  # (bending dominates: the tension's part of omega is 1e-5)
     eta = stiffness.grid_damping(links.h, links.m, np.full(31, 10.0), 1.0, omega_min=2.0 * om)
     assert not eta.any()  # no wave is faster than omega_min: nothing damped

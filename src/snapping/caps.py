@@ -56,29 +56,17 @@ import time
 from dataclasses import dataclass, replace
 
 from . import _validate as V
+from .caps_runs import (GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO, STIFF_TOL, STRETCH_N,  # noqa: F401
+                        Runs, method_for, problem, stretch_factor)
 
 __all__ = ["LineSpec", "spec", "cap", "design", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
 #: the ideal run's peak speed over the wave speed above which the stretching is run
 STRETCH_MATTERS = 0.05
-#: links of the elastic and rigid runs that give the stretching factor
-STRETCH_N = 30
 #: the links tried by ``N="auto"``, doubling, and the change of a peak from one to the next that stops it
 AUTO_N = (100, 200, 400, 800, 1600)
 RESOLVED = 0.01
-#: RODAS4's tolerance in the runs it takes (:func:`method_for`): the peaks within 2e-3 of RODAS4 at
-#: 1e-6 and of DOP853 at 1e-8 on every catalogue line, N 100-1000 (``benchmarks/bench_caps.py``)
-STIFF_TOL = 1e-4
-#: RODAS4 is taken when DOP853's stability limit needs this many times its accuracy-limited steps
-STIFF_RATIO = 10.0
-#: the grid damping ratio of a bending line's shortest waves (:func:`snapping.simulate.stiffness.grid_damping`;
-#: the regime studies' ``snapping.regimes.GRID_DAMPING``)
-GRID_DAMPING = 1.0
-#: the peaks answered: (name, SI units)
-QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
-#: the mechanisms, in the order they are tried
-MECHANISMS = ("bending", "drag", "end-mass", "taper", "stretching")
 
 
 @dataclass(frozen=True)
@@ -199,96 +187,10 @@ def _as_spec(line_or_spec, params: dict) -> LineSpec:
     return sp
 
 
-def problem(sp: LineSpec, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
-            damping: float = 0.0, omega_min: float = 0.0):
-    """The catenary start of ``sp`` at ``chi`` on ``N`` links with the mechanisms ``on`` (the
-    inextensible model's: stretching is not part of it); with bending, the grid damping of
-    ratio ``damping`` on the waves faster than ``omega_min``
-    (:func:`snapping.simulate.stiffness.grid_damping`; 0: none)."""
-    import numpy as np
-
-    from .simulate import Body, Links, Problem
-
-    tip = sp.end_mass / sp.mass if "end-mass" in on else 0.0
-    if "taper" in on and sp.has("taper"):
-        ln, L = sp.line, sp.length
-        lam = sp.mass / L
-        links = Links.from_density(np.full(N, 1.0 / N), lambda u: ln.mass_per_length * ln.ratio(L * (1.0 - u), L) ** 2
-                                   / lam, tip_mass=tip, kind="line", params={"line": ln.name})
-    else:
-        links = Links.uniform(N, tip_mass=tip, lumping=lumping)
-    kw = {}
-    if "bending" in on and sp.has("bending"):
-        kw["ei"] = sp.ei
-    if "drag" in on and sp.has("drag"):
-        kw.update(diameter=sp.diameter, cd_normal=sp.cd_normal if sp.diameter is not None else None,
-                  cd_tangential=sp.cd_tangential if sp.diameter is not None else None, air_density=sp.air_density,
-                  tip_drag_area=sp.tip_drag_area)
-    body = Body.from_si(sp.length, sp.mass, sp.g, **kw) if kw else None
-    if damping > 0.0 and "ei" in kw:
-        from .simulate.stiffness import grid_damping
-
-        eta = grid_damping(links.h, links.m, body.node_values("bending", links.h), damping, omega_min)
-        body = Body(body.bending, damping=eta, wind=body.wind, tip_drag=body.tip_drag, clamp=body.clamp,
-                    **{k: getattr(body, k) for k in ("curvature", "drag_normal", "drag_tangential",
-                                                     "drag_linear_normal", "drag_linear_tangential")})
-    return Problem.catenary(chi, links=links, body=body if body is not None and body.active else None)
-
-
 def _si(sp: LineSpec, nd: dict) -> dict:
     """Nondimensional peaks in SI: speed sqrt(g L), acceleration g, tension M g."""
     u = {"v_peak": math.sqrt(sp.g * sp.length), "a_peak": sp.g, "sigma_peak": sp.mass * sp.g}
     return {q: float(nd[q]) * u[q] for q in QUANTITIES}
-
-
-def method_for(problem_, tol: float, stiff_tol: float = None) -> tuple[str, float, float]:
-    """``(method, tol, omega_min)`` of one run of :func:`cap`: a run whose bending waves would hold
-    DOP853 to more than :data:`STIFF_RATIO` times its accuracy-limited steps (the shortest wave
-    faster than ``omega_min = STIFF_RATIO R_DOP853 n_acc / T_SNAP``, with
-    :func:`snapping.simulate.stiffness.accuracy_steps` ``n_acc`` and DOP853's stability boundary
-    ``R_DOP853``) is stiff: RODAS4 (``"rodas4"``) at ``stiff_tol`` (default :data:`STIFF_TOL`),
-    the waves faster than ``omega_min`` grid-damped (:func:`problem`); any other run is the fast
-    method's (DOP853) at ``tol``, undamped, as without this rule (``omega_min`` 0)."""
-    from .simulate import stiffness as S
-
-    body = getattr(problem_, "body", None)
-    if body is None or not body.has_bending:
-        return "fast", tol, 0.0
-    om, _ = S.shortest_wave(problem_.model())
-    omega_min = STIFF_RATIO * S.R_DOP853 * S.accuracy_steps(problem_.N, tol) / S.T_SNAP
-    if om > omega_min:
-        return "rodas4", STIFF_TOL if stiff_tol is None else stiff_tol, omega_min
-    return "fast", tol, 0.0
-
-
-def _run(problem_, method: str, tol: float) -> dict:
-    from .simulate import run
-
-    t0, c0 = time.perf_counter(), time.process_time()
-    r = run(problem_, method=method, tol=tol, progress=False)
-    a = r.dataset.attrs
-    if a.get("status") != "completed":
-        raise RuntimeError(f"a run of the real model did not complete ({a.get('status')}: {a.get('stop_reason', '')})")
-    return {**{q: float(a[q]) for q in QUANTITIES}, "n_rhs": int(a["n_rhs"]), "method": str(a["method"]),
-            "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
-
-
-def stretch_factor(sp: LineSpec, chi: float, tol: float = 1e-6, N: int = STRETCH_N) -> dict:
-    """The elastic line over the rigid chain on the same ``N`` uniform links (shared lumping),
-    peak by peak: the stretching factor of :func:`cap`."""
-    from .simulate import Links, Problem, run
-    from .simulate.elastic import Elastic, solve
-
-    t0, c0 = time.perf_counter(), time.process_time()
-    p = Problem.catenary(chi, links=Links.uniform(N, lumping="shared"))
-    rigid = run(p, method="fast", tol=tol, progress=False).dataset.attrs
-    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method="dop853").dataset.attrs
-    if el.get("status") != "completed":
-        raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')})")
-    return {**{q: float(el[q]) / float(rigid[q]) for q in QUANTITIES}, "N": N,
-            "n_rhs": int(el["n_rhs"]) + int(rigid["n_rhs"]), "wall": time.perf_counter() - t0,
-            "cpu": time.process_time() - c0,
-            "strain_peak": float(el["strain_peak"])}
 
 
 def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quantity: str = "sigma_peak",
@@ -345,7 +247,7 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
     damping = V.real("damping", damping)
     if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
-    runs = _Runs(sp, chi, tol, stiff_tol, damping)
+    runs = Runs(sp, chi, tol, stiff_tol, damping)
     if isinstance(N, str) and N == "auto":
         r = _auto(runs, quantity, alone)
     else:
@@ -356,28 +258,7 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
     return r
 
 
-class _Runs:
-    """The runs of one answer, each made once: ``get(on, N)`` (``on`` the mechanisms, () the ideal)."""
-
-    def __init__(self, sp, chi, tol, stiff_tol, damping):
-        self.sp, self.chi, self.tol, self.stiff_tol, self.damping = sp, chi, tol, stiff_tol, damping
-        self.done, self.log = {}, []
-
-    def get(self, on, N: int) -> dict:
-        key = (tuple(on), int(N))
-        if key not in self.done:
-            p = problem(self.sp, self.chi, N, on)
-            method, tol, omega_min = method_for(p, self.tol, self.stiff_tol) if self.damping > 0 else ("fast", self.tol, 0)
-            if method == "rodas4":
-                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min)
-            r = _run(p, method, tol)
-            self.done[key] = r
-            self.log.append({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
-                             "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
-        return self.done[key]
-
-
-def _answer(runs: _Runs, N: int, quantity: str, check: bool, alone: bool) -> dict:
+def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool) -> dict:
     """One answer on ``N`` links (the runs of ``runs``, each made once)."""
     sp, chi = runs.sp, runs.chi
     present = [m for m in MECHANISMS[:-1] if sp.has(m)]
@@ -440,7 +321,7 @@ def decide(factor: float, real: float, alone: dict, acts: bool = True, tried: bo
     return min(alone, key=lambda m: abs(math.log(alone[m] / real)))
 
 
-def _auto(runs: _Runs, quantity: str, alone: bool) -> dict:
+def _auto(runs: Runs, quantity: str, alone: bool) -> dict:
     """``N="auto"``: the full run on :data:`AUTO_N` links, doubling, until ``quantity`` moves by at
     most :data:`RESOLVED` from one to the next (or the last); then the answer on those links, its
     resolution the last two full runs' (each run made once)."""

@@ -55,8 +55,8 @@ from .. import _validate as V
 from . import forced as FR
 from . import general as G
 
-__all__ = ["R_DOP853", "ZETA_MIN", "grid_damping", "CHOICE_RATIO", "RODAS4_PRICE", "WARN_STEPS", "REFUSE_STEPS", "shortest_wave",
-           "largest_eigenvalue", "explicit_steps", "wave_of", "stiff_steps", "accuracy_steps", "choose", "check_cost",
+__all__ = ["R_DOP853", "ZETA_MIN", "CHOICE_RATIO", "RODAS4_PRICE", "WARN_STEPS", "REFUSE_STEPS", "shortest_wave",
+           "grid_damping", "largest_eigenvalue", "explicit_steps", "wave_of", "stiff_steps", "accuracy_steps", "choose", "check_cost",
            "CostWarning"]
 
 #: DOP853's stability boundary (min over the imaginary and negative real axes, from its tableau)
@@ -130,7 +130,7 @@ def grid_damping(h, m, bending, zeta: float = 1.0, omega_min: float = 0.0) -> np
 
     >>> import numpy as np
     >>> eta = grid_damping(np.full(4, 0.25), np.full(4, 0.25), np.full(5, 1e-2))
-    >>> [round(x, 6) for x in eta]   # (1/2) 0.25^2 sqrt(1e-2) at the inner nodes
+    >>> [round(float(x), 6) for x in eta]   # (1/2) 0.25^2 sqrt(1e-2) at the inner nodes
     [0.002209, 0.003125, 0.003125, 0.003125, 0.002209]
     """
     h = np.asarray(h, dtype=float)
