@@ -131,7 +131,7 @@ def grid_damping(h, m, bending, zeta: float = 1.0, omega_min: float = 0.0) -> np
     >>> import numpy as np
     >>> eta = grid_damping(np.full(4, 0.25), np.full(4, 0.25), np.full(5, 1e-2))
     >>> [round(float(x), 6) for x in eta]   # (1/2) 0.25^2 sqrt(1e-2) at the inner nodes
-    [0.002209, 0.003125, 0.003125, 0.003125, 0.002209]
+    [0.00221, 0.003125, 0.003125, 0.003125, 0.00221]
     """
     h = np.asarray(h, dtype=float)
     N = h.size
