@@ -6,7 +6,10 @@ end separation chi: the peak speed, acceleration and tension of its snap **from 
 real model**, the ideal chain's answer beside them, the factor between them, and the
 mechanism that capped the snap, decided by computation.
 
-The runs (all on N links, the fast method of :func:`snapping.simulate.run`, tolerance ``tol``):
+The runs (all on N links, each made once: :mod:`snapping.caps_runs`; the fast method of
+:func:`snapping.simulate.run` at tolerance ``tol``, except the stiff runs, whose bending waves
+would hold the explicit method to tiny steps: those are RODAS4's at ``stiff_tol`` with those
+waves grid-damped, :func:`snapping.caps_runs.method_for`):
 
 * **ideal**: the paper's chain, N equal links of the line's length and mass, no body;
 * **full**: the real model with every mechanism at once, the inextensible line of
@@ -32,6 +35,9 @@ within 10% of the ideal's (ratio >= :data:`snapping.regimes_analysis.LEVEL` = 0.
 crossover of the regime studies) nothing caps it but the ideal chain's own cap (geometry, and
 the links); otherwise it is the mechanism whose run *alone* comes closest to the real answer,
 closeness measured as |log(alone / real)|.
+
+:func:`design` answers at each chi of a list the same way (no N/2 check): the real and ideal
+peaks, their factor and the capping mechanism per chi, and which chi keep the peaks under limits.
 
 With ``check=True`` the full run is repeated on N/2 links: the relative change of each peak is
 the answer's resolution check (the peaks of a continuous line converge as the links shrink
@@ -59,7 +65,7 @@ from . import _validate as V
 from .caps_runs import (GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO, STIFF_TOL, STRETCH_N,  # noqa: F401
                         Runs, method_for, problem, stretch_factor)
 
-__all__ = ["LineSpec", "spec", "cap", "design", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
+__all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
 #: the ideal run's peak speed over the wave speed above which the stretching is run
@@ -398,7 +404,9 @@ def format_answer(r: dict) -> list[str]:
     out.append(f"  capped by: {verdict} -- {r['quantity']} {r['real'][r['quantity']]:.5g} "
                f"{QUANTITIES[r['quantity']]} (ideal {r['ideal'][r['quantity']]:.5g})")
     out.append(f"  rule: {r['rule']}")
-    out.append(f"  cost: {r['n_rhs']} right-hand-side evaluations, {r['wall']:.2f} s ({r['cpu']:.2f} s CPU)")
+    stiff = [f"{x['run']} ({x['N']})" for x in r.get("runs", ()) if x["method"] == "rodas4"]
+    out.append(f"  cost: {r['n_rhs']} right-hand-side evaluations, {r['wall']:.2f} s ({r['cpu']:.2f} s CPU); "
+               f"{len(r.get('runs', ()))} runs" + (f", RODAS4 (stiff): {', '.join(stiff)}" if stiff else ""))
     return out
 
 
