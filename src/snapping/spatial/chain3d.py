@@ -66,14 +66,13 @@ from numba import njit
 
 from ..simulate.general import BLOCK, _pow2_near
 from . import forces3d as F3
-# the held end's compiled motion and the layout of ``par`` (re-exported here: chain3d.pin3d, chain3d.P_BODY, ...)
+# the held end's compiled motion and the layout of ``par`` (also importable from here: chain3d.pin3d, chain3d.P_BODY)
 from .motion3d import (NPAR, P_AX, P_AY, P_AZ, P_BODY, P_GX, P_GY, P_GZ, P_NX, P_NY, P_NZ, P_PIN, P_T0, P_T1,
                        PIN_CIRCLE, PIN_FIXED, PIN_FLICK, PIN_PULL, PIN_TABLE, breakpoints, circle_data, pin3d,
                        table_data)
 
-__all__ = ["Work", "make_model", "rhs3d", "measure3d", "project", "pin3d", "nodes_to_state", "state_to_nodes",
-           "NMEAS", "MEAS_NAMES", "circle_data", "table_data", "breakpoints", "M_BEND", "M_DISS", "BODY_MEAS_NAMES",
-           "nmeas"]
+__all__ = ["Work", "make_model", "rhs3d", "measure3d", "project", "nodes_to_state", "state_to_nodes", "NMEAS",
+           "MEAS_NAMES", "M_BEND", "M_DISS", "BODY_MEAS_NAMES", "nmeas"]
 
 # ---------------------------------------------------------------- per-step measurements
 (M_VMAX, M_AMAX, M_SIGMAX, M_VTIP, M_ATIP, M_ENERGY, M_WORK, M_LG, M_ZAMP, M_VZAMP, M_LINKERR, M_VREL,
