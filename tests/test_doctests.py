@@ -8,8 +8,9 @@ import pytest
 
 MODULES = ["snapping.schema", "snapping.estimates", "snapping.estimates.catenary", "snapping.estimates.rules",
            "snapping.table", "snapping.design", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
-           "snapping._files", "snapping.units", "snapping.cli", "snapping.lines", "snapping.dimensionless",
-           "snapping.simulate.compression", "snapping.spatial", "snapping.regimes_analysis", "snapping.caps"]
+           "snapping._files", "snapping.units", "snapping.unit_scales", "snapping.cli", "snapping.lines",
+           "snapping.dimensionless", "snapping.simulate.compression", "snapping.spatial", "snapping.regimes_analysis",
+           "snapping.caps"]
 
 
 def _with_submodules(module):

@@ -3,10 +3,12 @@
 * :mod:`snapping.spatial.chain3d`: the equations (tridiagonal tension system with the
   cosines between neighbouring links), the compiled right-hand side and diagnostics;
 * :mod:`snapping.spatial.solve3d`: compiled DOP853 stepping with dense-output peaks, to the snap;
+  :mod:`snapping.spatial.error3d`: its steps' error norm (the links' angle and rate errors);
 * :mod:`snapping.spatial.starts3d`: :class:`Problem3D`, planar starts in space and the
   out-of-plane perturbations only 3D has, the whirling start (steady or spun up), any curve;
 * :mod:`snapping.spatial.held3d`: :class:`Pin3D`, the held end's motion in space (pull,
-  flick, a circle, sampled points of any curve);
+  flick, a circle, sampled points of any curve); :mod:`snapping.spatial.motion3d`: its
+  compiled form (``r_p(t)`` in the kernels);
 * :mod:`snapping.spatial.shape3d`: start curves in space (files of x, y, z; exact chords;
   a start that crosses itself refused);
 * :mod:`snapping.spatial.dataset3d`: the run Dataset of a 3D run (the planar names, and

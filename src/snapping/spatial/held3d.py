@@ -1,7 +1,7 @@
 """The held end of a 3D chain: fixed, pulled, flicked, driven around a circle, or along samples.
 
 :class:`Pin3D` is the held end's prescribed motion ``r_p(t)`` in space (it starts at the
-origin); the compiled evaluation is :func:`snapping.spatial.chain3d.pin3d`, so that what is
+origin); the compiled evaluation is :func:`snapping.spatial.motion3d.pin3d`, so that what is
 run, recorded and reported is one function. The kinds:
 
 * ``fixed``; ``pull`` (acceleration ``accel`` from ``t0`` for ``duration``, then constant
@@ -44,12 +44,13 @@ from .. import _validate as V
 from .._validate import _short
 from ..simulate.pin import ACCEL_MAX, MIN_DURATION, POSITION_MAX, T_MAX, sample_function
 from . import chain3d as C
+from . import motion3d as M
 
 __all__ = ["Pin3D", "parse_pin3d", "read_pin_table", "PIN3D_KINDS"]
 
 PIN3D_KINDS = ("fixed", "pull", "flick", "circle", "table")
-_CODES = {"fixed": C.PIN_FIXED, "pull": C.PIN_PULL, "flick": C.PIN_FLICK, "circle": C.PIN_CIRCLE,
-          "table": C.PIN_TABLE}
+_CODES = {"fixed": M.PIN_FIXED, "pull": M.PIN_PULL, "flick": M.PIN_FLICK, "circle": M.PIN_CIRCLE,
+          "table": M.PIN_TABLE}
 #: relative tolerance of a unit vector's length
 UNIT_RTOL = 1e-9
 #: largest circle rate (radians per time unit sqrt(L/g))
@@ -196,12 +197,12 @@ class Pin3D:
         data = None
         if self.kind == "circle":
             n, a = np.asarray(self.axis), np.asarray(self.start_dir)
-            data = C.circle_data(self.radius, self.omega, a, np.cross(n, a))
+            data = M.circle_data(self.radius, self.omega, a, np.cross(n, a))
         elif self.kind == "table":
             from scipy.interpolate import CubicSpline
 
             t, *xyz = self.table
-            data = C.table_data(t, *(CubicSpline(t, c).c for c in xyz))
+            data = M.table_data(t, *(CubicSpline(t, c).c for c in xyz))
         return (_CODES[self.kind], self.accel, float(self.t0), float(self.duration), data)
 
     def _par(self):
@@ -213,7 +214,7 @@ class Pin3D:
 
     @property
     def breakpoints(self) -> list[float]:
-        return C.breakpoints(self._par())
+        return M.breakpoints(self._par())
 
     @property
     def settle_time(self) -> float:
@@ -237,9 +238,9 @@ class Pin3D:
         """
         t = V.real("t", t)
         par = self._par()
-        out = [float(v) for v in C.pin3d(t, par)]
-        if t in C.breakpoints(par):  # (position and velocity are continuous there)
-            out[6:] = [float(v) for v in C.pin3d(float(np.nextafter(t, np.inf)), par)[6:]]
+        out = [float(v) for v in M.pin3d(t, par)]
+        if t in M.breakpoints(par):  # (position and velocity are continuous there)
+            out[6:] = [float(v) for v in M.pin3d(float(np.nextafter(t, np.inf)), par)[6:]]
         return tuple(out)
 
     def position(self, t: float) -> tuple:

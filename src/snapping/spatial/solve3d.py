@@ -7,11 +7,10 @@ evaluation ``dense_eval`` are generic in the state and reused as they are; its s
 has its own loop, :func:`advance3d`, around :func:`snapping.spatial.chain3d.rhs3d`).
 
 Per attempted step: 12 evaluations (first same as last); 3 more for the dense output of a
-step a peak search needs, 1 per point of the search. Error control on the planar method's quantities
-(max norm over links, rtol = atol = ``tol``): each link's angle and angular-velocity errors,
-the parts of its ``e_j`` and ``u_j`` estimates normal to ``e_j`` (what the projection leaves),
-by vector length, so the norm does not depend on the frame (:func:`step_error3d`). After each accepted step the state
-is projected back onto ``|e_j| = 1, e_j . u_j = 0`` (:func:`snapping.spatial.chain3d.project`);
+step a peak search needs, 1 per point of the search. Error control on the planar method's
+quantities (each link's angle and angular-velocity errors, by vector length, so the norm does
+not depend on the frame: :func:`snapping.spatial.error3d.step_error3d`, rtol = atol = ``tol``).
+After each accepted step the state is projected back onto ``|e_j| = 1, e_j . u_j = 0`` (:func:`snapping.spatial.chain3d.project`);
 the next step's first stage is the last stage of this one (at the unprojected end state,
 which differs by the local error: ``reeval=True`` evaluates it again at the projected state,
 one evaluation more per step).
@@ -42,6 +41,7 @@ from scipy.optimize import minimize_scalar
 
 from ..simulate import rk as R
 from . import chain3d as C
+from .error3d import STAGE_BLOCK, step_error3d, step_error3d_components
 
 __all__ = ["run3d", "Stepper3D"]
 
@@ -65,22 +65,20 @@ NREC = 3 + C.NMEAS
 RECORD_NAMES = ("t", "dt", "err") + C.MEAS_NAMES
 RECORD_CHUNK = 4096
 PEAK_XTOL = 1e-10
-#: error norm: 2 the links' angle and angular-velocity errors (:func:`step_error3d`, the planar
-#: method's quantities), 1 per component scaled by the link's norms (:func:`step_error3d_components`,
-#: the norm before), 0 per component (:func:`snapping.simulate.rk.step_error`)
+#: error norm: 2 the links' angle and angular-velocity errors
+#: (:func:`snapping.spatial.error3d.step_error3d`, the planar method's quantities), 1 per component
+#: scaled by the link's norms (:func:`snapping.spatial.error3d.step_error3d_components`, the norm
+#: before), 0 per component (:func:`snapping.simulate.rk.step_error`)
 NORM_MODE = 2
-
-
-#: elements a block of the stage arithmetic (:func:`_stage_state3d`): the output block stays in cache
-STAGE_BLOCK = 1024
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _stage_state3d(n, s, h, y0, Kst, out):
     """:func:`snapping.simulate.rk._stage_state` (``out = y0 + h sum_j A[s, j] K_j`` over the
-    nonzero ``A[s, j]``, in the same order: bit for bit), in blocks of :data:`STAGE_BLOCK`
-    elements, so that a block of ``out`` stays in the first-level cache over the stage's
-    terms (the 3D state is 3 times the planar one and outgrows it)."""
+    nonzero ``A[s, j]``, in the same order: bit for bit), in blocks of
+    :data:`snapping.spatial.error3d.STAGE_BLOCK` elements, so that a block of ``out`` stays in
+    the first-level cache over the stage's terms (the 3D state is 3 times the planar one and
+    outgrows it)."""
     m = R._NZ[s]
     for i0 in range(0, n, STAGE_BLOCK):
         i1 = min(i0 + STAGE_BLOCK, n)
@@ -98,130 +96,6 @@ def _stage_state3d(n, s, h, y0, Kst, out):
             Kj = Kst[j, i0:i1]
             for i in range(nb):
                 ob[i] += a * Kj[i]
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def step_error3d(N, h, tol, y0, y1, Kst, ytmp):
-    """The scaled error of a step (accept if <= 1), the planar method's quantity in 3D.
-
-    Hairer's DOP853 estimates (the 5th- and 3rd-order error vectors ``E5, E3`` of
-    :func:`snapping.simulate.rk.scaled_error`) of each link's direction ``e_j`` and rate
-    ``u_j``, taken as 3-vectors and projected onto the plane normal to ``e_j`` (at the step's
-    end): the parts along ``e_j`` (a drift of ``|e_j|`` off 1 and of ``e_j . u_j`` off 0) are
-    what :func:`snapping.spatial.chain3d.project` removes after the step, so they are not an
-    error of the solution. What is left is the error of the link's angle (``|P E5(e_j)|``, the
-    planar method's angle error) and of its angular velocity (``|P E5(u_j)|``: for a planar
-    motion ``u_j = omega_j n x e_j``, and the error of ``omega_j``), scaled as the planar norm
-    scales them: by ``tol (1 + |e_j|)`` and ``tol (1 + |u_j|)`` (the larger at the step's two
-    ends). Error per link ``|h| |E5|^2 / sqrt(|E5|^2 + 0.01 |E3|^2)`` (Hairer's combination with
-    the squares summed over the vector's components); ``W`` (and ``D`` with a body): per
-    component, their own size. The maximum over links and components; inf if not finite.
-    Uses ``ytmp`` and ``Kst[NSX - 2:]`` (dense-output stages, free during a step) as scratch."""
-    n3 = 3 * N
-    n6 = 2 * n3
-    ah = abs(h)
-    e5v = ytmp
-    e3v = Kst[R.NSX - 1]  # (scratch: the last dense-output stage, which dense_build3d fills afresh)
-    for i0 in range(0, n6, STAGE_BLOCK):  # (the estimates of all e, u components first, in cache blocks)
-        i1 = min(i0 + STAGE_BLOCK, n6)
-        nb = i1 - i0
-        b5 = e5v[i0:i1]
-        b3 = e3v[i0:i1]
-        for i in range(nb):
-            b5[i] = 0.0
-            b3[i] = 0.0
-        for jj in range(R._E5NZ.size):
-            k = R._E5NZ[jj]
-            c = R.E5_RK[k]
-            Kk = Kst[k, i0:i1]
-            for i in range(nb):
-                b5[i] += c * Kk[i]
-        for jj in range(R._E3NZ.size):
-            k = R._E3NZ[jj]
-            c = R.E3_RK[k]
-            Kk = Kst[k, i0:i1]
-            for i in range(nb):
-                b3[i] += c * Kk[i]
-    out = Kst[R.NSX - 2]  # (scratch as e3v: each link's two terms, then their maximum)
-    for part in range(2):  # (over slices, branch-free: vectorises)
-        o = part * n3
-        vx0, vy0, vz0 = y0[o:o + N], y0[o + N:o + 2 * N], y0[o + 2 * N:o + n3]
-        vx1, vy1, vz1 = y1[o:o + N], y1[o + N:o + 2 * N], y1[o + 2 * N:o + n3]
-        ex1, ey1, ez1 = y1[:N], y1[N:2 * N], y1[2 * N:n3]
-        p5x, p5y, p5z = e5v[o:o + N], e5v[o + N:o + 2 * N], e5v[o + 2 * N:o + n3]
-        p3x, p3y, p3z = e3v[o:o + N], e3v[o + N:o + 2 * N], e3v[o + 2 * N:o + n3]
-        ob = out[part * N:(part + 1) * N]
-        for j in range(N):
-            ex = ex1[j]
-            ey = ey1[j]
-            ez = ez1[j]
-            inv = 1.0 / math.sqrt(ex * ex + ey * ey + ez * ez)
-            ex *= inv
-            ey *= inv
-            ez *= inv
-            a0 = vx0[j] * vx0[j] + vy0[j] * vy0[j] + vz0[j] * vz0[j]
-            a1 = vx1[j] * vx1[j] + vy1[j] * vy1[j] + vz1[j] * vz1[j]
-            isc = 1.0 / (tol * (1.0 + math.sqrt(max(a0, a1))))
-            d5 = p5x[j] * ex + p5y[j] * ey + p5z[j] * ez
-            d3 = p3x[j] * ex + p3y[j] * ey + p3z[j] * ez
-            qx = (p5x[j] - d5 * ex) * isc
-            qy = (p5y[j] - d5 * ey) * isc
-            qz = (p5z[j] - d5 * ez) * isc
-            s5 = qx * qx + qy * qy + qz * qz
-            qx = (p3x[j] - d3 * ex) * isc
-            qy = (p3y[j] - d3 * ey) * isc
-            qz = (p3z[j] - d3 * ez) * isc
-            s3 = qx * qx + qy * qy + qz * qz
-            d = s5 + 0.01 * s3
-            v = ah * s5 / math.sqrt(d)
-            ob[j] = v if d > 0.0 else (0.0 if d == 0.0 else np.inf)
-    err = 0.0
-    for i in range(2 * N):
-        v = out[i]
-        err = v if not (v <= err) else err
-    for i in range(n6, y0.shape[0]):  # W (and D with a body): their own size
-        v = R.scaled_error(Kst, i, y0[i], y1[i], h, tol)
-        if not (v <= err):
-            err = v
-    return err if err - err == 0.0 else np.inf
-
-
-@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def step_error3d_components(N, h, tol, y0, y1, Kst, ytmp):
-    """The former scaled error of a step (kept for comparison, ``NORM_MODE = 1``) (accept if <= 1): Hairer's DOP853 estimate of every
-    component (as :func:`snapping.simulate.rk.scaled_error`), scaled per link by
-    ``tol (1 + |e_j|)`` for the three components of ``e_j`` and ``tol (1 + |u_j|)`` for those
-    of ``u_j`` (the larger at the step's two ends), maximum over the components. The norm of
-    the link's vector, not each component's own size: a component that passes through zero
-    while the link turns fast (``|u_j|`` large) would otherwise ask for a relative accuracy
-    the planar method (whose angular velocity is the link's ``|u_j|``) never asks for."""
-    n3 = 3 * N
-    for j in range(N):
-        a0 = 0.0
-        a1 = 0.0
-        b0 = 0.0
-        b1 = 0.0
-        for c in range(3):
-            i = c * N + j
-            a0 += y0[i] * y0[i]
-            a1 += y1[i] * y1[i]
-            b0 += y0[n3 + i] * y0[n3 + i]
-            b1 += y1[n3 + i] * y1[n3 + i]
-        se = math.sqrt(max(a0, a1))
-        su = math.sqrt(max(b0, b1))
-        for c in range(3):
-            ytmp[c * N + j] = se
-            ytmp[n3 + c * N + j] = su
-    n = y0.shape[0]
-    for i in range(2 * n3, n):  # W (and D with a body): their own size
-        ytmp[i] = max(abs(y0[i]), abs(y1[i]))
-    for i in range(n):  # (rk's branch-free component error with |y| := the link's norm: vectorises)
-        ytmp[i] = R.scaled_error(Kst, i, ytmp[i], ytmp[i], h, tol)
-    err = 0.0
-    for i in range(n):
-        if ytmp[i] > err:
-            err = ytmp[i]
-    return err if err - err == 0.0 else np.inf
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -445,8 +319,9 @@ class Stepper3D:
 
     def _initial_step(self, y0, f0, t0) -> float:
         """Hairer's starting step (Solving ODE I, II.4), in the run's norm: each link's
-        ``e_j`` and ``u_j`` (and their rates) by their vector lengths, as :func:`step_error3d`
-        (so that a rotated problem starts with the same step), ``W`` (``D``) by their own."""
+        ``e_j`` and ``u_j`` (and their rates) by their vector lengths, as
+        :func:`snapping.spatial.error3d.step_error3d` (so that a rotated problem starts with
+        the same step), ``W`` (``D``) by their own."""
         N = self.N
 
         def size(y):
