@@ -308,14 +308,23 @@ def ladder_of(r: Result) -> str:
     return r.code
 
 
+def fineness(r: Result) -> float:
+    """How fine a run's setting is: 1/tol (this project), 1/dt (the peers)."""
+    for word in r.setting.replace("(", " ").split():
+        if word.startswith(("tol=", "dt=")):
+            return 1.0 / float(word.split("=")[1])
+    return float(r.count)
+
+
 def cheapest(rows, code: str, level: float, criterion: str | None = None):
     """The run of ``code`` (a name, or a prefix such as 'MoorDyn') of least CPU time that is
-    within ``level``, and so is every costlier run of its ladder (:func:`ladder_of`): a run
-    within it by chance, with finer ones outside, does not count. None if none."""
+    within ``level``, and so is every finer run of its ladder (:func:`ladder_of`, a smaller
+    tolerance or step: :func:`fineness`): a run within it by chance, with finer ones outside,
+    does not count. None if none."""
     ok = []
     mine = [r for r in rows if r.code.startswith(code)]
     for r in mine:
-        same = [q for q in mine if ladder_of(q) == ladder_of(r) and q.count >= r.count]
+        same = [q for q in mine if ladder_of(q) == ladder_of(r) and fineness(q) >= fineness(r)]
         if all(error(q, criterion) <= level for q in same):
             ok.append(r)
     return min(ok, key=lambda r: r.cpu) if ok else None

@@ -149,7 +149,7 @@ def point(chi, N, c, start, a, moordyn_ok, elastica_ok):
 
 def summary(points, levels, criteria=("v", "both")) -> None:
     """The markdown table: per point and level, the cheapest run of each code within eps from
-    which on every costlier run of its ladder is within eps too (``elastic_common.cheapest``),
+    which on every finer run of its ladder (smaller tol or dt) is within eps too (``elastic_common.cheapest``),
     and the ratios of CPU times."""
     print("\n| N | c | start | ref (agreement v / sigma) | peak | eps | this project | MoorDyn | PyElastica "
           "| MoorDyn/this | PyElastica/this | >= 10x |")
