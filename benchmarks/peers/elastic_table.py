@@ -109,7 +109,8 @@ def point(chi, N, c, start, a, moordyn_ok, elastica_ok):
     finest = min(E.LEVELS)
     rows = []
     for meth in a.methods.split(","):
-        rows += ladder([(t, 1.5) for t in TOLS],
+        tols = [float(x) for x in a.tols.split(",")] if a.tols else TOLS
+        rows += ladder([(t, 1.5) for t in tols],
                        lambda t, meth=meth: cached("snapping", f"tol={t:g} ({meth})", N, c, start,
                                                    lambda: E.run_project(chi, N, c, t, meth, start), ref),
                        a.budget_project, finest)
@@ -158,8 +159,9 @@ def summary(points, levels, criteria=("v", "both")) -> None:
         for crit in criteria:
             for eps in levels:
                 best = {k: E.cheapest(rows, k, eps, crit) for k in ("snapping", "MoorDyn", "PyElastica")}
+                ran = {k: any(r.code == k for r in rows) for k in best}
                 cell = {k: (f"{r.setting}: {r.count:,} {'ev' if k == 'snapping' else 'st'}, {r.cpu:.2f} s"
-                            if r else "not reached") for k, r in best.items()}
+                            if r else "not reached" if ran[k] else "not run") for k, r in best.items()}
                 s = best["snapping"]
                 q = {k: (f"{best[k].cpu / s.cpu:.3g}x" if s and best[k] else "-") for k in ("MoorDyn", "PyElastica")}
                 ok = []
@@ -167,7 +169,7 @@ def summary(points, levels, criteria=("v", "both")) -> None:
                     if s and best[k]:
                         ok.append("yes" if best[k].cpu >= 10 * s.cpu else "no")
                     elif s:
-                        ok.append("(peer not reached)")
+                        ok.append("(peer not reached)" if ran[k] else "(peer not run)")
                     else:
                         ok.append("(this project not reached)")
                 agree = ref.agree_v if crit == "v" else max(ref.agree_v, ref.agree_sigma)
@@ -185,6 +187,7 @@ def main(argv=None) -> int:
     ap.add_argument("--c", default="30", help="wave speeds c/sqrt(gL), comma-separated")
     ap.add_argument("--start", default="stretched", help="starts, comma-separated (stretched, matched)")
     ap.add_argument("--methods", default="dop853,rodas4", help="this project's methods")
+    ap.add_argument("--tols", default="", help="this project's tolerances, in the order tried (default 1e-3 ... 1e-7)")
     ap.add_argument("--schemes", default="rk2,rk4", help="MoorDyn's schemes (its tScheme names)")
     ap.add_argument("--pyelastica", action="store_true", help="run PyElastica too")
     ap.add_argument("--peak", default="v", choices=("v", "sigma", "both"), help="the ladders' stop criterion")
