@@ -454,3 +454,31 @@ def test_pyelastica_elastic_quick_run(tmp_path):
     assert min(e for _, e in pe) < 6e-2
     assert all(3.3 < v < 4.5 for v, _ in pe)
     assert "largest compression" in out.stdout
+
+
+def test_elastic_matched_accuracy_rule():
+    """The cost at eps (elastic_common.cheapest): a run within eps by chance, with a finer run of
+    its ladder outside, does not count, whatever the costs (RODAS4 on the matched start costs
+    20x more at tol 1e-3 than at 3e-5); "both" judges MoorDyn (a node-averaged tension) by v.
+    No peer needed."""
+    C = _load(ROOT / "benchmarks" / "peers" / "elastic_common.py")
+
+    def run(code, setting, cpu, err, err_sigma=0.0, count=1000):
+        r = C.Result(code, 100, 30.0, setting, count, cpu, 1.0, 1.0, 1.0, 1.0)
+        r.err, r.err_sigma = err, err_sigma
+        return r
+
+    rows = [run("snapping", "tol=0.001 (rodas4)", 15.0, 1e-5, count=754257),   # lucky, and dear
+            run("snapping", "tol=0.0003 (rodas4)", 0.3, 1e-5, count=5000),     # lucky, and cheap
+            run("snapping", "tol=0.0001 (rodas4)", 13.0, 5e-3, count=616958),  # a finer run outside 1e-3
+            run("snapping", "tol=3e-05 (rodas4)", 0.6, 2e-4, count=29267),
+            run("snapping", "tol=1e-05 (rodas4)", 1.1, 3e-5, count=47362),
+            run("MoorDyn", "rk4 dt=1.67e-05", 4.2, 1e-7, err_sigma=2e-3),
+            run("MoorDyn", "rk4 dt=8.33e-06", 8.4, 1e-7, err_sigma=2e-3),
+            run("MoorDyn", "rk2 dt=4.17e-06", 8.1, 0.2, err_sigma=0.5)]
+    assert C.cheapest(rows, "snapping", 1e-3).setting == "tol=3e-05 (rodas4)"
+    assert C.cheapest(rows, "snapping", 1e-4).setting == "tol=1e-05 (rodas4)"
+    assert C.cheapest(rows, "snapping", 1e-6) is None
+    assert C.cheapest(rows, "MoorDyn", 1e-4, "both").setting == "rk4 dt=1.67e-05"
+    assert C.cheapest(rows, "MoorDyn", 1e-4, "sigma") is None
+    assert C.ladder_of(rows[5]) == "MoorDyn rk4" and C.ladder_of(rows[0]) == "snapping rodas4"

@@ -2,8 +2,9 @@
 
 The problem (``elastic_common.py``; nondimensional L = lambda = g = 1): the level catenary
 chi = 0.25 of N links of rest length 1/N, node masses 1/N (half at the free end), axial
-stiffness EA = c^2, tension-only, no damping; released from the stretched static equilibrium
-(this project's ``ElasticLine.start("stretched")``), the held end fixed.
+stiffness EA = c^2, tension-only, no damping; released from rest from this project's start
+(``--start``: ``stretched``, the static equilibrium; ``matched``, each link at the rigid chain's
+tension just after release), the held end fixed.
 
 MoorDyn (PyPI ``moordyn``, MoorDyn-C v2): one line of N segments, unstretched length 1,
 mass 1 per length, EA = c^2, between a Fixed point (the held end, the origin) and a Free
@@ -14,7 +15,7 @@ project's: lumped node masses (half a segment's at each end: the free point's ma
 node's, 1/(2N)), segments that carry EA (l/h - 1) when stretched and nothing when slack.
 
 The start: MoorDyn's own initial condition (its catenary) is replaced by this project's
-stretched equilibrium: ``Init_NoIC``, then its state (saved with ``SaveState``: the free
+start (``elastic_common.start_state``: nodes and velocities): ``Init_NoIC``, then its state (saved with ``SaveState``: the free
 point's and the line's inner nodes' positions and velocities) is rewritten with the start's
 nodes and loaded back with ``LoadState``; the script checks the positions MoorDyn then
 reports against the start (round-off).
@@ -112,11 +113,11 @@ def _blocks(buf: bytes, offset: int):
     return out
 
 
-def build_moordyn(chi: float, N: int, c: float, dt: float, scheme: str, workdir: str):
-    """(system, point, line) of MoorDyn at the stretched start (see the module docstring)."""
+def build_moordyn(chi: float, N: int, c: float, dt: float, scheme: str, workdir: str, start: str = "stretched"):
+    """(system, point, line) of MoorDyn at this project's ``start`` (see the module docstring)."""
     import moordyn
 
-    x, y = E.start_nodes(chi, N, c)
+    x, y, vx, vy = E.start_state(chi, N, c, start)
     path = os.path.join(workdir, "line.txt")
     with open(path, "w") as fh:
         fh.write(INPUT.format(ea=c * c, x0=float(x[0]), z0=float(-y[0]), N=N, dt=dt, scheme=scheme))
@@ -135,11 +136,11 @@ def build_moordyn(chi: float, N: int, c: float, dt: float, scheme: str, workdir:
     if len(blocks) != 3 or blocks[1][1:] != (1, 6) or blocks[2][1:] != (N - 1, 6):
         raise RuntimeError(f"unexpected MoorDyn state layout {blocks}")
     k1 = blocks[1][0]
-    f[k1:k1 + 6] = [x[0], 0.0, -y[0], 0.0, 0.0, 0.0]  # the free point
+    f[k1:k1 + 6] = [x[0], 0.0, -y[0], vx[0], 0.0, -vy[0]]  # the free point
     k2 = blocks[2][0]
     for i in range(1, N):  # line node i (from the fixed end A) is this project's node N - i
         j = N - i
-        f[k2 + 6 * (i - 1):k2 + 6 * i] = [x[j], 0.0, -y[j], 0.0, 0.0, 0.0]
+        f[k2 + 6 * (i - 1):k2 + 6 * i] = [x[j], 0.0, -y[j], vx[j], 0.0, -vy[j]]
     buf[off:] = f.tobytes()
     with open(st, "wb") as fh:
         fh.write(bytes(buf))
@@ -148,14 +149,14 @@ def build_moordyn(chi: float, N: int, c: float, dt: float, scheme: str, workdir:
     return s, moordyn.GetPoint(s, 2), moordyn.GetLine(s, 1)
 
 
-def start_check(chi: float, N: int, c: float, scheme: str = "rk2", dt: float = 1e-9):
+def start_check(chi: float, N: int, c: float, scheme: str = "rk2", dt: float = 1e-9, start: str = "stretched"):
     """Largest |MoorDyn's node position - the start| after one step of ``dt`` (the positions it
     reports are those of its last step), and MoorDyn's node masses (lumped)."""
     import moordyn
 
-    x, y = E.start_nodes(chi, N, c)
+    x, y, _, _ = E.start_state(chi, N, c, start)
     with tempfile.TemporaryDirectory() as d:
-        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d)
+        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
         with quiet_stdout():
             moordyn.Step(s, [], [], 0.0, dt)
             P = np.array([moordyn.GetLineNodePos(ln, i) for i in range(N + 1)])[::-1]
@@ -165,7 +166,7 @@ def start_check(chi: float, N: int, c: float, scheme: str = "rk2", dt: float = 1
 
 
 def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_end: float | None = None,
-                stop_fraction: float = 0.5) -> E.Result:
+                stop_fraction: float = 0.5, start: str = "stretched") -> E.Result:
     """MoorDyn at the fixed step ``dt`` to ``t_end`` (the reference's end), or without it until
     the free end's speed has fallen below ``stop_fraction`` of its running peak (after t = 0.8)."""
     import moordyn
@@ -175,7 +176,7 @@ def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_
     T = np.empty(n_max)
     with tempfile.TemporaryDirectory() as d, quiet_stdout():
         w = time.process_time()
-        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d)
+        s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
         step, vel, maxten = moordyn.Step, moordyn.GetPointVel, moordyn.GetLineMaxTen
         peak, t, n, bad = 0.0, 0.0, 0, False
         for n in range(1, n_max + 1):
@@ -198,39 +199,41 @@ def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_
     tt = dt * np.arange(1, n + 1)
     vp, tp = E.vertex(tt, v[:n])
     sp_, ts = E.vertex(tt, T[:n])
-    return E.Result("MoorDyn", N, c, f"{scheme} dt={dt:.3g}", n, w, vp, tp, sp_, ts)
+    return E.Result("MoorDyn", N, c, f"{scheme} dt={dt:.3g}", n, w, vp, tp, sp_, ts, start=start)
 
 
-def axial_dt(N: int, c: float) -> float:
-    return AXIAL_SAFETY / (N * c)
+def axial_dt(N: int, c: float, scheme: str = "rk2") -> float:
+    """The first step of the ladder: AXIAL_SAFETY h/c (RK2), twice that for RK4 (stable to 1.39 h/c)."""
+    return AXIAL_SAFETY * (2.0 if scheme.lower() == "rk4" else 1.0) / (N * c)
 
 
-def compare(chi, N, c, dts, scheme, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True):
-    ref = E.reference(chi, N, c) if with_ref else None
+def compare(chi, N, c, dts, scheme, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True,
+            start="stretched"):
+    ref = E.reference(chi, N, c, start=start) if with_ref else None
     if ref:
         E.header(ref, chi)
     else:
         print(f"chi = {chi:g}, N = {N}, c/sqrt(gL) = {c:g}: no reference (--no-reference); MoorDyn runs to its snap")
-    err0, M = start_check(chi, N, c, scheme)
+    err0, M = start_check(chi, N, c, scheme, start=start)
     print(f"  MoorDyn's start: largest node position - this project's start {err0:.1e}; node masses "
           f"{M[0]:.6g} (free end), {M[1]:.6g}, ..., total {M[:N].sum():.12g}")
-    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget) if ref else []
+    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget, start=start) if ref else []
     spent = 0.0
     for dt in dts:
         if spent > budget:
             print(f"  (MoorDyn dt={dt:.3g} skipped: the budget of {budget:g} s is spent)")
             continue
         try:
-            r = run_moordyn(chi, N, c, dt, scheme, ref.t_end if ref else None)
+            r = run_moordyn(chi, N, c, dt, scheme, ref.t_end if ref else None, start=start)
         except FloatingPointError as e:
             print(f"  ({e})")
             continue
         spent += r.cpu
         rows.append(E.score(r, ref) if ref else r)
-        if r.err <= min(E.LEVELS):
+        if E.error(r) <= min(E.LEVELS):
             break
     E.table(rows)
-    E.matched(rows, "MoorDyn")
+    E.matched(rows, "MoorDyn", ref=ref)
     print(flush=True)
     return rows
 
@@ -245,7 +248,15 @@ def main(argv=None) -> int:
                     help="MoorDyn's steps, comma-separated (default: 0.25 h/c, then halved --halvings times)")
     ap.add_argument("--halvings", type=int, default=3, help="default steps: 0.25 h/c halved this many times")
     ap.add_argument("--scheme", default="rk2", help="MoorDyn's time scheme (its tScheme option; default rk2)")
-    ap.add_argument("--method", default="radau", help="this project's method (any name of elastic.METHODS)")
+    ap.add_argument("--method", default="dop853,rodas4",
+                    help="this project's methods, comma-separated (names of elastic.METHODS; default dop853,rodas4)")
+    ap.add_argument("--start", default="stretched", choices=E.STARTS,
+                    help="the start every code is given (default stretched; matched: no release wave)")
+    ap.add_argument("--peak", default="v", choices=("v", "sigma", "both"),
+                    help="which peak decides 'within eps': the speed, the tension or both (default v)")
+    ap.add_argument("--levels", default=",".join(f"{x:g}" for x in E.LEVELS),
+                    help="the accuracy levels eps, comma-separated (default 1e-3,1e-4)")
+    ap.add_argument("--ref-method", default=E.REF_METHOD, help=f"the reference's method (default {E.REF_METHOD})")
     ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
                     help="this project's tolerances, loosest first (stops once the finest level is reached)")
     ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for MoorDyn per point (default 300)")
@@ -256,19 +267,21 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="N = 20, c = 30, two steps (h/(8 c), h/(16 c)): seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
-    E.REF_TOL = a.ref_tol
+    E.REF_TOL, E.REF_METHOD, E.CRITERION = a.ref_tol, a.ref_method.lower(), a.peak
+    E.LEVELS = tuple(sorted((float(x) for x in a.levels.split(",") if x), reverse=True))
     Ns = [int(x) for x in a.N.split(",") if x]
     cs = [float(x) for x in a.c.split(",") if x]
     tols = [float(x) for x in a.tols.split(",") if x]
     quick_dts = []
     if a.quick:
-        Ns, cs, tols = [20], [30.0], [1e-4, 1e-6]
+        Ns, cs, tols, a.method = [20], [30.0], [1e-4, 1e-6], "dop853"
         quick_dts = [axial_dt(20, 30.0) / 2, axial_dt(20, 30.0) / 4]
     from snapping.simulate.elastic import METHODS
 
-    if a.method.lower() not in METHODS:
-        print(f"--method {a.method!r} is not one of {tuple(METHODS)}", file=sys.stderr)
-        return 2
+    for m in a.method.lower().split(",") + [E.REF_METHOD]:
+        if m not in METHODS:
+            print(f"--method {m!r} is not one of {tuple(METHODS)}", file=sys.stderr)
+            return 2
     try:
         import moordyn  # noqa: F401
     except ImportError:
@@ -278,8 +291,9 @@ def main(argv=None) -> int:
     for N in Ns:
         for c in cs:
             dts = quick_dts or [float(x) for x in a.dt.split(",") if x] or \
-                [axial_dt(N, c) / 2 ** k for k in range(a.halvings + 1)]
-            compare(a.chi, N, c, dts, a.scheme, a.method.lower(), a.budget, tols, with_ref=not a.no_reference)
+                [axial_dt(N, c, a.scheme) / 2 ** k for k in range(a.halvings + 1)]
+            compare(a.chi, N, c, dts, a.scheme, a.method.lower(), a.budget, tols, with_ref=not a.no_reference,
+                    start=a.start)
     print(f"uptime: {os.popen('uptime').read().strip()}")
     return 0
 

@@ -2,8 +2,9 @@
 
 The problem (``elastic_common.py``; nondimensional L = lambda = g = 1): the level catenary
 chi = 0.25 of N links of rest length 1/N, node masses 1/N (half at the free end), axial
-stiffness EA = c^2, tension-only in this project, no damping; released from the stretched
-static equilibrium (this project's ``ElasticLine.start("stretched")``), the held end fixed.
+stiffness EA = c^2, tension-only in this project, no damping; released from rest from this
+project's start (``--start``: ``stretched``, the static equilibrium; ``matched``, each link at
+the rigid chain's tension just after release), the held end fixed.
 
 PyElastica (``pyelastica``, import ``elastica``): a Cosserat rod through the same nodes, the
 same rest lengths 1/N and node masses (PyElastica's own lumping: half an element at each
@@ -65,7 +66,7 @@ def bending_for(dt: float, ea: float, safety: float = BEND_SAFETY) -> float:
     return (dt * ea / (1.2 * safety)) ** 2
 
 
-def build_pyelastica(chi: float, N: int, c: float, B: float):
+def build_pyelastica(chi: float, N: int, c: float, B: float, start: str = "stretched"):
     """(simulator, rod) of PyElastica for the elastic catenary: rest lengths 1/N, node masses
     1/N (1/(2N) at the free end), stretch = shear stiffness EA = c^2, bending B; nodes at the
     stretched start, directors along its chords, the held end (node N) pinned, gravity +y."""
@@ -78,7 +79,7 @@ def build_pyelastica(chi: float, N: int, c: float, B: float):
     p = E.problem(chi, N)
     pos0 = np.zeros((3, N + 1))
     pos0[0], pos0[1] = p.x, p.y
-    xs, ys = E.start_nodes(chi, N, c)
+    xs, ys, vxs, vys = E.start_state(chi, N, c, start)
     pos = np.zeros((3, N + 1))
     pos[0], pos[1] = xs, ys
 
@@ -101,6 +102,7 @@ def build_pyelastica(chi: float, N: int, c: float, B: float):
                                        directors=d0)
     rod.position_collection[:] = pos
     rod.director_collection[:] = directors(pos)
+    rod.velocity_collection[0], rod.velocity_collection[1] = vxs, vys
     sim.append(rod)
     sim.constrain(rod).using(ea_.FixedConstraint, constrained_position_idx=(-1,))
     sim.add_forcing_to(rod).using(ea_.GravityForces, acc_gravity=np.array([0.0, 1.0, 0.0]))
@@ -109,7 +111,7 @@ def build_pyelastica(chi: float, N: int, c: float, B: float):
 
 
 def run_pyelastica(chi: float, N: int, c: float, dt: float, B: float | None = None, t_end: float | None = None,
-                   stop_fraction: float = 0.5) -> E.Result:
+                   stop_fraction: float = 0.5, start: str = "stretched") -> E.Result:
     """PositionVerlet at the fixed step ``dt`` to ``t_end`` (the reference's end), or without
     it until the speed has fallen below ``stop_fraction`` of its running peak (after t = 0.8);
     B defaults to :func:`bending_for`."""
@@ -117,7 +119,7 @@ def run_pyelastica(chi: float, N: int, c: float, dt: float, B: float | None = No
 
     B = bending_for(dt, c * c) if B is None else B
     w = time.process_time()
-    sim, rod = build_pyelastica(chi, N, c, B)
+    sim, rod = build_pyelastica(chi, N, c, B, start)
     stepper = ea_.PositionVerlet()
     n_max = int(math.ceil((3.0 if t_end is None else t_end) / dt - 1e-9))
     v = np.empty(n_max)
@@ -142,39 +144,40 @@ def run_pyelastica(chi: float, N: int, c: float, dt: float, B: float | None = No
     vp, tp = E.vertex(tt, v[:n])
     sp, ts = E.vertex(tt - 0.5 * dt, T[:n])
     return E.Result("PyElastica", N, c, f"dt={dt:.3g} B={B:.2g}", n, w, vp, tp, sp, ts,
-                    f"largest compression {-fmin:.3g} (this project's links go slack instead)", t)
+                    f"largest compression {-fmin:.3g} (this project's links go slack instead)", t, start=start)
 
 
 def axial_dt(N: int, c: float) -> float:
     return AXIAL_SAFETY / (N * c)
 
 
-def compare(chi, N, c, dts, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True):
-    ref = E.reference(chi, N, c) if with_ref else None
+def compare(chi, N, c, dts, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True,
+            start="stretched"):
+    ref = E.reference(chi, N, c, start=start) if with_ref else None
     if ref:
         E.header(ref, chi)
     else:
         print(f"chi = {chi:g}, N = {N}, c/sqrt(gL) = {c:g}: no reference (--no-reference); PyElastica runs to its snap")
-    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget) if ref else []
+    rows = E.project_rows(chi, N, c, ref, method=method, tols=tols, budget=project_budget, start=start) if ref else []
     spent = 0.0
     for dt in dts:
         if spent > budget:
             print(f"  (PyElastica dt={dt:.3g} skipped: the budget of {budget:g} s is spent)")
             continue
         try:
-            r = run_pyelastica(chi, N, c, dt, t_end=ref.t_end if ref else None)
+            r = run_pyelastica(chi, N, c, dt, t_end=ref.t_end if ref else None, start=start)
         except FloatingPointError as e:
             print(f"  ({e})")
             continue
         spent += r.cpu
         rows.append(E.score(r, ref) if ref else r)
-        if r.err <= min(E.LEVELS):
+        if E.error(r) <= min(E.LEVELS):
             break
     E.table(rows)
     for r in rows:
         if r.code == "PyElastica":
             print(f"  PyElastica {r.setting}: {r.extra}")
-    E.matched(rows, "PyElastica")
+    E.matched(rows, "PyElastica", ref=ref)
     print(flush=True)
     return rows
 
@@ -189,7 +192,15 @@ def main(argv=None) -> int:
                     help="PyElastica's steps, comma-separated (default: the axial limit 0.8 h/c, then halved "
                          "--halvings times); B follows each step")
     ap.add_argument("--halvings", type=int, default=3, help="default steps: the axial limit halved this many times")
-    ap.add_argument("--method", default="radau", help="this project's method (any name of elastic.METHODS)")
+    ap.add_argument("--method", default="dop853,rodas4",
+                    help="this project's methods, comma-separated (names of elastic.METHODS; default dop853,rodas4)")
+    ap.add_argument("--start", default="stretched", choices=E.STARTS,
+                    help="the start every code is given (default stretched; matched: no release wave)")
+    ap.add_argument("--peak", default="v", choices=("v", "sigma", "both"),
+                    help="which peak decides 'within eps': the speed, the tension or both (default v)")
+    ap.add_argument("--levels", default=",".join(f"{x:g}" for x in E.LEVELS),
+                    help="the accuracy levels eps, comma-separated (default 1e-3,1e-4)")
+    ap.add_argument("--ref-method", default=E.REF_METHOD, help=f"the reference's method (default {E.REF_METHOD})")
     ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
                     help="this project's tolerances, loosest first (stops once the finest level is reached)")
     ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for PyElastica per point (default 300)")
@@ -200,19 +211,22 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="N = 20, c = 10, two steps (h/(20 c), h/(40 c)): seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
-    E.REF_TOL = a.ref_tol
+    E.REF_TOL, E.REF_METHOD, E.CRITERION = a.ref_tol, a.ref_method.lower(), a.peak
+    E.LEVELS = tuple(sorted((float(x) for x in a.levels.split(",") if x), reverse=True))
     Ns = [int(x) for x in a.N.split(",") if x]
     cs = [float(x) for x in a.c.split(",") if x]
     tols = [float(x) for x in a.tols.split(",") if x]
     quick_dts = []
     if a.quick:  # c = 10: a rod soft enough in bending (B ~ 1e-4) at steps of 1e-4
-        Ns, cs, tols = [20], [10.0], [1e-4, 1e-6]
+        Ns, cs, tols, a.method = [20], [10.0], [1e-4, 1e-6], "dop853"
+        E.LEVELS = (1e-2, 1e-3)
         quick_dts = [axial_dt(20, 10.0) / 16, axial_dt(20, 10.0) / 32]
     from snapping.simulate.elastic import METHODS
 
-    if a.method.lower() not in METHODS:
-        print(f"--method {a.method!r} is not one of {tuple(METHODS)}", file=sys.stderr)
-        return 2
+    for m in a.method.lower().split(",") + [E.REF_METHOD]:
+        if m not in METHODS:
+            print(f"--method {m!r} is not one of {tuple(METHODS)}", file=sys.stderr)
+            return 2
     try:
         import elastica  # noqa: F401
     except ImportError:
@@ -224,7 +238,7 @@ def main(argv=None) -> int:
         for c in cs:
             dts = quick_dts or [float(x) for x in a.dt.split(",") if x] or \
                 [axial_dt(N, c) / 2 ** k for k in range(a.halvings + 1)]
-            compare(a.chi, N, c, dts, a.method.lower(), a.budget, tols, with_ref=not a.no_reference)
+            compare(a.chi, N, c, dts, a.method.lower(), a.budget, tols, with_ref=not a.no_reference, start=a.start)
     print(f"uptime: {os.popen('uptime').read().strip()}")
     return 0
 

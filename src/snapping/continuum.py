@@ -210,7 +210,7 @@ def _run_level(args):
     if elastic and elastic[0] is not None:  # the extensible line (snapping.sweep_elastic)
         from .sweep_elastic import level_row
 
-        return level_row(chi, h, lumping, free_end, tol, path, elastic[0]), path
+        return level_row(chi, h, lumping, free_end, tol, path, elastic[0], *elastic[1:]), path
     problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact",
                                body=None if body is None else Body.from_describe(body))
     if path is not None and os.path.isfile(path):
@@ -241,7 +241,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
              free_end: str | None = None, tol: float = 1e-7, output=None, workers: int = 1,
              progress: bool | None = False, frac0: float = FRAC0, h_min0: float = H_MIN0,
              h_max0: float = H_MAX0, overwrite: bool = False, body=None, n0: int = 50,
-             elastic=None) -> Convergence:
+             elastic=None, elastic_start: str | None = None) -> Convergence:
     """Refine graded chains from the catenary of separation ``chi`` and extrapolate the snap's
     peaks to the continuum (the string).
 
@@ -297,6 +297,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         levels are uniform chains of ``n0 / ratio**k`` links as with a body, each run through
         :func:`snapping.simulate.elastic.solve` (:mod:`snapping.sweep_elastic`); ``kappa_peak``
         is not measured (NaN).
+    elastic_start : {"stretched", "matched", "unstretched"}, optional
+        The extensible line's start (:func:`snapping.simulate.elastic.solve`'s ``start``;
+        default ``"stretched"``), recorded in the Dataset's ``elastic_start`` attribute.
 
     Returns
     -------
@@ -329,6 +332,13 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         from .sweep_elastic import description
 
         elastic_d = description(elastic, "elastic")
+        from .simulate.elastic import STARTS
+
+        elastic_start = "stretched" if elastic_start is None else elastic_start
+        if not isinstance(elastic_start, str) or elastic_start not in STARTS:
+            raise V.SnappingInputError(f"elastic_start={elastic_start!r} is not one of {STARTS}")
+    elif elastic_start is not None:
+        raise V.SnappingInputError(f"elastic_start={elastic_start!r} is the extensible line's start: give elastic too")
         if body_d is not None:
             raise V.SnappingInputError("body: bending and drag are not built for the extensible line (elastic) yet")
     if body_d is not None or elastic_d is not None:
@@ -357,7 +367,8 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             out = stack.enter_context(output_dir(output, name="output"))
             paths = [os.path.join(out, f"level{first + k}.nc") for k in range(len(params))]
             check_own_files(paths + [os.path.join(out, "convergence.nc")], name="output", overwrite=overwrite)
-        jobs = [(chi, p, lumping, free_end, tol, path, body_d, elastic_d) for p, path in zip(params, paths)]
+        jobs = [(chi, p, lumping, free_end, tol, path, body_d, elastic_d, elastic_start)
+                for p, path in zip(params, paths)]
         t0 = time.perf_counter()
         rows = [None] * len(jobs)
         if workers == 1 or len(jobs) == 1:
@@ -381,6 +392,8 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         if body_d is not None or elastic_d is not None:
             ds.attrs["grading"] = "uniform"
             ds.attrs["body" if elastic_d is None else "elastic"] = json.dumps(body_d or elastic_d, sort_keys=True)
+            if elastic_d is not None:
+                ds.attrs["elastic_start"] = elastic_start
         if output is not None:
             from .simulate import save
 

@@ -106,10 +106,11 @@ def file_bytes(params: dict) -> int:
     return int(8 * (3000 * 19 + n_snap * 12 * (int(params["N"]) + 1)) + 100_000)
 
 
-def level_row(chi, h, lumping, free_end, tol, path, elastic_d) -> dict:
+def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "stretched") -> dict:
     """One level of :func:`snapping.continuum.converge` for the extensible line: the line of links
     ``h`` from the catenary of ``chi`` to the snap, its peaks and cost (``kappa_peak`` and
-    ``link_drift`` NaN: not measured). A completed run of the same level at ``path`` is reused."""
+    ``link_drift`` NaN: not measured), from the elastic ``start``. A completed run of the same
+    level and start at ``path`` is reused."""
     import json
     import os
     import time
@@ -125,6 +126,7 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d) -> dict:
             old = load_run(path)
             if (old.attrs.get("status") == "completed" and old.attrs.get("model") == "elastic"
                     and np.array_equal(old.link_length.values, h) and float(old.attrs["tol"]) == tol
+                    and old.attrs.get("start", "stretched") == start
                     and np.array_equal(old.node_mass.values[:-1], problem.links.m)
                     and json.loads(old.attrs["elastic"]) == json.loads(json.dumps(elastic_d, sort_keys=True))):
                 ds = old  # resumed: this level is done (its CPU time unknown)
@@ -132,7 +134,7 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d) -> dict:
             pass
     if ds is None:
         cpu0 = time.process_time()
-        ds = solve(problem, elastic, tol=tol).dataset
+        ds = solve(problem, elastic, tol=tol, start=start).dataset
         cpu = time.process_time() - cpu0
         if path is not None:
             from .sweep_files import atomic_to_netcdf

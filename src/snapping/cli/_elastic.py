@@ -16,7 +16,9 @@ NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
                "dt0": "--dt0 sets the rigid-link methods' first step",
                "max_link_error": "--max-link-error checks rigid links", "chords": "--chords",
                "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections",
-               "start": "--start (the bending line's start; the extensible line starts at its stretched equilibrium)"}
+               "start": "--start (the bending line's start; the extensible line's is --elastic-start)"}
+#: the extensible line's starts (--elastic-start; snapping.simulate.elastic_model.STARTS)
+ELASTIC_STARTS = ("stretched", "matched", "unstretched")
 
 
 #: the elastic solver's method for each --method (fast: Radau, the elastic line's default)
@@ -27,7 +29,7 @@ def add_elastic_options(p) -> None:
     g = p.add_argument_group(
         "the extensible line (tension-only links: snapping.simulate.elastic; any of these runs it, with scipy's "
         "Radau on the banded Jacobian, or --method rodas4 (compiled) or dop853; released from its stretched "
-        "equilibrium)",
+        "equilibrium, or --elastic-start matched)",
         "SI with --length METERS --mass KG [--g]; or nondimensional: EA in M g, c = sqrt(EA/lambda) in sqrt(g L)")
     g.add_argument("--ea", type=float, default=None, metavar="N", help="axial stiffness EA in N (SI)")
     g.add_argument("--stretching", type=float, default=None, metavar="C",
@@ -39,6 +41,11 @@ def add_elastic_options(p) -> None:
     g.add_argument("--grid-damping", dest="grid_damping", type=float, default=None, metavar="ZETA",
                    help="damping ratio of the shortest longitudinal mode (added Kelvin-Voigt damping; ~1 damps "
                         "the release's grid-scale ringing, the long waves by about ZETA pi/(4N))")
+    g.add_argument("--elastic-start", dest="elastic_start", default=None, choices=ELASTIC_STARTS,
+                   help="the extensible line's start: stretched (default: the static equilibrium with both ends "
+                        "held, then one let go: its unloading wave rings along the line), matched (the start's "
+                        "shape stretched to the rigid chain's tensions after release: no release wave, the rigid "
+                        "chain's release as EA -> infinity) or unstretched (every link at its rest length)")
     g.add_argument("--strain-table", default=None, metavar="CSV",
                    help="tension-strain curve: rows strain,tension (tension in N with --length/--mass, else in "
                         "M g), strains increasing from 0; replaces --ea")
@@ -104,6 +111,9 @@ def elastic_from_args(args, scales):
 
     given = _given(args)
     if not given:
+        if getattr(args, "elastic_start", None) is not None:
+            raise SnappingInputError(f"--elastic-start {args.elastic_start} is the extensible line's start: give it "
+                                     f"with --ea, --stretching or --strain-table")
         return None
     if getattr(args, "method", None) in ("euler-richardson", "euler-richardson-fixed"):
         opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
@@ -159,6 +169,11 @@ def elastic_from_args(args, scales):
         raise SnappingInputError(f"--strain-table={args.strain_table!r}: {exc}") from None
 
 
+def elastic_start(args) -> str:
+    """The extensible line's start of the options (--elastic-start; default "stretched")."""
+    return getattr(args, "elastic_start", None) or "stretched"
+
+
 def run_elastic(args, problem, elastic, times):
     """Solve, write -o, and return (summary, dataset)."""
     from .. import _files
@@ -169,7 +184,7 @@ def run_elastic(args, problem, elastic, times):
         out = _files.check_output(args.output, overwrite=args.overwrite)
     r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
               method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
-              snapshot_times=times)
+              snapshot_times=times, start=elastic_start(args))
     if out is not None:
         ds = r.dataset
         _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)

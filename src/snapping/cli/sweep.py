@@ -82,6 +82,8 @@ def _cmd_sweep(args) -> int:
         options["body"] = body
     if elastic is not None:
         options["elastic"] = elastic
+        if args.elastic_start is not None:
+            options["start"] = args.elastic_start
     grid = sweep.Grid(chi=args.chi, N=args.N, options=options)
     target = sweep.check_combined(Path(args.output) / "sweep.nc", grid, overwrite=args.overwrite)
     failed = None
@@ -259,6 +261,8 @@ def _cmd_converge(args) -> int:
     extra = {} if body is None or not body.active else {"body": body, "n0": args.n0}
     if elastic is not None:
         extra = {"elastic": elastic, "n0": args.n0}
+        if args.elastic_start is not None:
+            extra["elastic_start"] = args.elastic_start
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
                              free_end=args.free_end, tol=args.tol, output=args.output, workers=args.workers,
                              progress=None if not args.json else False, overwrite=args.overwrite, **extra)

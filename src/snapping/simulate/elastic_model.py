@@ -23,7 +23,13 @@ start's two end nodes (both held), the minimum of its potential energy (convex f
 tension-only links; :mod:`~snapping.simulate.elastic_statics`: a few O(N) Newton steps
 from the start taken as a rigid chain, at any N and stiffness); or
 ``"unstretched"``, the nodes exactly at the problem's start (every link at its rest length:
-no tension at t = 0, so the whole line first falls freely).
+no tension at t = 0, so the whole line first falls freely); or ``"matched"``, the problem's
+start shape and velocities with each link stretched to the tension the rigid chain carries the
+instant after release (:func:`~snapping.simulate.elastic_statics.matched`: every taut link's
+length has zero second derivative at t = 0, so no release wave is launched; as EA -> infinity
+it is the inextensible chain's release). ``"stretched"`` is a physical sudden release (a line
+hanging between two holds, one let go: its unloading wave rings along the line); ``"matched"``
+is the start to compare with the rigid chain.
 
 Example
 -------
@@ -46,7 +52,7 @@ from . import elastic_kernels as EK
 
 __all__ = ["Elastic", "ElasticLine", "STARTS"]
 
-STARTS = ("stretched", "unstretched")
+STARTS = ("stretched", "unstretched", "matched")
 #: largest axial stiffness accepted (units of M g): c = 1e8 sqrt(g L) and more is beyond the doubles' use
 EA_MAX = 1e16
 
@@ -264,11 +270,16 @@ class ElasticLine:
         return tuple(np.concatenate([z[k:4 * N:4], [p[k]]]) for k in range(4))
 
     def start(self, kind: str = "stretched") -> np.ndarray:
-        """The state at t = 0: ``"unstretched"`` (the problem's nodes and velocities) or
+        """The state at t = 0: ``"unstretched"`` (the problem's nodes and velocities),
         ``"stretched"`` (the static equilibrium between the start's end nodes, at rest; only
-        for a start at rest)."""
-        if kind not in STARTS:
+        for a start at rest) or ``"matched"`` (the start's shape and velocities stretched to
+        the rigid chain's tensions after release: :func:`snapping.simulate.elastic_statics.matched`)."""
+        if not isinstance(kind, str) or kind not in STARTS:
             raise V.SnappingInputError(f"start={kind!r} is not one of {STARTS}")
+        if kind == "matched":
+            from .elastic_statics import matched
+
+            return matched(self)[0]
         p = self.problem
         z = self.pack(p.x, p.y, p.vx, p.vy)
         if kind == "stretched":

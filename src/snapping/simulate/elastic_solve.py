@@ -179,8 +179,12 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         scipy's Radau IIA (with the analytic banded Jacobian), explicit DOP853, or the compiled
         RODAS4 of :mod:`snapping.simulate.elastic_rodas` (exact banded Jacobian, O(N) a step;
         its tolerance is a max norm, Radau's and DOP853's an rms norm).
-    start : {"stretched", "unstretched"}
-        See :mod:`snapping.simulate.elastic`; ignored when ``initial`` is given.
+    start : {"stretched", "unstretched", "matched"}
+        See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
+        both ends held, then released (its unloading wave rings); ``"matched"`` the start's
+        shape stretched to the rigid chain's tensions after release (no release wave: the
+        rigid chain's release as EA -> infinity); ``"unstretched"`` every link at its rest
+        length. Recorded in the Dataset's ``start`` attribute; ignored when ``initial`` is given.
     initial : (x, y, vx, vy), optional
         Node values at t = 0 (N + 1 each, the last the held end's), any strains.
     snapshot_times : sequence of float
@@ -205,7 +209,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     stop_fraction = V.real("stop_fraction", stop_fraction)
     if not 0.0 < stop_fraction < 1.0:
         raise V.SnappingInputError(f"stop_fraction={stop_fraction!r} is out of range: must lie in (0, 1)")
-    if start not in STARTS:
+    if not isinstance(start, str) or start not in STARTS:
         raise V.SnappingInputError(f"start={start!r} is not one of {STARTS}")
     snaps = sorted(float(V.real("snapshot_times", s)) for s in np.atleast_1d(np.asarray(snapshot_times, float)))
     max_rhs = V.integer("max_rhs", max_rhs, 1)

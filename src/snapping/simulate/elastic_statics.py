@@ -1,5 +1,6 @@
 """The static equilibrium of the extensible line (:class:`~snapping.simulate.elastic_model.ElasticLine`):
-the ``"stretched"`` start, and the hanging line's stretch.
+the ``"stretched"`` start, and the hanging line's stretch; and the ``"matched"`` start
+(:func:`matched`: the rigid chain's tensions the instant after release).
 
 The equilibrium minimises the potential energy (elastic + gravity), convex for tension-only
 links. Newton on the stiffness alone stalls on a long, stiff line started from its
@@ -18,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg  # noqa: F401  (so that sp.linalg is there)
 
-__all__ = ["statics", "mixed", "rigid_tensions", "strain_of"]
+__all__ = ["statics", "mixed", "rigid_tensions", "strain_of", "matched"]
 
 
 def _solve(A, b) -> np.ndarray:
@@ -260,3 +261,85 @@ def statics(line, z0: np.ndarray, *, hold_free_end: bool = False, tol: float = 1
 
     raise SimulationError(f"statics: no equilibrium within {max_iter} Newton steps (largest force "
                           f"{np.abs(grad_hess(z)[0]).max():.3g})")
+
+
+def matched(line, *, tol: float = 1e-15, max_iter: int = 50):
+    """The ``"matched"`` start: the line at the problem's start shape and velocities, each
+    link stretched to the tension the rigid chain carries the instant after release, so that
+    no release wave is launched (as EA -> infinity it is the inextensible chain's release).
+
+    A taut link's length obeys ``l_j'' = (a_{j+1} - a_j).u_j + |w_j|^2/l_j`` with ``w_j``
+    the part of the nodes' relative velocity across the link (``l_j' = 0`` where the start's
+    velocities are a rigid chain's). Asking ``l_j'' = 0`` of every link with the elastic
+    accelerations ``a_i = F_i/m_i`` is the rigid chain's tension system
+    (:func:`snapping.simulate.general.general_rhs`, its held end's acceleration included) on
+    the stretched lengths ``l_j = h_j (1 + e_j)``, with ``T_j = f_j(e_j)``: solved for T_j on
+    the start's link directions and angular velocities, ``e_j = f_j^{-1}(T_j)``
+    (:func:`strain_of`), repeated until the lengths stop changing. A link the rigid chain
+    would compress (T_j <= 0, a coarse chain's free arm) is left at its rest length, slack,
+    with every link beyond it: the piece it frees falls as a whole (at rest: no tension in
+    it, every link's l'' = 0), and the rest is solved again as a chain whose free end is the
+    node inside the slack link nearest the held end (:func:`_rigid_release_tensions`). At rest the tension system
+    does not involve the lengths (only ``h_j theta_j'^2`` does), so it ends after one
+    solve; with angular velocities each pass shrinks the change by O(T/EA).
+    Node positions are laid from the held end along the start's directions, velocities
+    ``v_j = v_{j+1} - l_j theta_j' n_j``. Returns (state vector, tensions, passes);
+    ``line.matched_iterations`` records the passes."""
+    from . import general as G
+    from .errors import SimulationError
+
+    N = line.N
+    p = line.problem
+    th = np.unwrap(np.arctan2(np.diff(p.y), np.diff(p.x)))
+    c, s = np.cos(th), np.sin(th)
+    om = (-s * np.diff(p.vx) + c * np.diff(p.vy)) / line.h
+    invm = 1.0 / line.m
+    pin_args = line.pin.model_args()
+    t0 = 0.0
+    if 0.0 in G.breakpoints(G.make_model(line.h, invm, g=line.g, **pin_args)):
+        t0 = float(np.nextafter(0.0, 1.0))  # (the held end's acceleration from t = 0 on: the right limit)
+    lengths = line.h.copy()
+    for it in range(1, max_iter + 1):
+        T = _rigid_release_tensions(N, t0, th, om, lengths, invm, line.g, pin_args)
+        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), 0.0)
+        new = line.h * (1.0 + e)
+        change = float(np.abs(new - lengths).max())
+        lengths = new
+        if change <= tol * float(line.h.max()):
+            break
+    else:
+        raise SimulationError(f"matched start: the link lengths still change by {change:.3g} after {max_iter} passes")
+    if not np.all(np.isfinite(lengths)):
+        raise SimulationError("matched start: the rigid chain's tension system has no finite solution")
+    px, py, pvx, pvy = line.pin_state(0.0)
+    # node j = node j+1 - l_j t_j, from the held end
+    x = px - np.concatenate([np.cumsum((lengths * c)[::-1])[::-1], [0.0]])
+    yy = py - np.concatenate([np.cumsum((lengths * s)[::-1])[::-1], [0.0]])
+    vx = pvx - np.concatenate([np.cumsum((-lengths * om * s)[::-1])[::-1], [0.0]])
+    vy = pvy - np.concatenate([np.cumsum((lengths * om * c)[::-1])[::-1], [0.0]])
+    line.matched_iterations = it
+    return line.pack(x, yy, vx, vy), np.where(T > 0.0, T, 0.0), it
+
+
+def _rigid_release_tensions(N, t, th, om, lengths, invm, g, pin_args) -> np.ndarray:
+    """The rigid chain's tensions (:func:`snapping.simulate.general.general_rhs`) on links of
+    directions ``th``, angular velocities ``om`` and ``lengths``, with the tension-only links'
+    active set: while some tension is <= 0, the links from the free end to the last such one
+    are dropped (zero tension: the piece they join falls freely) and the rest is solved again
+    as a chain whose free end is the first node kept."""
+    from . import general as G
+
+    T = np.zeros(N)
+    lo = 0
+    while lo < N:
+        n = N - lo
+        w = G.Work(n)
+        y = np.concatenate([th[lo:], om[lo:], [0.0]])
+        G.general_rhs(n, t, y, np.zeros_like(y), w.c, w.s, w.S, w.cp, w.dp, w.sig,
+                      *G.make_model(lengths[lo:], invm[lo:], g=g, **pin_args))
+        bad = np.flatnonzero(w.sig <= 0.0)
+        if bad.size == 0:
+            T[lo:] = w.sig
+            break
+        lo += int(bad[-1]) + 1
+    return T
