@@ -39,9 +39,13 @@ STUDIES = {
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
                 "levels": 3},
-    # stretching: not shipped; the elastic line (scipy Radau) took > 70 s of CPU for one run of 284 links at
-    # chi = 0.3, c = 30 (not finished): a 4 x 8 scan is beyond this machine
-    "stretching": {"chis": [0.3], "numbers": [1 / 300, 1 / 100, 1 / 30, 1 / 10], "accuracy": "coarse", "levels": 2},
+    # stretching (number sqrt(gL)/c): the elastic line by RODAS4 with the grid damping zeta = 1 and the stop
+    # floor of regimes_spec (before: scipy Radau, undamped, the stop rule never armed on fold-graded links: one
+    # run of 284 links at chi = 0.3, c = 30 did not finish in 70 s; now 9.4 s, 196620 evaluations). Numbers:
+    # c = 1000 down to 3.3, bracketing c ~ 3 v_ideal at every chi; three fold levels one coarser than the
+    # others' (first -3: 108-284 links at chi = 0.3, 267-... at 0.1), chi = 0.1 costing most
+    "stretching": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8), "accuracy": "coarse",
+                   "first": -3, "levels": 3, "tol": 1e-6},
 }
 
 

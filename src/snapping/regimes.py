@@ -53,7 +53,7 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
-from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX
+from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_METHOD, STRETCH_STOP_FLOOR
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
@@ -124,7 +124,8 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING):
     if mechanism == "stretching" and number > 0:
         from .simulate.elastic import Elastic, solve
 
-        ds = solve(problem, Elastic.from_wave_speed(1.0 / number), tol=tol).dataset
+        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping), tol=tol,
+                   method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
         ds = run(problem, method=method, tol=tol, progress=False).dataset
@@ -323,8 +324,10 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     damping = V.real("damping", damping)
     if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
-    if mechanism == "bending":
+    if mechanism in ("bending", "stretching"):
         acc["damping"] = damping
+    if mechanism == "stretching":
+        acc.update(elastic_method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR)
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
