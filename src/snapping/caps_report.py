@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 __all__ = ["catalogue", "catalogue_table", "studies", "report_section", "section", "LIVE", "CATALOGUE_N",
-           "RESOLVED"]
+           "RESOLVED", "stretching_speeds"]
 
 #: the catalogue's links per mode (the ball chain always on its 229)
 CATALOGUE_N = {"quick": 100, "full": 400}
@@ -134,9 +134,29 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
         lines += report(ds) + ["```", "",
                                f"**Verdict (computed, v_peak): {'; '.join(crossed)}; {a['crossover_law']['statement']}.**",
                                ""]
+        if ds.attrs["mechanism"] == "stretching":
+            lines += [f"**Verdict (computed, stretching against the issue's guess, c ~ v): "
+                      f"{'; '.join(stretching_speeds(a))}.**", ""]
         if k < len(figure_names):
             lines += [f"![{figure_names[k]}](figures/{figure_names[k]}.png)", ""]
     return lines
+
+
+def stretching_speeds(analysis: dict) -> list[str]:
+    """Per chi of a stretching study's v_peak analysis (:func:`snapping.regimes_analysis.analyze`):
+    the crossover wave speed c_c = 1/number_c (units sqrt(g L); interval from the number's) against
+    the ideal's peak speed, c_c / v_ideal -- the issue's guess was that stretching matters once the
+    speed approaches c (c_c / v_ideal ~ 1)."""
+    out = []
+    for chi, r in analysis["chi"].items():
+        x, v = r["crossover"], r["ideal"]
+        if not x["bracketed"]:
+            out.append(f"chi={chi:g}: no c_c ({x['statement']})")
+            continue
+        cc = 1.0 / x["number"]
+        span = (f" ({1.0 / x['hi']:.3g}..{1.0 / x['lo']:.3g})" if x["hi"] > 0 and x["lo"] > 0 else "")
+        out.append(f"chi={chi:g}: c_c = {cc:.3g}{span}, v_ideal = {v:.4g}, c_c/v_ideal = {cc / v:.3g}")
+    return out
 
 
 def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
