@@ -47,7 +47,7 @@ STUDIES = {
     # c = 1000 down to 3.3, bracketing c ~ 3 v_ideal at every chi; three fold levels one coarser than the
     # others' (first -3: 108-284 links at chi = 0.3, 267-... at 0.1), chi = 0.1 costing most
     "stretching": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8), "accuracy": "coarse",
-                   "first": -3, "levels": 3, "tol": 1e-6},
+                   "first": -4, "levels": 3, "tol": 1e-6},
 }
 
 
@@ -70,26 +70,32 @@ def study(mech: str, workers: int, chis=None, out=None) -> None:
 
 
 def merge(mech: str, parts) -> None:
-    """Copy the runs of part studies (same settings, some of the chi) into the shipped study file
-    of ``mech`` (which must exist, e.g. partial: it fixes the grid), then recompute its limits."""
+    """Put part studies (the same settings, each some of the chi) together as the shipped study
+    file of ``mech``: the runs of each part, the study key of all their chi (so that ``--study``
+    resumes the merged file as one study), the limits recomputed."""
+    import json
+
+    import xarray as xr
+
     from snapping.regimes import _finish, load_study
     from snapping.sweep_files import atomic_to_netcdf
 
+    ds = [load_study(p) for p in parts]
+    keys = [json.loads(d.attrs["regimes_study"]) for d in ds]
+    for k in keys[1:]:
+        if {a: b for a, b in k.items() if a != "chi"} != {a: b for a, b in keys[0].items() if a != "chi"}:
+            raise SystemExit("the parts are not parts of one study (their settings differ)")
+    runs = [v for v in ds[0].data_vars if v.endswith("_level")]
+    whole = xr.concat([d[runs] for d in ds], dim="chi", data_vars="minimal", coords="minimal",
+                      compat="override").sortby("chi")
+    whole["resolution"], whole["resolution_ideal"] = ds[0]["resolution"], ds[0]["resolution_ideal"]
+    whole.attrs = dict(ds[0].attrs)
+    whole.attrs["regimes_study"] = json.dumps({**keys[0], "chi": sorted(float(c) for c in whole.chi.values)},
+                                              sort_keys=True)
     out = os.path.join(DATA, f"{mech}.nc")
-    ds = load_study(out)
-    for path in parts:
-        part = load_study(path)
-        for name in [v for v in part.data_vars if v.endswith("_level")]:
-            for chi in part.chi.values:
-                i = int(np.flatnonzero(np.isclose(ds.chi.values, chi))[0])
-                src = part[name].sel(chi=chi).values
-                if "number" in part[name].dims:
-                    assert np.allclose(part.number.values, ds.number.values)
-                dst = ds[name].values
-                keep = np.isfinite(src)
-                dst[i][keep] = src[keep]
-    atomic_to_netcdf(_finish(ds), out)
-    print(f"{mech}: merged {len(parts)} part(s) into {out}; status {ds.attrs['status']}")
+    whole = _finish(whole)
+    atomic_to_netcdf(whole, out)
+    print(f"{mech}: merged {len(parts)} part(s) into {out}; status {whole.attrs['status']}")
 
 
 def cost(mech: str, path=None) -> dict:
