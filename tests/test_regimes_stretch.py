@@ -8,7 +8,7 @@ rule's floor, and the shipped study ``data/regimes/stretching.nc``.
   never arms: the run goes on to ``t_end_max``); bad values refused;
 * the shipped study: its ideal limits agree with the end-mass study's (other levels, other
   runs: an independent computation) within the two error bars, and the smallest number
-  (c = 1000 sqrt(gL)) reproduces the ideal limit within the error bars, at every chi whose
+  (c = 442 sqrt(gL)) reproduces the ideal limit within the error bars, at every chi whose
   cells are resolved.
 """
 
@@ -97,13 +97,13 @@ def test_shipped_study_is_the_stretching_scan(shipped):
     ds = shipped
     assert ds.attrs["mechanism"] == "stretching" and ds.attrs["number_name"] == "inverse_stretching"
     assert ds.attrs["elastic_method"] == "rodas4" and ds.attrs["damping"] == 1.0
-    assert list(ds.chi.values) == [0.1, 0.2, 0.3, 0.5] and ds.sizes["number"] == 8
-    assert ds.number.values[0] == pytest.approx(1e-3) and ds.number.values[-1] == pytest.approx(0.3)
+    assert list(ds.chi.values) == [0.2, 0.3, 0.5] and ds.sizes["number"] == 7
+    assert ds.number.values[0] == pytest.approx(2.26e-3) and ds.number.values[-1] == pytest.approx(0.3)
 
 
 def test_shipped_ideal_limits_agree_with_the_end_mass_study(shipped):
-    """Two computations of the ideal's limit: this study's fold levels (first -3) and the end-mass
-    study's (first -1, 4x the links): they agree within the two error bars where both resolve."""
+    """Two computations of the ideal's limit: this study's fold levels (first -4) and the end-mass
+    study's (first -1, 8x the links): they agree within the two error bars where both resolve."""
     other = R.bundled_study("end-mass")
     n = 0
     for chi in shipped.chi.values:
@@ -116,7 +116,7 @@ def test_shipped_ideal_limits_agree_with_the_end_mass_study(shipped):
 
 
 def test_smallest_number_is_the_ideal_limit(shipped):
-    """c = 1000 sqrt(gL): the elastic line's limit is the ideal's within the error bars."""
+    """c = 442 sqrt(gL): the elastic line's limit is the ideal's within the error bars."""
     n0 = float(shipped.number.values[0])
     n = 0
     for chi in shipped.chi.values:
