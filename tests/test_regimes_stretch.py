@@ -78,19 +78,14 @@ def test_stop_floor_arms_the_stop_rule():
 
 
 # ------------------------------------------------------------------ the shipped study
+#: the smallest number's ratio to the ideal (same links, extrapolated) is 1 within its error bar or this
+RATIO_TOL = 0.005
 @pytest.fixture(scope="module")
 def shipped():
     try:
         return R.bundled_study("stretching")
     except SnappingInputError as exc:
         pytest.skip(str(exc))
-
-
-def _resolved(ds, q, sel):
-    from snapping.regimes_analysis import resolved
-
-    c = ds.sel(**sel)
-    return bool(resolved(float(c[q]), float(c[q + "_error"]), float(c[q + "_order"])))
 
 
 def test_shipped_study_is_the_stretching_scan(shipped):
@@ -109,42 +104,68 @@ def test_shipped_ideal_limits_agree_with_the_end_mass_study(shipped):
     for chi in shipped.chi.values:
         a, ea = float(shipped.v_peak_ideal.sel(chi=chi)), float(shipped.v_peak_ideal_error.sel(chi=chi))
         b, eb = float(other.v_peak_ideal.sel(chi=chi)), float(other.v_peak_ideal_error.sel(chi=chi))
-        if ea <= 0.05 * a:
-            assert abs(a - b) <= ea + eb, (chi, a, ea, b, eb)
-            n += 1
-    assert n >= 2
+        assert abs(a - b) <= ea + eb, (chi, a, ea, b, eb)
+        n += ea <= 0.05 * a
+    assert n >= 1  # (chi = 0.5: 4.459 +- 0.11 against 4.534 +- 0.002; the others' bars are 30-40%)
 
 
 def test_smallest_number_is_the_ideal_limit(shipped):
-    """c = 442 sqrt(gL): the elastic line's limit is the ideal's within the error bars."""
-    n0 = float(shipped.number.values[0])
-    n = 0
+    """The stiffest line computed at each chi (c = 442 or, where its finest run is not in the file,
+    196 sqrt(gL)): its limit is the ideal's within the two error bars; at chi = 0.5, where the ideal's
+    limit is resolved, with bars under 5% and the same-links ratio within RATIO_TOL of 1."""
+    from snapping.regimes_analysis import level_ratios
+
+    lr = level_ratios(shipped)
     for chi in shipped.chi.values:
-        if not _resolved(shipped, "v_peak", {"chi": chi, "number": n0}):
-            continue
-        c = shipped.sel(chi=chi, number=n0)
-        assert abs(float(c.v_peak) - float(c.v_peak_ideal)) <= float(c.v_peak_error) + float(c.v_peak_ideal_error), chi
-        n += 1
-    assert n >= 2
+        c = shipped.sel(chi=chi)
+        j = int(np.flatnonzero(np.isfinite(c.v_peak.values))[0])
+        assert shipped.number.values[j] <= 0.0052
+        v, e = float(c.v_peak[j]), float(c.v_peak_error[j])
+        assert abs(v - float(c.v_peak_ideal)) <= e + float(c.v_peak_ideal_error), chi
+        if chi == 0.5:
+            assert e < 0.05 * v
+            assert abs(lr["chi"][0.5]["ratio"][j] - 1.0) <= RATIO_TOL
 
 
 # ------------------------------------------------------------------ the report's verdict
 def test_stretching_speeds_by_hand():
     from snapping.caps_report import stretching_speeds
 
-    a = {"chi": {0.2: {"ideal": 15.0, "crossover": {"bracketed": True, "number": 0.02, "lo": 0.016, "hi": 0.025,
-                                                     "statement": ""}},
-                 0.5: {"ideal": 4.5, "crossover": {"bracketed": False, "number": float("nan"), "lo": float("nan"),
-                                                    "hi": float("nan"), "statement": "crossover above 0.3"}}}}
-    out = stretching_speeds(a)
-    assert out[0] == "chi=0.2: c_c = 50 (40..62.5), v_ideal = 15, c_c/v_ideal = 3.33"  # 1/0.02, 50/15
+    a = {"chi": {0.2: {"crossover": {"bracketed": True, "number": 0.02, "lo": 0.016, "hi": 0.025, "statement": ""}},
+                 0.5: {"crossover": {"bracketed": False, "number": float("nan"), "lo": float("nan"),
+                                     "hi": float("nan"), "statement": "crossover above 0.3"}}}}
+    out = stretching_speeds(a, {0.2: (15.0, "x")})
+    assert out[0] == "chi=0.2: c_c = 50 (40..62.5), v_ideal = 15 (x), c_c/v_ideal = 3.33"  # 1/0.02, 50/15
     assert out[1] == "chi=0.5: no c_c (crossover above 0.3)"
 
 
-def test_report_section_gives_the_stretching_verdict(shipped):
-    from snapping.caps_report import report_section, stretching_speeds
-    from snapping.regimes_analysis import analyze
+def test_level_ratios_extrapolate_the_same_links_ratio(shipped):
+    """The ratio on the same links, level by level, and its Richardson limit by hand (three levels
+    halving: order p = log2(d1/d2), limit r2 - d2/(2^p - 1))."""
+    from snapping.regimes_analysis import level_ratios
 
-    text = "\n".join(report_section([], [shipped]))
-    want = "; ".join(stretching_speeds(analyze(shipped, "v_peak")))
+    lr = level_ratios(shipped)
+    n = 0
+    for chi in shipped.chi.values:
+        c = shipped.sel(chi=chi)
+        for j in range(shipped.sizes["number"]):
+            r = c.v_peak_level.values[j] / c.v_peak_ideal_level.values
+            d1, d2 = r[1] - r[0], r[2] - r[1]
+            if not (np.all(np.isfinite(r)) and d1 * d2 > 0 and abs(d2) < abs(d1)):
+                continue
+            p = math.log2(d1 / d2)
+            assert lr["chi"][float(chi)]["order"][j] == pytest.approx(p, rel=1e-9)
+            assert lr["chi"][float(chi)]["ratio"][j] == pytest.approx(r[2] + d2 / (2**p - 1), rel=1e-9)
+            n += 1
+    assert n >= 5
+
+
+def test_report_section_gives_the_stretching_verdict(shipped):
+    from snapping.caps_report import ideal_speeds, report_section, stretching_speeds
+    from snapping.regimes_analysis import level_ratios
+
+    other = R.bundled_study("end-mass")
+    text = "\n".join(report_section([], [other, shipped]))
+    want = "; ".join(stretching_speeds(level_ratios(shipped), ideal_speeds([other, shipped])))
     assert f"**Verdict (computed, stretching against the issue's guess, c ~ v): {want}.**" in text
+    assert "(end-mass study" in want  # the resolved ideal speed, not this study's own
