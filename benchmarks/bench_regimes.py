@@ -193,6 +193,10 @@ def report(mechs, figdir=None) -> None:
                 print("\n".join(estimates(mech, ds, a)))
         if figdir:
             path = os.path.join(figdir, f"regimes_{mech}.png")
+            if mech == "stretching":  # its limits are not resolved apart: the same-links ratios, extrapolated
+                from snapping.regimes_analysis import with_level_ratios
+
+                ds = with_level_ratios(ds)
             plt.close(regime_map(ds, path))
             print(f"  map: {path}")
 

@@ -154,6 +154,9 @@ def test_level_ratios_extrapolate_the_same_links_ratio(shipped):
             if not (np.all(np.isfinite(r)) and d1 * d2 > 0 and abs(d2) < abs(d1)):
                 continue
             p = math.log2(d1 / d2)
+            if not 0.0 < r[2] + d2 / (2**p - 1) < 2.0:  # a failed extrapolation (order near 0): left out
+                assert math.isnan(lr["chi"][float(chi)]["ratio"][j])
+                continue
             assert lr["chi"][float(chi)]["order"][j] == pytest.approx(p, rel=1e-9)
             assert lr["chi"][float(chi)]["ratio"][j] == pytest.approx(r[2] + d2 / (2**p - 1), rel=1e-9)
             n += 1

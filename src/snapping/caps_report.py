@@ -195,7 +195,7 @@ def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
 
     from . import figures
     from ._files import write_atomic
-    from .regimes_analysis import regime_map
+    from .regimes_analysis import regime_map, with_level_ratios
 
     t0 = time.perf_counter()
     if live not in LIVE:
@@ -216,7 +216,8 @@ def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
     names = []
     for ds in found:
         name = f"fig7_regime_map_{ds.attrs['mechanism']}"
-        figures.save(regime_map(ds), Path(figdir) / name)
+        figures.save(regime_map(with_level_ratios(ds) if ds.attrs["mechanism"] == "stretching" else ds),
+                     Path(figdir) / name)
         names.append(name)
     log(f"what caps the snap: {len(answers)} lines, {len(found)} regime studies ({time.perf_counter() - t0:.0f} s)")
     return report_section(answers, found, names)

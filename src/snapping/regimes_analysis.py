@@ -32,7 +32,7 @@ import numpy as np
 from . import _validate as V
 
 __all__ = ["power_law", "crossover", "crossover_law", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR",
-           "level_ratios"]
+           "level_ratios", "with_level_ratios"]
 
 #: the crossover: the peak 10% below the ideal's
 LEVEL = 0.9
@@ -351,7 +351,8 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
     (:func:`snapping.continuum.extrapolate`) -- for a study whose levels are too coarse for each
     limit apart (the stretching study's: its ideal limits carry 3-40% error bars, their observed
     orders 0.2-0.3) while the ratio, its discretisation errors shared, moves by 1-2% from level to
-    level. Per chi: ``ratio``, ``error`` and ``order`` per number, and :func:`crossover` on them.
+    level. Per chi: ``ratio``, ``error`` and ``order`` per number (nan where the extrapolated ratio
+    leaves (0, 2): an order near 0, a failed extrapolation), and :func:`crossover` on them.
 
     Returns
     -------
@@ -372,7 +373,8 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
         for j in range(nums.size):
             if np.all(np.isfinite(lv[j])):
                 x = extrapolate(res, lv[j])
-                r[j], e[j], o[j] = x["limit"], x["error"], x["order"]
+                if 0.0 < x["limit"] < 2.0:  # else a failed extrapolation (an order near 0): left out
+                    r[j], e[j], o[j] = x["limit"], x["error"], x["order"]
         ok = np.isfinite(r) & np.isfinite(e)
         cross = crossover(nums[ok], r[ok], e[ok])
         out["chi"][float(chi)] = {"ratio": r, "error": e, "order": o, "levels": lv, "crossover": cross}
@@ -383,4 +385,17 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
         out["crossover_law"] = crossover_law(cx, nx, lo, hi)
     else:
         out["crossover_law"] = crossover_law([], [])
+    return out
+
+
+def with_level_ratios(ds, quantity: str = "v_peak"):
+    """A copy of the study whose ``{quantity}_ratio`` (and ``_error``) are the same-links ratios
+    extrapolated across the levels (:func:`level_ratios`): the regime map of a study whose limits
+    are not resolved apart (stretching)."""
+    lr = level_ratios(ds, quantity)
+    out = ds.copy()
+    out[f"{quantity}_ratio"] = (("chi", "number"), np.array([lr["chi"][float(c)]["ratio"] for c in ds.chi.values]))
+    out[f"{quantity}_ratio_error"] = (("chi", "number"),
+                                      np.array([lr["chi"][float(c)]["error"] for c in ds.chi.values]))
+    out.attrs["mechanism"] = f"{ds.attrs['mechanism']}, same-links ratios"
     return out
