@@ -20,6 +20,8 @@ Usage::
     python benchmarks/bench_regimes.py --cost end-mass
     python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
+    python benchmarks/bench_regimes.py --study stretching --chis 0.1 --out lo.nc   # a part (some chi) ...
+    python benchmarks/bench_regimes.py --study stretching --merge lo.nc hi.nc       # ... put into the shipped file
 """
 
 from __future__ import annotations
@@ -39,9 +41,16 @@ STUDIES = {
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
                 "levels": 3},
-    # stretching: not shipped; the elastic line (scipy Radau) took > 70 s of CPU for one run of 284 links at
-    # chi = 0.3, c = 30 (not finished): a 4 x 8 scan is beyond this machine
-    "stretching": {"chis": [0.3], "numbers": [1 / 300, 1 / 100, 1 / 30, 1 / 10], "accuracy": "coarse", "levels": 2},
+    # stretching (number sqrt(gL)/c): the elastic line by RODAS4 with the grid damping zeta = 1 and the stop
+    # floor of regimes_spec (before: scipy Radau, undamped, the stop rule never armed on fold-graded links: one
+    # run of 284 links at chi = 0.3, c = 30 did not finish in 70 s; now 9.4 s, 196620 evaluations). Numbers:
+    # c = 442 down to 3.3 (7 of geomspace(1e-3, 0.3, 8): c = 1000 dropped, its runs cost 7x those at 442),
+    # bracketing the crossover at every chi; fold levels first -4 (chi = 0.3: 70-166 links). chi = 0.1 is
+    # not in the shipped file: its runs cost most (c = 1000, 160 links: > 80 s of CPU, not finished; c = 100,
+    # 267 links: 24 s); `--study stretching --chis 0.1 --out lo.nc` then `--merge lo.nc <shipped file>` and
+    # chis [0.1, 0.2, 0.3, 0.5] here add it
+    "stretching": {"chis": [0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8)[1:], "accuracy": "coarse",
+                   "first": -4, "levels": 3, "tol": 1e-6},
 }
 
 
@@ -49,15 +58,47 @@ def _numbers(v):
     return [float(f"{x:.3g}") for x in v]  # as the command line passes them (3 digits)
 
 
-def study(mech: str, workers: int) -> None:
+def study(mech: str, workers: int, chis=None, out=None) -> None:
+    """Run (or resume) the study of ``mech``; ``chis`` and ``out``: a part of it (some chi) in a
+    file of its own, to be put into the shipped study by :func:`merge` (cells are the same runs)."""
     from snapping.regimes import regimes
 
     s = dict(STUDIES[mech])
     os.makedirs(DATA, exist_ok=True)
-    out = os.path.join(DATA, f"{mech}.nc")
+    out = out or os.path.join(DATA, f"{mech}.nc")
+    all_chis = s.pop("chis")
     t = time.time()
-    regimes(mech, s.pop("chis"), _numbers(s.pop("numbers")), out=out, workers=workers, progress=True, **s)
+    regimes(mech, chis or all_chis, _numbers(s.pop("numbers")), out=out, workers=workers, progress=True, **s)
     print(f"{mech}: {out} ({time.time() - t:.0f} s wall, load {os.getloadavg()[0]:.1f})")
+
+
+def merge(mech: str, parts) -> None:
+    """Put part studies (the same settings, each some of the chi) together as the shipped study
+    file of ``mech``: the runs of each part, the study key of all their chi (so that ``--study``
+    resumes the merged file as one study), the limits recomputed."""
+    import json
+
+    import xarray as xr
+
+    from snapping.regimes import _finish, load_study
+    from snapping.sweep_files import atomic_to_netcdf
+
+    ds = [load_study(p) for p in parts]
+    keys = [json.loads(d.attrs["regimes_study"]) for d in ds]
+    for k in keys[1:]:
+        if {a: b for a, b in k.items() if a != "chi"} != {a: b for a, b in keys[0].items() if a != "chi"}:
+            raise SystemExit("the parts are not parts of one study (their settings differ)")
+    runs = [v for v in ds[0].data_vars if v.endswith("_level")]
+    whole = xr.concat([d[runs] for d in ds], dim="chi", data_vars="minimal", coords="minimal",
+                      compat="override").sortby("chi")
+    whole["resolution"], whole["resolution_ideal"] = ds[0]["resolution"], ds[0]["resolution_ideal"]
+    whole.attrs = dict(ds[0].attrs)
+    whole.attrs["regimes_study"] = json.dumps({**keys[0], "chi": sorted(float(c) for c in whole.chi.values)},
+                                              sort_keys=True)
+    out = os.path.join(DATA, f"{mech}.nc")
+    whole = _finish(whole)
+    atomic_to_netcdf(whole, out)
+    print(f"{mech}: merged {len(parts)} part(s) into {out}; status {whole.attrs['status']}")
 
 
 def cost(mech: str, path=None) -> dict:
@@ -96,6 +137,7 @@ def estimates(mech: str, ds, a) -> list[str]:
     * bending: the rod's fold radius sqrt(B/T) reaches the ideal fold's radius 1/kappa at the
       ideal's tension T = sigma: beta_c ~ sigma_ideal / kappa_ideal^2;
     * end mass: the fold's length (~ its radius 1/kappa_ideal) reaches M/lambda: M_c ~ 1/kappa_ideal;
+    * stretching: the speed approaches the wave speed, c_c ~ v_ideal (number_c ~ 1/v_ideal);
     * drag: the drag length 2 lambda/(rho C_n d) = 1/d (chain lengths; d the normal drag number)
       reaches the fold's length 1/kappa_ideal: d_c ~ kappa_ideal (an upper estimate: the drag acts
       over the whole fast part of the line, longer than the fold).
@@ -104,13 +146,17 @@ def estimates(mech: str, ds, a) -> list[str]:
     for chi, r in a["chi"].items():
         c = ds.sel(chi=chi)
         kap, sig = float(c["kappa_peak_ideal"]), float(c["sigma_peak_ideal"])
-        est = {"bending": sig / kap**2, "end-mass": 1.0 / kap, "drag": kap}.get(mech, float("nan"))
+        est = {"bending": sig / kap**2, "end-mass": 1.0 / kap, "drag": kap,
+               "stretching": 1.0 / float(c["v_peak_ideal"])}.get(mech, float("nan"))
         x = r["crossover"]
         meas = f"{x['number']:.3g} ({x['lo']:.3g}..{x['hi']:.3g})" if x["bracketed"] else x["statement"]
         ratio = x["number"] / est if x["bracketed"] else float("nan")
         extra = ""
         if mech == "drag" and x["bracketed"]:
             extra = f"; drag length at the crossover 1/d_c = {1 / x['number']:.3g} chain lengths"
+        if mech == "stretching" and x["bracketed"]:
+            extra = (f"; c_c = {1 / x['number']:.3g} = {1 / (x['number'] * float(c['v_peak_ideal'])):.3g} v_ideal "
+                     f"(the guess c_c ~ v_ideal)")
         if mech == "bending" and x["bracketed"]:
             extra = (f"; bending length sqrt(beta_c/sigma) = {(x['number'] / sig) ** 0.5:.3g} against the ideal fold's "
                      f"radius {1 / kap:.3g}")
@@ -147,6 +193,10 @@ def report(mechs, figdir=None) -> None:
                 print("\n".join(estimates(mech, ds, a)))
         if figdir:
             path = os.path.join(figdir, f"regimes_{mech}.png")
+            if mech == "stretching":  # its limits are not resolved apart: the same-links ratios, extrapolated
+                from snapping.regimes_analysis import with_level_ratios
+
+                ds = with_level_ratios(ds)
             plt.close(regime_map(ds, path))
             print(f"  map: {path}")
 
@@ -163,29 +213,54 @@ def damping_check(chi: float, beta: float, zetas=(0.5, 1.0, 2.0), levels: int = 
               f"{float(np.nansum(c.cpu_time_level)):.1f} s", flush=True)
 
 
+def cell(mech: str, chi: float, number: float, levels, first: int = -3, tol: float = 1e-6, damping: float = 1.0) -> None:
+    """One cell of a study at some fold levels (the study's own runs, :func:`snapping.regimes._run_task`):
+    the peaks, evaluations and CPU seconds of each, beside the ideal chain's on the same links."""
+    from snapping.continuum import level_parameters
+    from snapping.regimes import _run_task
+
+    lv = level_parameters(max(levels) - first + 1, 0.5, first=first)
+    for k in levels:
+        for m, n in ((None, 0.0), (mech, number)):
+            r = _run_task(chi, m, n, lv[k - first], tol, damping)
+            print(f"chi {chi:g} {m or 'ideal'} {n:g} level {k} ({r['n_links']} links): v_peak {r['v_peak']:.6g} "
+                  f"a_peak {r['a_peak']:.6g} sigma_peak {r['sigma_peak']:.6g}; {r['n_rhs']} evaluations, "
+                  f"{r['cpu_time']:.2f} s CPU", flush=True)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", choices=sorted(STUDIES))
+    ap.add_argument("--chis", default=None, help="--study: only these chi (comma-separated) into --out")
+    ap.add_argument("--out", default=None, help="--study: the file of a part study (with --chis)")
+    ap.add_argument("--merge", nargs="+", default=None, help="part study files to merge into the shipped --cost/--study MECH")
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
     ap.add_argument("--damping-check", action="store_true")
-    ap.add_argument("--report", action="store_true", help="analyse the shipped studies (and --figures DIR)")
+    ap.add_argument("--report", nargs="*", default=None, metavar="MECH",
+                    help="analyse the shipped studies (these, default all; and --figures DIR)")
     ap.add_argument("--figures", default=None, help="write the regime maps there (regimes_MECH.png)")
+    ap.add_argument("--cell", nargs="+", type=float, default=None, metavar="X",
+                    help="--cell CHI NUMBER LEVEL...: one cell of --study MECH at these fold levels (first -3)")
     ap.add_argument("--chi", type=float, default=0.3)
     ap.add_argument("--beta", type=float, default=1e-4)
     ap.add_argument("--workers", type=int, default=1)
     a = ap.parse_args(argv)
     print(f"load {os.getloadavg()[0]:.1f}")
-    if a.study:
-        study(a.study, a.workers)
+    if a.cell:
+        cell(a.study, a.cell[0], a.cell[1], [int(k) for k in a.cell[2:]])
+    elif a.study and a.merge:
+        merge(a.study, a.merge)
+    elif a.study:
+        study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out)
     if a.cost:
         cost(a.cost, a.file)
     if a.damping_check:
         damping_check(a.chi, a.beta)
-    if a.report:
+    if a.report is not None:
         from snapping.regimes import BUNDLED
 
-        report(BUNDLED, a.figures)
+        report(a.report or BUNDLED, a.figures)
 
 
 if __name__ == "__main__":

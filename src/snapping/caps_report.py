@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 __all__ = ["catalogue", "catalogue_table", "studies", "report_section", "section", "LIVE", "CATALOGUE_N",
-           "RESOLVED"]
+           "RESOLVED", "stretching_speeds", "ideal_speeds"]
 
 #: the catalogue's links per mode (the ball chain always on its 229)
 CATALOGUE_N = {"quick": 100, "full": 400}
@@ -106,7 +106,7 @@ def studies(mode: str = "quick", data_dir=None, out_dir=None, log=print) -> list
 def report_section(answers: list[dict], study_list: list, figure_names=()) -> list[str]:
     """Markdown lines of the section "Beyond the paper: what caps the snap"."""
     from . import caps
-    from .regimes_analysis import LEVEL, analyze, report
+    from .regimes_analysis import LEVEL, analyze, level_ratios, report
 
     lines = ["## Beyond the paper: what caps the snap", "",
              "The paper's snap is capped by geometry (the fold's curvature scale); a real line has bending, "
@@ -134,9 +134,56 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
         lines += report(ds) + ["```", "",
                                f"**Verdict (computed, v_peak): {'; '.join(crossed)}; {a['crossover_law']['statement']}.**",
                                ""]
+        if ds.attrs["mechanism"] == "stretching":
+            lr = level_ratios(ds, "v_peak")
+            lines += ["The stretching study's levels are too coarse for each limit apart (above); the ratio to "
+                      "the ideal on the same links, extrapolated across the levels "
+                      "(`regimes_analysis.level_ratios`):", "", "```"]
+            for chi, r in lr["chi"].items():
+                lines.append(f"chi={chi:g}: " + " ".join(f"{n:g}: {v:.3f} +- {e:.2g}" for n, v, e in
+                                                         zip(ds.number.values, r["ratio"], r["error"]))
+                             + f"; {r['crossover']['statement']}")
+            lines += [f"{lr['crossover_law']['statement']}", "```", "",
+                      f"**Verdict (computed, stretching against the issue's guess, c ~ v): "
+                      f"{'; '.join(stretching_speeds(lr, ideal_speeds(study_list)))}.**", ""]
         if k < len(figure_names):
             lines += [f"![{figure_names[k]}](figures/{figure_names[k]}.png)", ""]
     return lines
+
+
+def stretching_speeds(ratios: dict, v_ideal: dict) -> list[str]:
+    """Per chi of a stretching study's level ratios (:func:`snapping.regimes_analysis.level_ratios`):
+    the crossover wave speed c_c = 1/number_c (units sqrt(g L); interval from the number's) against
+    the ideal's peak speed ``v_ideal[chi] = (value, source)``, c_c / v_ideal -- the issue's guess
+    was that stretching matters once the speed approaches c (c_c / v_ideal ~ 1)."""
+    out = []
+    for chi, r in ratios["chi"].items():
+        x = r["crossover"]
+        if not x["bracketed"]:
+            out.append(f"chi={chi:g}: no c_c ({x['statement']})")
+            continue
+        cc = 1.0 / x["number"]
+        span = (f" ({1.0 / x['hi']:.3g}..{1.0 / x['lo']:.3g})" if x["hi"] > 0 and x["lo"] > 0 else "")
+        if chi not in v_ideal:
+            out.append(f"chi={chi:g}: c_c = {cc:.3g}{span} (no resolved ideal speed)")
+            continue
+        v, src = v_ideal[chi]
+        out.append(f"chi={chi:g}: c_c = {cc:.3g}{span}, v_ideal = {v:.4g} ({src}), c_c/v_ideal = {cc / v:.3g}")
+    return out
+
+
+def ideal_speeds(study_list) -> dict:
+    """chi -> (the ideal's continuum peak speed, its source) from the studies whose ideal limit is
+    resolved (error bar <= MAX_REL_ERROR), the smallest error bar first."""
+    from .regimes_analysis import MAX_REL_ERROR
+
+    best = {}
+    for ds in study_list:
+        for chi in ds.chi.values:
+            v, e = float(ds.v_peak_ideal.sel(chi=chi)), float(ds.v_peak_ideal_error.sel(chi=chi))
+            if abs(e) <= MAX_REL_ERROR * abs(v) and (float(chi) not in best or e < best[float(chi)][2]):
+                best[float(chi)] = (v, f"{ds.attrs['mechanism']} study, +- {e:.2g}", e)
+    return {c: (v, s) for c, (v, s, _) in best.items()}
 
 
 def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
@@ -148,7 +195,7 @@ def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
 
     from . import figures
     from ._files import write_atomic
-    from .regimes_analysis import regime_map
+    from .regimes_analysis import regime_map, with_level_ratios
 
     t0 = time.perf_counter()
     if live not in LIVE:
@@ -169,7 +216,8 @@ def section(N: int, live: str, out: Path, figdir: Path, log=print) -> list[str]:
     names = []
     for ds in found:
         name = f"fig7_regime_map_{ds.attrs['mechanism']}"
-        figures.save(regime_map(ds), Path(figdir) / name)
+        figures.save(regime_map(with_level_ratios(ds) if ds.attrs["mechanism"] == "stretching" else ds),
+                     Path(figdir) / name)
         names.append(name)
     log(f"what caps the snap: {len(answers)} lines, {len(found)} regime studies ({time.perf_counter() - t0:.0f} s)")
     return report_section(answers, found, names)

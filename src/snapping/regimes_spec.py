@@ -6,7 +6,7 @@ line can build its parser, and answer a table query, without importing them.
 
 from __future__ import annotations
 
-__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX"]
+__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_STOP_FLOOR"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -31,3 +31,15 @@ ACCURACY = {
 
 #: the largest number a cell takes (every mechanism's number is a ratio to the chain's scales)
 NUMBER_MAX = 1e4
+
+#: stretching: the elastic line's method in a study (the compiled RODAS4 of
+#: :mod:`snapping.simulate.elastic_rodas`; its grid damping is the study's ``damping``)
+STRETCH_METHOD = "rodas4"
+#: stretching: the running peak of v_max (units sqrt(g L)) above which the elastic run's stop rule
+#: judges the snap (:func:`snapping.simulate.elastic.solve`'s ``stop_floor``). Its default bound,
+#: from the release's elastic energy given to the lightest node, exceeds the snap itself on
+#: fold-graded links (tip links of 1e-5: chi = 0.5, c = 30, a floor of 14.6 against a peak of 4.3),
+#: so the run went on to t = 10. Every snap scanned peaks above 2 (c = 3.3, chi = 0.5: 3.7), and
+#: the fall's own speed passes 1 only at t ~ 1, the release's ringing adding far less (the fall's
+#: v_max 0.397 at t = 0.36 against g t = 0.36, chi = 0.5, c = 30)
+STRETCH_STOP_FLOOR = 1.0

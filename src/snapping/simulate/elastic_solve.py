@@ -159,7 +159,7 @@ def _initial(line, start, initial):
 
 def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float = 1e-8, method: str = "radau",
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
-          snapshot_times=(), max_rhs: int = 50_000_000) -> ElasticRun:
+          snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None) -> ElasticRun:
     """Integrate the elastic line of ``problem`` made of ``elastic`` links.
 
     Parameters
@@ -191,6 +191,10 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         Times of full profiles (besides t = 0, the peak of v_max and the end).
     max_rhs : int
         Right-hand-side evaluations after which the run stops (status 'failed').
+    stop_floor : float, optional
+        The running peak of v_max above which the stop rule judges the snap, instead of
+        :func:`speed_floor`'s bound (which, from the lightest node's mass, can exceed the snap
+        itself on fold-graded links: the run then goes on to ``t_end_max``).
 
     Returns
     -------
@@ -213,6 +217,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         raise V.SnappingInputError(f"start={start!r} is not one of {STARTS}")
     snaps = sorted(float(V.real("snapshot_times", s)) for s in np.atleast_1d(np.asarray(snapshot_times, float)))
     max_rhs = V.integer("max_rhs", max_rhs, 1)
+    if stop_floor is not None:
+        stop_floor = V.positive("stop_floor", stop_floor)
 
     wall0 = time.perf_counter()
     z0 = _initial(line, start, initial)
@@ -240,7 +246,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     first_slack = np.nan
     i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
-    err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction)
+    err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
     while solver.status == "running":
         msg = solver.step()
