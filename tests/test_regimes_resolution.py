@@ -111,3 +111,34 @@ def test_shipped_bending_study_names_its_unconverged_cells():
     assert np.all((ds.bending_resolution.values[~ok] < RR.BEND_RESOLVED) | ~np.isfinite(ds.v_peak_order.values[~ok]))
     a = A.analyze(ds)
     assert "1e-08" in a["chi"][0.1]["unresolved"]
+
+
+def test_report_verdict_names_unconverged_cells_and_rises():
+    """caps_report's verdict: the flagged cells named; a rise claimed only from converged cells
+    above 1 by three error bars (synthetic ratios: 1.5 flagged, 1.2 +- 0.01 converged, 1.02 +- 0.01
+    converged but within three bars)."""
+    import xarray as xr
+
+    from snapping.caps_report import convergence_words
+
+    r = np.array([[1.5, 1.2, 1.02, 0.5]])
+    err = np.array([[1e-3, 1e-2, 1e-2, 1e-3]])
+    ds = xr.Dataset({"v_peak": (("chi", "number"), 10 * r), "v_peak_error": (("chi", "number"), 10 * err),
+                     "v_peak_order": (("chi", "number"), np.full(r.shape, 2.0)),
+                     "v_peak_ratio": (("chi", "number"), r), "v_peak_ratio_error": (("chi", "number"), err),
+                     "converged": (("chi", "number"), np.array([[0, 1, 1, 1]], dtype=np.int8))},
+                    coords={"chi": [0.2], "number": [1e-8, 1e-7, 1e-6, 1e-5]}, attrs={"number_name": "beta"})
+    w = convergence_words(ds)
+    assert "1 of 4 cells not converged" in w and "chi=0.2 beta=1e-08" in w
+    assert "x1.200 +- 0.01 at chi=0.2, beta=1e-07" in w
+    ds["converged"].values[:] = 1
+    assert "x1.500" in convergence_words(ds) and "every cell converged" in convergence_words(ds)
+    ds["v_peak_ratio"].values[:] = [[0.99, 1.01, 1.0, 0.5]]
+    assert "no converged cell has its peak raised" in convergence_words(ds)
+
+
+def test_module_example():
+    import doctest
+
+    res = doctest.testmod(RR)
+    assert res.attempted >= 1 and res.failed == 0

@@ -347,9 +347,11 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
     ax.set_xscale("log")
     ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
     ax.set_ylabel("chi")
-    ax.set_title(f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})"
-                 + ("\n?: not converged, left out of the fits" if "converged" in ds and not ds["converged"].values.all()
-                    else ""), fontsize=10)
+    title = f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})"
+    if "converged" in ds and not ds["converged"].values.all():
+        ax.set_title(title + "\n?: not converged (left out of the fits)", fontsize=10)
+    else:
+        ax.set_title(title)
     fig.tight_layout()
     if path is not None:
         from ._files import save_figure
