@@ -40,6 +40,9 @@ def test_bending_resolution_by_hand():
     assert RR.converged([2.0, float("nan"), 2.0, 2.0], [1.5, 3.0, 0.5, float("nan")]).tolist() == [
         True, False, False, False]
     assert RR.converged([2.0, float("nan")]).tolist() == [True, False]
+    # levels agreeing to AGREE of the value converge without an order; wider ones do not
+    agree = RR.converged([float("nan")] * 2, value=[10.0, 10.0], error=[0.9e-3 * 10, 1.1e-3 * 10])
+    assert agree.tolist() == [True, False]
 
 
 def _bending_study(chis, betas, levels=3, first=-3):

@@ -124,8 +124,9 @@ def _mark(ds: xr.Dataset) -> None:
         ds["bending_resolution"] = (("chi", "number"), res, {
             "long_name": "bending length sqrt(beta/sigma_peak_ideal) over the finest level's link at the ideal fold "
                          "(arclength 1/kappa_peak_ideal from the free end)"})
-    ds["converged"] = (("chi", "number"), converged(ds["v_peak_order"].values, res).astype(np.int8), {
-        "long_name": "1: the cell's levels converge (v_peak's observed order is finite)"
+    ds["converged"] = (("chi", "number"), converged(ds["v_peak_order"].values, res, value=ds["v_peak"].values,
+                                                    error=ds["v_peak_error"].values).astype(np.int8), {
+        "long_name": "1: the cell's levels converge (v_peak's observed order is finite, or its levels agree to 0.1%)"
                      + (f" and resolve the bending length at the fold (bending_resolution >= {BEND_RESOLVED:g})"
                         if res is not None else "") + "; 0: not converged, its limit is not the continuum's"})
 

@@ -37,7 +37,7 @@ import numpy as np
 
 from . import _validate as V
 
-__all__ = ["BEND_RESOLVED", "fold_link", "bending_resolution", "converged"]
+__all__ = ["BEND_RESOLVED", "AGREE", "fold_link", "bending_resolution", "converged"]
 
 #: bending: a cell is converged only when its finest level has l_B / h_fold >= this (see the module)
 BEND_RESOLVED = 1.0
@@ -68,12 +68,22 @@ def bending_resolution(h, beta: float, sigma_ideal: float, kappa_ideal: float) -
     return math.sqrt(beta / sigma_ideal) / fold_link(h, kappa_ideal)
 
 
-def converged(order, resolution=None, threshold: float = BEND_RESOLVED) -> np.ndarray:
-    """The per-cell flag: the extrapolation converged (finite observed ``order``) and, where a
+#: levels whose spread is at most this fraction of the value agree (converged for a study aiming at 1%) even where
+#: the extrapolation finds no order (differences of the tolerance's size change sign)
+AGREE = 1e-3
+
+
+def converged(order, resolution=None, threshold: float = BEND_RESOLVED, value=None, error=None) -> np.ndarray:
+    """The per-cell flag: the levels converge (a finite observed ``order``, or, given ``value`` and
+    its ``error`` bar, levels that agree to :data:`AGREE` of the value) and, where a
     ``resolution`` (:func:`bending_resolution` of the finest level) is given, it is at least
     ``threshold`` (NaN resolution: not converged)."""
     o = np.asarray(order, dtype=float)
     ok = np.isfinite(o)
+    if value is not None and error is not None:
+        v, e = np.asarray(value, dtype=float), np.asarray(error, dtype=float)
+        with np.errstate(invalid="ignore"):
+            ok = ok | (np.isfinite(v) & np.isfinite(e) & (np.abs(e) <= AGREE * np.abs(v)))
     if resolution is not None:
         r = np.asarray(resolution, dtype=float)
         with np.errstate(invalid="ignore"):
