@@ -18,7 +18,10 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   shortest wave at every node the damping ratio ``zeta`` (``damping``, default 1) and vanishes
   as h^2 with the links, so the continuum extrapolation removes it (checked: the limits at
   zeta 0.5, 1 and 2 agree within their error bars, ``benchmarks/bench_regimes.py``). Run with
-  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps).
+  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps). A cell is flagged
+  ``converged`` = 0 where its finest links do not resolve the bending length at the fold
+  (``bending_resolution`` < 1, :mod:`snapping.regimes_resolution`): such levels are
+  pre-asymptotic, and their extrapolation can look converged without being so.
 * ``drag`` (normal number d, tangential ``d * pi C_t / C_n`` with the default coefficients
   of :mod:`snapping.units`), ``drag-normal``, ``drag-tangential``: ``Body(drag_...)``;
   fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
@@ -337,7 +340,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     xarray.Dataset
         Dimensions chi, number, level: ``{q}_level`` (each run's peak), ``{q}`` (limit),
         ``{q}_error``, ``{q}_order``, ``{q}_ideal`` (+ ``_error``, per chi), ``{q}_ratio``
-        (+ ``_error``) for q in :data:`snapping.continuum.QUANTITIES`.
+        (+ ``_error``) for q in :data:`snapping.continuum.QUANTITIES`; ``converged`` (per cell, 1/0:
+        :mod:`snapping.regimes_resolution`) and, bending, ``bending_resolution``.
 
     Raises
     ------

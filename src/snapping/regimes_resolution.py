@@ -14,11 +14,15 @@ radius of its own, and refining the links changes the physics of the run, not on
 accuracy. The fold's links are measured where the ideal fold is at the snap: ``h_fold``, the
 link at arclength ``1/kappa_ideal`` (the ideal fold's radius) from the free end.
 
-Measured (``python benchmarks/bench_bendconv.py``, chi = 0.1 and 0.2, beta = 1e-8 - 3.7e-6,
-fold-graded levels frac = 0.08 ... 0.0025): wherever ``l_B / h_fold < BEND_RESOLVED`` at the
-finest level the last three levels are not yet in their asymptotic regime (differences
-growing or changing sign, or a limit the next level leaves by more than its error bar); see
-:data:`BEND_RESOLVED` for the numbers.
+Measured (``python benchmarks/bench_bendconv.py``, fold-graded levels frac = 0.08 ... 0.01):
+at chi = 0.1, beta = 7.2e-8 the levels give 47.20, 57.59, 58.25, 57.19 with ``l_B / h_fold``
+= 0.30, 0.33, 0.46, 0.92: the first three extrapolate to 58.29 +- 0.04 (order 4), a limit the
+fourth level leaves by 25 error bars; at beta = 1e-8 they climb 31.9, 35.5, 39.3, 41.5
+(``l_B / h_fold`` <= 0.34). Where the finest level reaches ``l_B / h_fold`` >= 1 (chi = 0.2,
+beta = 5.2e-7: 16.25, 17.23, 17.55, 17.65 at 0.41-1.47; chi = 0.3: 1.03) the levels are
+monotone with differences shrinking at order 1.7-1.8. Resolution is necessary, not sufficient:
+chi = 0.1, beta = 5.2e-7 reaches 2.47 and its differences still grow (+1.37, +2.12); the order
+test flags it.
 
 :func:`converged` is the per-cell flag the study stores (``converged``, with
 ``bending_resolution``, by :func:`snapping.regimes.regimes`) and that
