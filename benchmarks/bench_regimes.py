@@ -17,6 +17,7 @@ worker process); the machine is shared, so wall times mean little (load printed)
 Usage::
 
     python benchmarks/bench_regimes.py --study end-mass --workers 1
+    python benchmarks/bench_regimes.py --extend bending --seed benchmarks/results/bendconv_chi0.*.json
     python benchmarks/bench_regimes.py --cost end-mass
     python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
@@ -39,8 +40,10 @@ DATA = os.path.join(HERE, "..", "src", "snapping", "data", "regimes")
 STUDIES = {
     "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-5, 1.0, 8), "accuracy": "medium"},
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
+    # bending: 4 levels (frac 0.08-0.01; was 3 to 0.02, whose small-beta cells at chi 0.1-0.2 sat before their
+    # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
-                "levels": 3},
+                "levels": 4},
     # stretching (number sqrt(gL)/c): the elastic line by RODAS4 with the grid damping zeta = 1 and the stop
     # floor of regimes_spec (before: scipy Radau, undamped, the stop rule never armed on fold-graded links: one
     # run of 284 links at chi = 0.3, c = 30 did not finish in 70 s; now 9.4 s, 196620 evaluations). Numbers:
@@ -99,6 +102,58 @@ def merge(mech: str, parts) -> None:
     whole = _finish(whole)
     atomic_to_netcdf(whole, out)
     print(f"{mech}: merged {len(parts)} part(s) into {out}; status {whole.attrs['status']}")
+
+
+def extend(mech: str, workers: int, seeds=()) -> None:
+    """Refine a shipped study by more levels (STUDIES[mech]["levels"]) without redoing its runs: the
+    shipped file's levels, and any of the same runs in ``seeds`` (benchmarks/bench_bendconv.py's JSON
+    files, keys "chi beta k" with frac = 0.04 * 2**-k), are copied into the new study's file, then
+    :func:`snapping.regimes.regimes` computes only the runs missing. Every copied run is the same
+    computation (same links, tolerance and grid damping): checked bit for bit on one."""
+    import json
+
+    from snapping import regimes as R
+    from snapping.continuum import QUANTITIES
+    from snapping.sweep_files import atomic_to_netcdf
+
+    s = dict(STUDIES[mech])
+    chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"))
+    old = R.load_study(os.path.join(DATA, f"{mech}.nc"))
+    acc = dict(R.ACCURACY[s.pop("accuracy")])
+    acc.update(s)
+    if mech == "bending":
+        acc["damping"] = R.GRID_DAMPING
+    lev, ilev = R._levels(R.MECHANISMS[mech][1], acc, 0.5), R._levels("fold", acc, 0.5)
+    ds = R._empty(mech, chis, numbers, lev, ilev, R._study_key(mech, chis, numbers, acc, 0.5), acc, 0.5)
+    names = [f"{q}_level" for q in QUANTITIES + ("n_rhs", "cpu_time", "n_links")]
+    copied = 0
+    for k, p in enumerate(lev):  # the shipped file's levels, matched by their fold fraction
+        ko = np.flatnonzero(np.isclose(old.resolution.values, p["frac"], rtol=1e-12))
+        if ko.size:
+            for n in names:
+                ds[n].values[:, :, k] = old[n].sel(chi=chis, number=numbers).values[:, :, ko[0]]
+                ds[n.replace("_level", "_ideal_level")].values[:, k] = old[n.replace("_level", "_ideal_level")].sel(
+                    chi=chis).values[:, ko[0]]
+            copied += 1
+    seeded = 0
+    for path in seeds:
+        for key, row in json.load(open(path)).items():
+            chi, beta, kk = float(key.split()[0]), float(key.split()[1]), int(key.split()[2])
+            k = kk - acc["first"]
+            if chi not in chis or not 0 <= k < len(lev) or (beta and beta not in numbers):
+                continue
+            assert np.isclose(lev[k]["frac"], 0.04 * 0.5**kk, rtol=1e-12)
+            i = chis.index(chi)
+            for q in QUANTITIES + ("n_rhs", "cpu_time", "n_links"):
+                if beta == 0:
+                    ds[f"{q}_ideal_level"].values[i, k] = row[q]
+                else:
+                    ds[f"{q}_level"].values[i, numbers.index(beta), k] = row[q]
+            seeded += 1
+    out = os.path.join(DATA, f"{mech}.nc")
+    atomic_to_netcdf(R._finish(ds), out)
+    print(f"{mech}: {copied} levels copied from the shipped file, {seeded} runs from {list(seeds)}; resuming")
+    study(mech, workers)
 
 
 def cost(mech: str, path=None) -> dict:
@@ -235,6 +290,9 @@ def main(argv=None) -> None:
     ap.add_argument("--out", default=None, help="--study: the file of a part study (with --chis)")
     ap.add_argument("--merge", nargs="+", default=None, help="part study files to merge into the shipped --cost/--study MECH")
     ap.add_argument("--cost", choices=sorted(STUDIES))
+    ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
+                    "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
+    ap.add_argument("--seed", nargs="*", default=[])
     ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
     ap.add_argument("--damping-check", action="store_true")
     ap.add_argument("--report", nargs="*", default=None, metavar="MECH",
@@ -253,6 +311,8 @@ def main(argv=None) -> None:
         merge(a.study, a.merge)
     elif a.study:
         study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out)
+    if a.extend:
+        extend(a.extend, a.workers, a.seed)
     if a.cost:
         cost(a.cost, a.file)
     if a.damping_check:

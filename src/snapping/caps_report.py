@@ -20,8 +20,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-__all__ = ["catalogue", "catalogue_table", "studies", "report_section", "section", "LIVE", "CATALOGUE_N",
-           "RESOLVED", "stretching_speeds", "ideal_speeds"]
+__all__ = ["catalogue", "catalogue_table", "studies", "report_section", "section", "convergence_words", "LIVE",
+           "CATALOGUE_N", "RESOLVED", "stretching_speeds", "ideal_speeds"]
 
 #: the catalogue's links per mode (the ball chain always on its 229)
 CATALOGUE_N = {"quick": 100, "full": 400}
@@ -103,6 +103,37 @@ def studies(mode: str = "quick", data_dir=None, out_dir=None, log=print) -> list
     return out
 
 
+def convergence_words(ds, quantity: str = "v_peak") -> str:
+    """A study's own convergence verdict: its cells flagged not converged
+    (:mod:`snapping.regimes_resolution`), named, and where the mechanism *raises* the peak
+    (converged, resolved cells whose ratio exceeds 1 by more than three error bars: the
+    largest per chi). Empty for a study without the flag."""
+    import numpy as np
+
+    from .regimes_analysis import resolved
+
+    if "converged" not in ds:
+        return ""
+    name = ds.attrs["number_name"]
+    ok = ds["converged"].values.astype(bool)
+    bad = [f"chi={c:g} {name}={n:.3g}" for i, c in enumerate(ds.chi.values) for j, n in enumerate(ds.number.values)
+           if not ok[i, j]]
+    words = ("every cell converged" if not bad else
+             f"{len(bad)} of {ok.size} cells not converged (their finest links do not resolve the mechanism's "
+             f"length, or the levels do not converge; left out of the laws): {', '.join(bad)}")
+    r, e = ds[f"{quantity}_ratio"].values, ds[f"{quantity}_ratio_error"].values
+    good = ok & resolved(ds[quantity].values, ds[f"{quantity}_error"].values, ds[f"{quantity}_order"].values)
+    rises = []
+    for i, c in enumerate(ds.chi.values):
+        up = np.flatnonzero(good[i] & (r[i] - 1.0 > 3.0 * e[i]))
+        if up.size:
+            j = up[np.argmax(r[i, up])]
+            rises.append(f"x{r[i, j]:.3f} +- {e[i, j]:.2g} at chi={c:g}, {name}={ds.number.values[j]:.3g}")
+    words += ("; a small " + name + " raises the peak (converged cells, ratio > 1 by 3 error bars): "
+              + "; ".join(rises) if rises else f"; no converged cell has its peak raised above the ideal's")
+    return words
+
+
 def report_section(answers: list[dict], study_list: list, figure_names=()) -> list[str]:
     """Markdown lines of the section "Beyond the paper: what caps the snap"."""
     from . import caps
@@ -132,7 +163,8 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
         crossed = [f"chi={chi:g}: {row['crossover']['statement']}" for chi, row in a["chi"].items()]
         lines += [f"### Regime study: {ds.attrs['mechanism']} ({ds.attrs.get('source', '')})", "", "```"]
         lines += report(ds) + ["```", "",
-                               f"**Verdict (computed, v_peak): {'; '.join(crossed)}; {a['crossover_law']['statement']}.**",
+                               f"**Verdict (computed, v_peak): {'; '.join(crossed)}; {a['crossover_law']['statement']}"
+                               + (f"; {convergence_words(ds)}" if "converged" in ds else "") + ".**",
                                ""]
         if ds.attrs["mechanism"] == "stretching":
             lr = level_ratios(ds, "v_peak")

@@ -18,7 +18,10 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   shortest wave at every node the damping ratio ``zeta`` (``damping``, default 1) and vanishes
   as h^2 with the links, so the continuum extrapolation removes it (checked: the limits at
   zeta 0.5, 1 and 2 agree within their error bars, ``benchmarks/bench_regimes.py``). Run with
-  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps).
+  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps). A cell is flagged
+  ``converged`` = 0 where its finest links do not resolve the bending length at the fold
+  (``bending_resolution`` < 1, :mod:`snapping.regimes_resolution`): such levels are
+  pre-asymptotic, and their extrapolation can look converged without being so.
 * ``drag`` (normal number d, tangential ``d * pi C_t / C_n`` with the default coefficients
   of :mod:`snapping.units`), ``drag-normal``, ``drag-tangential``: ``Body(drag_...)``;
   fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
@@ -49,6 +52,7 @@ Example
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -61,7 +65,7 @@ from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_METHOD, STRETCH_STOP_FLOOR
 
-__all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
+__all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
 
 #: bending: the free end's links are at least this times the level's fold fraction times sqrt(beta)
@@ -91,6 +95,51 @@ def _drag_ratio() -> float:
     return math.pi * units.CD_TANGENTIAL / units.CD_NORMAL
 
 
+def cell_links(chi: float, mechanism: str, number: float, level: dict) -> np.ndarray:
+    """The link lengths of one run (:func:`cell_problem`'s), free end first."""
+    from .simulate import grading
+
+    if "n_links" in level:
+        return np.full(int(level["n_links"]), 1.0 / int(level["n_links"]))
+    h_min = level["h_min"]
+    if mechanism == "bending" and number > 0:
+        h_min = max(h_min, BEND_FLOOR * level["frac"] * math.sqrt(number))
+    return grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
+
+
+@functools.lru_cache(maxsize=256)
+def _finest_links(chi: float, number: float, levels: int, first: int, n0: int, ratio: float, grading: str):
+    level = _levels(grading, {"levels": levels, "first": first, "n0": n0}, ratio)[-1]
+    return cell_links(chi, "bending", number, level)
+
+
+def _mark(ds: xr.Dataset) -> None:
+    """The per-cell ``converged`` flag and, for bending, ``bending_resolution`` (the finest level's
+    l_B / h_fold): :mod:`snapping.regimes_resolution`."""
+    from .regimes_resolution import BEND_RESOLVED, bending_resolution, converged
+
+    res = None
+    if ds.attrs["mechanism"] == "bending":
+        a = ds.attrs
+        res = np.full((ds.sizes["chi"], ds.sizes["number"]), np.nan)
+        for i, chi in enumerate(ds.chi.values):
+            sig, kap = float(ds["sigma_peak_ideal"].values[i]), float(ds["kappa_peak_ideal"].values[i])
+            if not (np.isfinite(sig) and np.isfinite(kap)):
+                continue
+            for j, beta in enumerate(ds.number.values):
+                h = _finest_links(float(chi), float(beta), int(a["levels"]), int(a["first"]), int(a["n0"]),
+                                  float(a["ratio"]), a["grading"])
+                res[i, j] = bending_resolution(h, float(beta), sig, kap)
+        ds["bending_resolution"] = (("chi", "number"), res, {
+            "long_name": "bending length sqrt(beta/sigma_peak_ideal) over the finest level's link at the ideal fold "
+                         "(arclength 1/kappa_peak_ideal from the free end)"})
+    ds["converged"] = (("chi", "number"), converged(ds["v_peak_order"].values, res, value=ds["v_peak"].values,
+                                                    error=ds["v_peak_error"].values).astype(np.int8), {
+        "long_name": "1: the cell's levels converge (v_peak's observed order is finite, or its levels agree to 0.1%)"
+                     + (f" and resolve the bending length at the fold (bending_resolution >= {BEND_RESOLVED:g})"
+                        if res is not None else "") + "; 0: not converged, its limit is not the continuum's"})
+
+
 def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping: str = "shared",
                  damping: float = GRID_DAMPING):
     """The problem of one run: the catenary of separation ``chi`` with the mechanism at
@@ -98,15 +147,9 @@ def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping
     ``level`` (``n_links``: a uniform chain; else the fold-following grading; bending: its
     free end's links floored at ``BEND_FLOOR frac sqrt(beta)``, grid damping ratio ``damping``).
     Stretching: the (inextensible) problem whose links the elastic line takes."""
-    from .simulate import Body, Links, Problem, grading
+    from .simulate import Body, Links, Problem
 
-    if "n_links" in level:
-        h = np.full(int(level["n_links"]), 1.0 / int(level["n_links"]))
-    else:
-        h_min = level["h_min"]
-        if mechanism == "bending" and number > 0:
-            h_min = max(h_min, BEND_FLOOR * level["frac"] * math.sqrt(number))
-        h = grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
+    h = cell_links(chi, mechanism, number, level)
     body, tip = None, 0.0
     if mechanism == "bending" and number > 0:
         body = Body(bending=number, damping=eta_grid(h, number, damping) if damping > 0 else 0.0)
@@ -258,6 +301,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
         ds[f"{q}_ratio"] = (("chi", "number"), r, {"long_name": f"{q} / the ideal's"})
         ds[f"{q}_ratio_error"] = (("chi", "number"),
                                   np.abs(r) * np.hypot(err / lim, (ierr / ilim)[:, None]))
+    _mark(ds)
     done = np.isfinite(ds["v_peak_level"].values).all() and np.isfinite(ds["v_peak_ideal_level"].values).all()
     ds.attrs["status"] = "complete" if done else "partial"
     return ds
@@ -302,7 +346,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     xarray.Dataset
         Dimensions chi, number, level: ``{q}_level`` (each run's peak), ``{q}`` (limit),
         ``{q}_error``, ``{q}_order``, ``{q}_ideal`` (+ ``_error``, per chi), ``{q}_ratio``
-        (+ ``_error``) for q in :data:`snapping.continuum.QUANTITIES`.
+        (+ ``_error``) for q in :data:`snapping.continuum.QUANTITIES`; ``converged`` (per cell, 1/0:
+        :mod:`snapping.regimes_resolution`) and, bending, ``bending_resolution``.
 
     Raises
     ------

@@ -9,7 +9,8 @@ Pure functions on arrays, then on a study (:func:`snapping.regimes.regimes`):
 * :func:`crossover` finds the first number where a ratio to the ideal falls below
   ``level`` (0.9: 10% below), interpolated linearly in (log number, log ratio), with an
   interval from the ratios' error bars.
-* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%) of each chi of a study
+* :func:`analyze` applies both to the resolved cells (converging, error bar <= 5%, and the study's
+  ``converged`` flag where it has one) of each chi of a study
   (the power law to the capped cells alone, ratio < 0.9), fits the crossover against chi,
   and :func:`report` prints it; :func:`regime_map` draws chi against the number, colour
   the peak over the ideal's, with the 0.9 contour.
@@ -253,6 +254,8 @@ def analyze(ds, quantity: str = "v_peak", *, slope_tol: float = 0.1, max_rel_err
     for chi in ds.chi.values:
         c = ds.sel(chi=chi)
         ok = resolved(c[quantity].values, c[f"{quantity}_error"].values, c[f"{quantity}_order"].values, max_rel_error)
+        if "converged" in c:  # the study's own verdict (snapping.regimes_resolution): levels before the asymptotics
+            ok &= c["converged"].values.astype(bool)
         ideal_ok = abs(float(c[f"{quantity}_ideal_error"])) <= max_rel_error * abs(float(c[f"{quantity}_ideal"]))
         capped = ok & (c[f"{quantity}_ratio"].values < LEVEL)  # the law of the cap: past the crossover only
         fit = power_law(nums[capped], c[quantity].values[capped], c[f"{quantity}_error"].values[capped],
@@ -292,14 +295,22 @@ def report(ds, quantities=("v_peak", "a_peak", "sigma_peak")) -> list[str]:
         for chi in ds.chi.values:
             c = ds.sel(chi=chi)
             cells = [f"{float(c[q][j]):.5g} +- {float(c[q + '_error'][j]):.2g} ({float(c[q + '_ratio'][j]):.3f})"
-                     for j in range(ds.sizes["number"])]
+                     + ("*" if _unconverged(c, j) else "") for j in range(ds.sizes["number"])]
             lines.append(f"{chi:6.3g} {float(c[q + '_ideal']):9.5g} +- {float(c[q + '_ideal_error']):5.2g} "
                          + " ".join(f"{x:>28}" for x in cells))
+        if "converged" in ds and not ds["converged"].values.all():
+            lines.append("  * not converged (snapping.regimes_resolution): the levels are not yet in their asymptotic "
+                         "regime; the value is the finest level's extrapolation, not the continuum's")
         a = analyze(ds, q)
         for chi, r in a["chi"].items():
             lines.append(f"  chi={chi:g}: {r['fit']['statement']}; {r['crossover']['statement']}")
         lines.append(f"  {a['crossover_law']['statement']}")
     return lines
+
+
+def _unconverged(c, j) -> bool:
+    """Whether cell ``j`` of one chi's row is flagged not converged (a study without the flag: no)."""
+    return "converged" in c and not bool(c["converged"].values[j])
 
 
 def regime_map(ds, path=None, quantity: str = "v_peak"):
@@ -332,12 +343,16 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
     for i, chi in enumerate(chis):
         for j, n in enumerate(nums):
             if np.isfinite(r[i, j]):
-                ax.annotate(f"{r[i, j]:.2f}", (n, chi), ha="center", va="center", fontsize=7, color="k",
+                ax.annotate(f"{r[i, j]:.2f}" + ("?" if _unconverged(ds.isel(chi=i), j) else ""), (n, chi), ha="center", va="center", fontsize=7, color="k",
                             bbox={"boxstyle": "round", "fc": "w", "alpha": 0.6, "lw": 0})
     ax.set_xscale("log")
     ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
     ax.set_ylabel("chi")
-    ax.set_title(f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})")
+    title = f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})"
+    if "converged" in ds and not ds["converged"].values.all():
+        ax.set_title(title + "\n?: not converged (left out of the fits)", fontsize=10)
+    else:
+        ax.set_title(title)
     fig.tight_layout()
     if path is not None:
         from ._files import save_figure
