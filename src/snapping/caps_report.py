@@ -130,7 +130,7 @@ def convergence_words(ds, quantity: str = "v_peak") -> str:
             j = up[np.argmax(r[i, up])]
             rises.append(f"x{r[i, j]:.3f} +- {e[i, j]:.2g} at chi={c:g}, {name}={ds.number.values[j]:.3g}")
     words += ("; a small " + name + " raises the peak (converged cells, ratio > 1 by 3 error bars): "
-              + "; ".join(rises) if rises else f"; no converged cell has its peak raised above the ideal's")
+              + "; ".join(rises) if rises else "; no converged cell has its peak raised above the ideal's")
     return words
 
 
