@@ -350,6 +350,40 @@ def matched(rows, peer: str, levels=LEVELS, target: float = 10.0, ref: Result | 
             print(f"  at {level:g}: not reached by {who} within the runs above{note}")
 
 
+def add_arguments(ap, peer: str) -> None:
+    """The options every elastic peers script shares (the line, this project's side, the
+    reference and the accuracy levels); ``peer`` names the other code in the help."""
+    ap.add_argument("--chi", type=float, default=0.25, help="end separation / length (default 0.25)")
+    ap.add_argument("--N", default="100", help="links, comma-separated (default 100)")
+    ap.add_argument("--c", default="30", help="wave speeds c/sqrt(gL), comma-separated (default 30)")
+    ap.add_argument("--method", default="dop853,rodas4",
+                    help="this project's methods, comma-separated (names of elastic.METHODS; default dop853,rodas4)")
+    ap.add_argument("--start", default="stretched", choices=STARTS,
+                    help="the start every code is given (default stretched; matched: no release wave)")
+    ap.add_argument("--peak", default="v", choices=("v", "sigma", "both"),
+                    help="which peak decides 'within eps': the speed, the tension or both (default v)")
+    ap.add_argument("--levels", default=",".join(f"{x:g}" for x in LEVELS),
+                    help="the accuracy levels eps, comma-separated (default 1e-3,1e-4)")
+    ap.add_argument("--ref-method", default=REF_METHOD, help=f"the reference's method (default {REF_METHOD})")
+    ap.add_argument("--tols", default=",".join(f"{t:g}" for t in PROJECT_TOLS),
+                    help="this project's tolerances, loosest first (stops once the finest level is reached)")
+    ap.add_argument("--budget", type=float, default=300.0, help=f"CPU seconds for {peer} per point (default 300)")
+    ap.add_argument("--ref-tol", type=float, default=REF_TOL,
+                    help=f"tolerance of the reference run (default {REF_TOL:g}; cached per tolerance)")
+    ap.add_argument("--no-reference", action="store_true",
+                    help="the peer's runs only (no reference, no runs of this project; the peer stops at its snap)")
+
+
+def apply_arguments(a):
+    """Set the module's reference and accuracy settings from :func:`add_arguments`' options;
+    returns (the N, the c, this project's tolerances) as lists."""
+    global REF_TOL, REF_METHOD, CRITERION, LEVELS
+    REF_TOL, REF_METHOD, CRITERION = a.ref_tol, a.ref_method.lower(), a.peak
+    LEVELS = tuple(sorted((float(x) for x in a.levels.split(",") if x), reverse=True))
+    return ([int(x) for x in a.N.split(",") if x], [float(x) for x in a.c.split(",") if x],
+            [float(x) for x in a.tols.split(",") if x])
+
+
 def machine(peer_pkg: str) -> None:
     try:
         from bench_simulate import print_machine

@@ -185,37 +185,15 @@ def compare(chi, N, c, dts, method, budget, tols=E.PROJECT_TOLS, project_budget=
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--chi", type=float, default=0.25, help="end separation / length (default 0.25)")
-    ap.add_argument("--N", default="100", help="links, comma-separated (default 100)")
-    ap.add_argument("--c", default="30", help="wave speeds c/sqrt(gL), comma-separated (default 30)")
+    E.add_arguments(ap, "PyElastica")
     ap.add_argument("--dt", default="",
                     help="PyElastica's steps, comma-separated (default: the axial limit 0.8 h/c, then halved "
                          "--halvings times); B follows each step")
     ap.add_argument("--halvings", type=int, default=3, help="default steps: the axial limit halved this many times")
-    ap.add_argument("--method", default="dop853,rodas4",
-                    help="this project's methods, comma-separated (names of elastic.METHODS; default dop853,rodas4)")
-    ap.add_argument("--start", default="stretched", choices=E.STARTS,
-                    help="the start every code is given (default stretched; matched: no release wave)")
-    ap.add_argument("--peak", default="v", choices=("v", "sigma", "both"),
-                    help="which peak decides 'within eps': the speed, the tension or both (default v)")
-    ap.add_argument("--levels", default=",".join(f"{x:g}" for x in E.LEVELS),
-                    help="the accuracy levels eps, comma-separated (default 1e-3,1e-4)")
-    ap.add_argument("--ref-method", default=E.REF_METHOD, help=f"the reference's method (default {E.REF_METHOD})")
-    ap.add_argument("--tols", default=",".join(f"{t:g}" for t in E.PROJECT_TOLS),
-                    help="this project's tolerances, loosest first (stops once the finest level is reached)")
-    ap.add_argument("--budget", type=float, default=300.0, help="CPU seconds for PyElastica per point (default 300)")
-    ap.add_argument("--ref-tol", type=float, default=E.REF_TOL,
-                    help=f"tolerance of the reference run (default {E.REF_TOL:g}; cached per tolerance)")
-    ap.add_argument("--no-reference", action="store_true",
-                    help="the peer's runs only (no reference, no runs of this project; the peer stops at its snap)")
     ap.add_argument("--quick", action="store_true", help="N = 20, c = 10, two steps (h/(20 c), h/(40 c)): seconds")
     a = ap.parse_args(argv)
     sys.stdout.reconfigure(line_buffering=True)
-    E.REF_TOL, E.REF_METHOD, E.CRITERION = a.ref_tol, a.ref_method.lower(), a.peak
-    E.LEVELS = tuple(sorted((float(x) for x in a.levels.split(",") if x), reverse=True))
-    Ns = [int(x) for x in a.N.split(",") if x]
-    cs = [float(x) for x in a.c.split(",") if x]
-    tols = [float(x) for x in a.tols.split(",") if x]
+    Ns, cs, tols = E.apply_arguments(a)
     quick_dts = []
     if a.quick:  # c = 10: a rod soft enough in bending (B ~ 1e-4) at steps of 1e-4
         Ns, cs, tols, a.method = [20], [10.0], [1e-4, 1e-6], "dop853"
