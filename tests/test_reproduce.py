@@ -105,7 +105,7 @@ def _cells(text: str, claim_start: str) -> list[str]:
 
 def test_report_verdicts_follow_from_the_numbers_in_their_rows(tiny):
     """The verdict of each computed claim is recomputed here from the numbers printed in its row."""
-    from snapping import reproduce as R
+    from snapping import reproduce_verdicts as R
 
     text = tiny[1]
     num = r"([-+0-9.e]+)"
@@ -146,7 +146,7 @@ def test_report_verdicts_follow_from_the_numbers_in_their_rows(tiny):
 
 
 def test_verdict_rules_on_the_papers_own_numbers():
-    from snapping import reproduce as R
+    from snapping import reproduce_verdicts as R
 
     # Fig. 4 as the paper describes it (chi = 0.1, N = 5000): delta_kappa_m v, a excellent, sigma x2
     assert R.delta_verdict("delta_kappa_m", [dict(v=0.98, a=0.94, sigma=1.95)]).startswith("agrees")
