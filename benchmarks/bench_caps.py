@@ -19,7 +19,9 @@ difference over every run of the answer (ideal, full, each alone), the capping m
 each, the graded levels (links) and the answer's error estimate where graded, and which runs
 RODAS4 took; for the nylon line the full run's tension against its converged value
 (``NYLON_T``: levels of 535, 1054 and 2091 graded links by DOP853, tol 1e-6, undamped, order 2.0).
-``--after-only`` skips the before answers.
+``--after-only`` skips the before answers. ``--order LINE`` instead runs LINE's full model on
+graded levels 0, 1, 2 (:meth:`snapping.caps_runs.Runs.graded`) and prints the observed order of
+each peak and the extrapolations from levels 0-1 (what :func:`snapping.caps.cap` answers) and 1-2.
 
 Usage::
 
@@ -53,6 +55,30 @@ def _graded(r: dict) -> str:
     return f"{g['levels'][0]}/{g['levels'][1]} (T +- {g['relative_error']['sigma_peak']:.2%})"
 
 
+def _order(name: str, chi: float) -> int:
+    """Graded levels 0, 1, 2 of the full model: observed order, extrapolations 0-1 and 1-2."""
+    import math
+
+    from snapping import caps_runs
+
+    sp = caps.spec(name)
+    runs = caps_runs.Runs(sp, chi, 1e-6, caps_runs.STIFF_TOL, caps_runs.GRID_DAMPING)
+    on = tuple(m for m in caps.MECHANISMS[:-1] if sp.has(m))
+    lv = [runs.graded(on, k) for k in (0, 1, 2)]
+    si = [caps._si(sp, x) for x in lv]
+    print(f"{name}, chi = {chi:g}: graded levels {[x['links'] for x in lv]} links, evaluations "
+          f"{[x['n_rhs'] for x in lv]}, CPU s {[round(x['cpu'], 2) for x in lv]}; load {os.getloadavg()[0]:.1f}")
+    for q in caps.QUANTITIES:
+        v = [x[q] for x in si]
+        p_obs = math.log2(abs((v[1] - v[0]) / (v[2] - v[1])))
+        e01, e12 = caps_runs.richardson(v[0], v[1]), caps_runs.richardson(v[1], v[2])
+        print(f"  {q}: levels {v[0]:.6g}, {v[1]:.6g}, {v[2]:.6g}; observed order {p_obs:.2f}; extrapolated "
+              f"0-1 {e01[0]:.6g} +- {e01[1]:.2g}, 1-2 {e12[0]:.6g} +- {e12[1]:.2g}")
+    if name == "nylon-monofilament":
+        print(f"  converged (DOP853, undamped, 535/1054/2091 links): T {NYLON_T} +- {NYLON_T_ERR} N, v {NYLON_V} m/s")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--N", nargs="+", type=int, default=[100, 200, 400, 1000])
@@ -60,7 +86,10 @@ def main(argv=None) -> int:
     p.add_argument("--chi", type=float, default=0.25)
     p.add_argument("--after-only", action="store_true")
     p.add_argument("--before", choices=("uniform", "undamped"), default="uniform")
+    p.add_argument("--order", choices=lines.names(), help="verify the graded levels' order on this line")
     a = p.parse_args(argv)
+    if a.order:
+        return _order(a.order, a.chi)
     before_kw = {"graded": False} if a.before == "uniform" else {"graded": False, "damping": 0.0}
     caps.cap("bungee-cord", a.chi, N=12)  # compile the kernels (both methods)
     caps.cap("bungee-cord", a.chi, N=12, damping=0.0)

@@ -41,6 +41,10 @@ def test_rule_takes_grading_for_nylon_like_numbers_only():
     runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.25, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 100, ["bending", "drag"], "auto")
     assert g["used"] and g["collapse"] >= math.pi / 2 and [x["run"] for x in runs.log] == ["drag"]
+    # a bending length far below the nylon line's: graded links too many, the uniform answer said unresolved
+    runs = caps_runs.Runs(caps.spec(None, length=2.0, mass=0.1, ei=1e-9, diameter=0.05), 0.3, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 16, ["bending", "drag"], "auto")
+    assert not g["used"] and g["too_fine"] > caps_runs.MAX_GRADED_LINKS and "NOT resolved" in g["why"]
 
 
 def test_graded_answer_matches_direct_runs_and_their_extrapolation():

@@ -286,6 +286,14 @@ def _grading(runs: Runs, N: int, present: list, graded) -> dict:
     if 0.0 < lb < GRADE_LINKS / N:
         kh = runs.get(tuple(m for m in present if m != "bending"), N)["kappa_peak"] / N
     used, why = grading_rule(lb, 1.0 / N, kh)
+    if used:
+        from .caps_runs import MAX_GRADED_LINKS, graded_h
+
+        n = graded_h(runs.chi, lb, 1).size
+        if n > MAX_GRADED_LINKS:
+            return {"used": False, "bending_length": lb, "collapse": kh, "too_fine": n,
+                    "why": f"{why}; but its finer level would need {n} links (> {MAX_GRADED_LINKS}): answered on "
+                           f"{N} uniform links, where the fold is NOT resolved"}
     return {"used": used, "why": why, "bending_length": lb, "collapse": kh}
 
 
@@ -447,6 +455,8 @@ def format_answer(r: dict) -> list[str]:
         out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
                    f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
     g = r.get("graded", {})
+    if g.get("too_fine"):
+        out.append(f"  graded links: {g['why']}")
     if g.get("used"):
         out.append(f"  graded links: {g['why']}; full run on {g['levels'][0]} and {g['levels'][1]} links, "
                    f"extrapolated (order {g['order']:g}): " + ", ".join(

@@ -21,7 +21,7 @@ import time
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
            "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
-           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "grading_rule"]
+           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule"]
 
 #: links of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -147,6 +147,9 @@ GRADE_LINKS = 20.0
 #: at least this (pi/2: folded past a right angle at one node; the nylon line's drag alone: pi at N >= 200,
 #: 2.3 at 100; every other catalogue line's run without bending: at most 0.7, falling as 1/N)
 COLLAPSE = 1.5707963267948966
+#: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
+#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
+MAX_GRADED_LINKS = 2500
 
 
 def grading_rule(lb: float, h_tip: float, kappa_h=None) -> tuple[bool, str]:
@@ -176,8 +179,8 @@ def richardson(coarse: float, fine: float, order: float = GRADED_ORDER, ratio: f
     ``order``: ``fine + (fine - coarse)/(ratio^order - 1)``; the error estimate is that correction
     (the finer level's own error, a bound on the extrapolation's once the order holds).
 
-    >>> richardson(1.0 + 0.04, 1.0 + 0.01)      # 1 + c h^2 at h = 0.2, 0.1
-    (1.0, 0.01)
+    >>> [round(x, 12) for x in richardson(1.0 + 0.04, 1.0 + 0.01)]      # 1 + c h^2 at h = 0.2, 0.1
+    [1.0, 0.01]
     """
     d = (fine - coarse) / (ratio ** order - 1.0)
     return fine + d, abs(d)
