@@ -41,6 +41,11 @@ def test_rule_takes_grading_for_nylon_like_numbers_only():
     runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.25, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 100, ["bending", "drag"], "auto")
     assert g["used"] and g["collapse"] >= math.pi / 2 and [x["run"] for x in runs.log] == ["drag"]
+    # at chi = 0.1 drag alone keeps its fold above the links, but the full run's folds onto one link
+    runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.1, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 200, ["bending", "drag"], "auto")
+    assert g["used"] and g["collapse_run"] == "with bending" and g["collapse"] >= math.pi / 2
+    assert [x["run"] for x in runs.log] == ["drag", "bending+drag"]
     # a bending length far below the nylon line's: graded links too many, the uniform answer said unresolved
     runs = caps_runs.Runs(caps.spec(None, length=2.0, mass=0.1, ei=1e-9, diameter=0.05), 0.3, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 16, ["bending", "drag"], "auto")

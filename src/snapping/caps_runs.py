@@ -152,12 +152,13 @@ COLLAPSE = 1.5707963267948966
 MAX_GRADED_LINKS = 2500
 
 
-def grading_rule(lb: float, h_tip: float, kappa_h=None) -> tuple[bool, str]:
+def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without bending") -> tuple[bool, str]:
     """``(graded, why)``: whether an answer needs graded links (:meth:`Runs.graded`) rather than
     uniform links of length ``h_tip`` (nondimensional) at the free end. Graded when bending holds
     the fold and the links cannot: the bending length ``lb`` (:func:`bending_length`; 0: none) is
-    under :data:`GRADE_LINKS` links, and the run without bending folds onto one link,
-    ``kappa_h`` (its curvature peak times ``h_tip``; None: not run) at least :data:`COLLAPSE`.
+    under :data:`GRADE_LINKS` links, and a run on those links folds onto one link, ``kappa_h`` (its
+    curvature peak times ``h_tip``; None: not run) at least :data:`COLLAPSE` -- the run ``where``
+    (without bending: nothing else holds the fold; or with it: its fold is below the links).
 
     >>> grading_rule(1e-3, 1e-3, 3.14)[0], grading_rule(0.0, 1e-3, 3.14)[0], grading_rule(1e-3, 1e-3, 0.5)[0]
     (True, False, False)
@@ -167,9 +168,9 @@ def grading_rule(lb: float, h_tip: float, kappa_h=None) -> tuple[bool, str]:
     if lb >= GRADE_LINKS * h_tip:
         return False, f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (>= {GRADE_LINKS:g}): resolved"
     if kappa_h is None or kappa_h < COLLAPSE:
-        return False, ("without bending the fold stays above the link scale (curvature peak x link "
+        return False, ("with and without bending the fold stays above the link scale (curvature peak x link "
                        f"{kappa_h if kappa_h is not None else float('nan'):.3g} < pi/2): the links resolve what caps it")
-    return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and without bending "
+    return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
                   f"the fold collapses onto one link (curvature peak x link {kappa_h:.3g} >= pi/2): bending sets the "
                   f"fold, graded links resolve it")
 
