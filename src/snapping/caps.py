@@ -456,7 +456,9 @@ def format_answer(r: dict) -> list[str]:
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
             f"{m} {v[r['quantity']]:.5g}" for m, v in r["alone"].items()))
     out.append(f"  stretching: {r['stretching']['why']}")
-    if r.get("auto_N"):
+    if r.get("auto_N") and r.get("graded", {}).get("used"):
+        out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each mechanism alone")
+    elif r.get("auto_N"):
         out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
                    f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
     g = r.get("graded", {})
