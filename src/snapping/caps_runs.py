@@ -127,16 +127,17 @@ def graded_h(chi: float, lb: float, level: int) -> "np.ndarray":
     """The links of graded level ``level`` (0 or 1) of a line whose bending length is ``lb``
     (nondimensional, :func:`bending_length`): ``grading.fold_following`` with the links along the
     fold's path at most :data:`FOLD_LINK` lb, :data:`TIP_LINK` lb at the free end and
-    :data:`HELD_LINK` lb on the held arm, all halved on level 1 (the nylon line at chi 0.25: 535
-    and 1054 links)."""
+    :data:`HELD_LINK` lb on the held arm (each at most 0.5 L, the fold's at most half its radius),
+    all halved on level 1 (the nylon line: 545 and 1072 links, at every chi)."""
     from . import estimates
     from .simulate import grading
 
     k = 0.5 ** int(level)
     a = estimates.catenary_parameter(chi)
-    h_max = min(0.5, HELD_LINK * lb * k)
-    h_min = min(h_max, TIP_LINK * lb * k)
-    return grading.fold_following(chi, frac=min(0.5, FOLD_LINK * lb * k / a), h_min=h_min, h_max=h_max)
+    h_max = min(0.5, HELD_LINK * lb)  # level 0's, capped before the halving: the levels stay halvings
+    h_min = min(h_max, TIP_LINK * lb)
+    frac = min(0.5, FOLD_LINK * lb / a)
+    return grading.fold_following(chi, frac=frac * k, h_min=h_min * k, h_max=h_max * k)
 
 
 #: graded links are used when the bending length is under this many links at the free end (uniform links
@@ -145,7 +146,8 @@ def graded_h(chi: float, lb: float, level: int) -> "np.ndarray":
 GRADE_LINKS = 20.0
 #: ... and without bending the fold collapses onto one link: the curvature peak times the free end's link
 #: at least this (pi/2: folded past a right angle at one node; the nylon line's drag alone: pi at N >= 200,
-#: 2.3 at 100; every other catalogue line's run without bending: at most 0.7, falling as 1/N)
+#: 2.3 at 100; every other catalogue line's run without bending: at most 0.7 at N >= 100, falling as 1/N;
+#: at N = 20 they reach 1.2-2.2, and the bungee cord's, 0.8 links per bending length, is graded there)
 COLLAPSE = 1.5707963267948966
 #: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
 #: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
