@@ -18,6 +18,12 @@ waves grid-damped, :func:`snapping.caps_runs.method_for`):
 * **each mechanism alone** (``bending``, ``drag``, ``end-mass``, ``taper``: those the line
   has), the others switched off.
 
+**Graded links** (``graded="auto"``): when bending holds a fold the N links cannot resolve
+(:func:`snapping.caps_runs.grading_rule`: the bending length under 20 links, a run on them folded
+onto one link), the full run is made on two levels of links graded to the free end in bending
+lengths and extrapolated at order 2, with an error estimate per peak (the nylon line: 545 and 1072
+links, its tension within 0.11% of the converged value, estimate 0.55%).
+
 **Stretching** is the elastic model (:func:`snapping.simulate.elastic.solve`), which has no
 bending or drag; it is run when EA is given and matters: when the ideal run's peak speed
 reaches ``STRETCH_MATTERS`` = 5% of the longitudinal wave speed c = sqrt(EA/lambda) (the
