@@ -70,6 +70,7 @@ from dataclasses import dataclass, replace
 from . import _validate as V
 from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO, STIFF_TOL, STRETCH_N,  # noqa: F401
                         Runs, bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
+from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
@@ -276,36 +277,6 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
     r.update({"runs": runs.log, "n_rhs": sum(x["n_rhs"] for x in runs.log), "wall": time.perf_counter() - t0,
               "cpu": time.process_time() - c0})
     return r
-
-
-def _grading(runs: Runs, N: int, present: list, graded) -> dict:
-    """Whether the answer on ``N`` links takes graded links (:func:`snapping.caps_runs.grading_rule`):
-    only when the bending length is under ``GRADE_LINKS`` links, the run without bending on N links,
-    and when its fold does not collapse, the full run on N links (the uniform answer's own)."""
-    from .caps_runs import COLLAPSE, GRADE_LINKS
-
-    if graded is False or "bending" not in present:
-        return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
-    lb = bending_length(runs.sp)
-    if graded is True:
-        return {"used": lb > 0.0, "why": "graded=True", "bending_length": lb}
-    kh, where = None, "without bending"
-    if 0.0 < lb < GRADE_LINKS / N:
-        kh = runs.get(tuple(m for m in present if m != "bending"), N)["kappa_peak"] / N
-        if kh < COLLAPSE:  # the full run (made anyway when not graded): its fold below the links?
-            kf = runs.get(tuple(present), N)["kappa_peak"] / N
-            if kf >= COLLAPSE:
-                kh, where = kf, "with bending"
-    used, why = grading_rule(lb, 1.0 / N, kh, where)
-    if used:
-        from .caps_runs import MAX_GRADED_LINKS, graded_h
-
-        n = graded_h(runs.chi, lb, 1).size
-        if n > MAX_GRADED_LINKS:
-            return {"used": False, "bending_length": lb, "collapse": kh, "collapse_run": where, "too_fine": n,
-                    "why": f"{why}; but its finer level would need {n} links (> {MAX_GRADED_LINKS}): answered on "
-                           f"{N} uniform links, where the fold is NOT resolved"}
-    return {"used": used, "why": why, "bending_length": lb, "collapse": kh, "collapse_run": where}
 
 
 def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded="auto") -> dict:

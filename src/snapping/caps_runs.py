@@ -21,7 +21,7 @@ import time
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
            "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
-           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule"]
+           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule", "grading_for"]
 
 #: links of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -175,6 +175,33 @@ def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without be
     return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
                   f"the fold collapses onto one link (curvature peak x link {kappa_h:.3g} >= pi/2): bending sets the "
                   f"fold, graded links resolve it")
+
+
+def grading_for(runs, N: int, present: list, graded="auto") -> dict:
+    """Whether the answer of :class:`Runs` ``runs`` on ``N`` links takes graded links
+    (:func:`grading_rule`; ``present``: the line's mechanisms; ``graded``: "auto", True or False):
+    only when the bending length is under :data:`GRADE_LINKS` links, the run without bending on N
+    links, and when its fold does not collapse, the full run on N links (the uniform answer's own)."""
+    if graded is False or "bending" not in present:
+        return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
+    lb = bending_length(runs.sp)
+    if graded is True:
+        return {"used": lb > 0.0, "why": "graded=True", "bending_length": lb}
+    kh, where = None, "without bending"
+    if 0.0 < lb < GRADE_LINKS / N:
+        kh = runs.get(tuple(m for m in present if m != "bending"), N)["kappa_peak"] / N
+        if kh < COLLAPSE:  # the full run (made anyway when not graded): its fold below the links?
+            kf = runs.get(tuple(present), N)["kappa_peak"] / N
+            if kf >= COLLAPSE:
+                kh, where = kf, "with bending"
+    used, why = grading_rule(lb, 1.0 / N, kh, where)
+    if used:
+        n = graded_h(runs.chi, lb, 1).size
+        if n > MAX_GRADED_LINKS:
+            return {"used": False, "bending_length": lb, "collapse": kh, "collapse_run": where, "too_fine": n,
+                    "why": f"{why}; but its finer level would need {n} links (> {MAX_GRADED_LINKS}): answered on "
+                           f"{N} uniform links, where the fold is NOT resolved"}
+    return {"used": used, "why": why, "bending_length": lb, "collapse": kh, "collapse_run": where}
 
 
 def richardson(coarse: float, fine: float, order: float = GRADED_ORDER, ratio: float = 2.0) -> tuple[float, float]:
