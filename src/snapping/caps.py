@@ -68,8 +68,8 @@ import time
 from dataclasses import dataclass, replace
 
 from . import _validate as V
-from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO, STIFF_TOL, STRETCH_N,  # noqa: F401
-                        Runs, bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
+from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO,  # noqa: F401
+                        STIFF_TOL, STRETCH_N, Runs, bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
 from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
@@ -434,7 +434,8 @@ def format_answer(r: dict) -> list[str]:
             f"{m} {v[r['quantity']]:.5g}" for m, v in r["alone"].items()))
     out.append(f"  stretching: {r['stretching']['why']}")
     if r.get("auto_N") and r.get("graded", {}).get("used"):
-        out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each mechanism alone")
+        out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each "
+                   f"mechanism alone")
     elif r.get("auto_N"):
         out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
                    f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")

@@ -21,7 +21,8 @@ import time
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
            "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
-           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule", "grading_for"]
+           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
+           "grading_for"]
 
 #: links of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -170,8 +171,9 @@ def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without be
     if lb >= GRADE_LINKS * h_tip:
         return False, f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (>= {GRADE_LINKS:g}): resolved"
     if kappa_h is None or kappa_h < COLLAPSE:
-        return False, ("with and without bending the fold stays above the link scale (curvature peak x link "
-                       f"{kappa_h if kappa_h is not None else float('nan'):.3g} < pi/2): the links resolve what caps it")
+        kh = kappa_h if kappa_h is not None else float("nan")
+        return False, (f"with and without bending the fold stays above the link scale (curvature peak x link "
+                       f"{kh:.3g} < pi/2): the links resolve what caps it")
     return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
                   f"the fold collapses onto one link (curvature peak x link {kappa_h:.3g} >= pi/2): bending sets the "
                   f"fold, graded links resolve it")
