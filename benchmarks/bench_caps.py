@@ -1,26 +1,32 @@
 """The cost of a design answer for a real line (issue 24's target: at most 10 s of CPU for
-100-1000 links, the peaks to 1%), before and after the stiff runs' rule of
-:func:`snapping.caps.method_for`.
+100-1000 links, the peaks to 1%), and what the graded links and the stiff runs' rule change.
 
 For every catalogue line and each N: :func:`snapping.caps.cap` (chi 0.25, the N/2 check, each
 mechanism alone) twice:
 
-* **before**: ``damping=0`` -- every run by the fast method (DOP853, tol 1e-6), undamped: the
-  answers as they were made before the rule (the reference: DOP853 at 1e-6 is within 1e-6 of
+* **before** (``--before uniform``, the default): ``graded=False`` -- every run on N uniform links,
+  the answers as they were made before the graded links (:func:`snapping.caps_runs.grading_rule`);
+  ``--before undamped``: also ``damping=0``, every run by the fast method (DOP853, tol 1e-6),
+  undamped: the answers as they were before the stiff runs' rule (DOP853 at 1e-6 is within 1e-6 of
   DOP853 at 1e-8 in these peaks);
-* **after**: the default -- the runs whose bending waves would hold DOP853 to more than
-  ``STIFF_RATIO`` times its accuracy-limited steps by RODAS4 at ``STIFF_TOL`` with those waves
-  grid-damped, the others as before (bit for bit).
+* **after**: the default -- graded links where the rule takes them (the nylon line), the runs whose
+  bending waves would hold DOP853 to more than ``STIFF_RATIO`` times its accuracy-limited steps by
+  RODAS4 at ``STIFF_TOL`` with those waves grid-damped, the others as before (bit for bit).
 
-It prints, per line and N: CPU seconds and right-hand-side evaluations of each answer, the
-real answer's peaks of each and their largest relative difference (the 1% check), the largest
-difference over every run of the answer (ideal, full, each alone, the N/2 check), the capping
-mechanism of each, and which runs RODAS4 took. ``--after-only`` skips the (slow) before answers.
+It prints, per line and N: CPU seconds and right-hand-side evaluations of each answer, the real
+answer's tension of each and the largest relative difference of its peaks, the largest
+difference over every run of the answer (ideal, full, each alone), the capping mechanism of
+each, the graded levels (links) and the answer's error estimate where graded, and which runs
+RODAS4 took; for the nylon line the full run's tension against its converged value
+(``NYLON_T``: levels of 535, 1054 and 2091 graded links by DOP853, tol 1e-6, undamped, order 2.0).
+``--after-only`` skips the before answers. ``--order LINE`` instead runs LINE's full model on
+graded levels 0, 1, 2 (:meth:`snapping.caps_runs.Runs.graded`) and prints the observed order of
+each peak and the extrapolations from levels 0-1 (what :func:`snapping.caps.cap` answers) and 1-2.
 
 Usage::
 
     python benchmarks/bench_caps.py                      # N = 100 200 400 1000, every line
-    python benchmarks/bench_caps.py --N 1000 --lines bullwhip bungee-cord
+    python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
 """
 
 from __future__ import annotations
@@ -30,13 +36,47 @@ import os
 
 from snapping import caps, lines
 
+#: the nylon line's converged peak tension at chi 0.25 (N), its error bar, and speed (m/s)
+NYLON_T, NYLON_T_ERR, NYLON_V = 0.009656, 0.000016, 21.568
+
 
 def _peaks(r: dict) -> dict:
-    """Every run's peaks of an answer, nondimensional keys: (what, quantity) -> SI value."""
+    """Every run's peaks of an answer: (what, quantity) -> SI value."""
     out = {("real", q): v for q, v in r["real"].items()}
     for m, pk in r["alone"].items():
         out.update({(m, q): v for q, v in pk.items()})
     return out
+
+
+def _graded(r: dict) -> str:
+    g = r["graded"]
+    if not g.get("used"):
+        return "-"
+    return f"{g['levels'][0]}/{g['levels'][1]} (T +- {g['relative_error']['sigma_peak']:.2%})"
+
+
+def _order(name: str, chi: float) -> int:
+    """Graded levels 0, 1, 2 of the full model: observed order, extrapolations 0-1 and 1-2."""
+    import math
+
+    from snapping import caps_runs
+
+    sp = caps.spec(name)
+    runs = caps_runs.Runs(sp, chi, 1e-6, caps_runs.STIFF_TOL, caps_runs.GRID_DAMPING)
+    on = tuple(m for m in caps.MECHANISMS[:-1] if sp.has(m))
+    lv = [runs.graded(on, k) for k in (0, 1, 2)]
+    si = [caps._si(sp, x) for x in lv]
+    print(f"{name}, chi = {chi:g}: graded levels {[x['links'] for x in lv]} links, evaluations "
+          f"{[x['n_rhs'] for x in lv]}, CPU s {[round(x['cpu'], 2) for x in lv]}; load {os.getloadavg()[0]:.1f}")
+    for q in caps.QUANTITIES:
+        v = [x[q] for x in si]
+        p_obs = math.log2(abs((v[1] - v[0]) / (v[2] - v[1])))
+        e01, e12 = caps_runs.richardson(v[0], v[1]), caps_runs.richardson(v[1], v[2])
+        print(f"  {q}: levels {v[0]:.6g}, {v[1]:.6g}, {v[2]:.6g}; observed order {p_obs:.2f}; extrapolated "
+              f"0-1 {e01[0]:.6g} +- {e01[1]:.2g}, 1-2 {e12[0]:.6g} +- {e12[1]:.2g}")
+    if name == "nylon-monofilament":
+        print(f"  converged (DOP853, undamped, 535/1054/2091 links): T {NYLON_T} +- {NYLON_T_ERR} N, v {NYLON_V} m/s")
+    return 0
 
 
 def main(argv=None) -> int:
@@ -45,34 +85,45 @@ def main(argv=None) -> int:
     p.add_argument("--lines", nargs="+", default=lines.names(), choices=lines.names())
     p.add_argument("--chi", type=float, default=0.25)
     p.add_argument("--after-only", action="store_true")
+    p.add_argument("--before", choices=("uniform", "undamped"), default="uniform")
+    p.add_argument("--order", choices=lines.names(), help="verify the graded levels' order on this line")
     a = p.parse_args(argv)
+    if a.order:
+        return _order(a.order, a.chi)
+    before_kw = {"graded": False} if a.before == "uniform" else {"graded": False, "damping": 0.0}
     caps.cap("bungee-cord", a.chi, N=12)  # compile the kernels (both methods)
     caps.cap("bungee-cord", a.chi, N=12, damping=0.0)
-    print(f"chi = {a.chi:g}; load {os.getloadavg()[0]:.1f}\n")
+    caps.cap("nylon-monofilament", a.chi, N=8, check=False, alone=False, graded=False)
+    print(f"chi = {a.chi:g}; before = {before_kw}; load {os.getloadavg()[0]:.1f}\n")
     print("| line | N | CPU s before | CPU s after | evaluations before | evaluations after | T before (N) | "
-          "T after (N) | v, a, T: largest change | every run: largest change | cap before / after | "
+          "T after (N) | v, a, T: largest change | every run: largest change | cap before / after | graded levels | "
           "RODAS4 runs |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for N in a.N:
         for name in a.lines:
             after = caps.cap(name, a.chi, N=N)
             stiff = [f"{x['run']}@{x['N']}" for x in after["runs"] if x["method"] == "rodas4"]
+            note = ""
+            if name == "nylon-monofilament":
+                f = after["full"]
+                note = (f"  (nylon: full run T {f['sigma_peak']:.6g} N, {f['sigma_peak'] / NYLON_T - 1:+.2%} from the "
+                        f"converged {NYLON_T:g} +- {NYLON_T_ERR:g}; v {f['v_peak']:.5g} m/s, "
+                        f"{f['v_peak'] / NYLON_V - 1:+.2%} from {NYLON_V:g}; load {os.getloadavg()[0]:.1f})")
             if a.after_only:
                 print(f"| {name} | {N} | - | {after['cpu']:.2f} | - | {after['n_rhs']} | - | "
-                      f"{after['real']['sigma_peak']:.5g} | - | - | {after['cap']} | {', '.join(stiff) or '-'} |",
-                      flush=True)
-                continue
-            before = caps.cap(name, a.chi, N=N, damping=0.0)
-            pb, pa = _peaks(before), _peaks(after)
-            real = max(abs(pa[("real", q)] / pb[("real", q)] - 1.0) for q in caps.QUANTITIES)
-            every = max(abs(pa[k] / pb[k] - 1.0) for k in pb)
-            res = {k: abs(after["resolution"][k] - before["resolution"][k]) for k in caps.QUANTITIES}
-            print(f"| {name} | {N} | {before['cpu']:.2f} | {after['cpu']:.2f} | {before['n_rhs']} | "
-                  f"{after['n_rhs']} | {before['real']['sigma_peak']:.5g} | {after['real']['sigma_peak']:.5g} | "
-                  f"{real:.2%} | {every:.2%} | {before['cap']} / {after['cap']} | {', '.join(stiff) or '-'} |",
-                  flush=True)
-            if max(res.values()) > 0.01:
-                print(f"  (the N/2 check moved by {max(res.values()):.2%})")
+                      f"{after['real']['sigma_peak']:.5g} | - | - | {after['cap']} | {_graded(after)} | "
+                      f"{', '.join(stiff) or '-'} |", flush=True)
+            else:
+                before = caps.cap(name, a.chi, N=N, **before_kw)
+                pb, pa = _peaks(before), _peaks(after)
+                real = max(abs(pa[("real", q)] / pb[("real", q)] - 1.0) for q in caps.QUANTITIES)
+                every = max(abs(pa[k] / pb[k] - 1.0) for k in pb)
+                print(f"| {name} | {N} | {before['cpu']:.2f} | {after['cpu']:.2f} | {before['n_rhs']} | "
+                      f"{after['n_rhs']} | {before['real']['sigma_peak']:.5g} | {after['real']['sigma_peak']:.5g} | "
+                      f"{real:.2%} | {every:.2%} | {before['cap']} / {after['cap']} | {_graded(after)} | "
+                      f"{', '.join(stiff) or '-'} |", flush=True)
+            if note:
+                print(note, flush=True)
     print(f"\nload {os.getloadavg()[0]:.1f}")
     return 0
 

@@ -50,7 +50,13 @@ def catalogue(chi: float = 0.25, N: int = 200, *, tol: float = 1e-6, check: bool
 
 
 def resolved_words(r: dict) -> str:
-    """The resolution verdict of one answer (its tension from N/2 to N)."""
+    """The resolution verdict of one answer (its tension from N/2 to N; on graded links, the
+    extrapolation's error estimate)."""
+    g = r.get("graded") or {}
+    if g.get("used"):
+        e = g["relative_error"]["sigma_peak"]
+        return (f"{'resolved' if e <= RESOLVED else f'not resolved to {RESOLVED:.0%}'} on graded links "
+                f"({g['levels'][0]}/{g['levels'][1]}, extrapolated: +-{e:.1%})")
     res = r.get("resolution")
     if not res:
         return "not checked"
@@ -152,7 +158,7 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
         who = ("nothing but the ideal chain's own cap" if r["cap"] == "none" else f"**{r['cap']}**")
         lines.append(f"- {r['line']}: capped by {who} at {r['real'][q]:.4g} N (ideal {r['ideal'][q]:.4g} N, "
                      f"factor {r['factor'][q]:.3f}); {resolved_words(r)}; stretching: {r['stretching']['why']}.")
-    n_res = sum(1 for r in answers if r.get("resolution") and abs(r["resolution"]["sigma_peak"]) <= RESOLVED)
+    n_res = sum(1 for r in answers if resolved_words(r).startswith("resolved"))
     capped = sorted({r["cap"] for r in answers if r["cap"] != "none"})
     lines += ["", f"**Verdict (computed): {len(answers) - sum(r['cap'] == 'none' for r in answers)} of "
                   f"{len(answers)} lines are capped below {LEVEL:g} of the ideal chain's peak tension (by "

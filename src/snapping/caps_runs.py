@@ -20,7 +20,9 @@ from __future__ import annotations
 import time
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
-           "STRETCH_N", "QUANTITIES", "MECHANISMS"]
+           "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
+           "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
+           "grading_for"]
 
 #: links of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -30,6 +32,16 @@ STIFF_TOL = 1e-4
 STIFF_RATIO = 10.0
 #: the damping ratio given to the stiff runs' fast waves (:func:`snapping.simulate.stiffness.grid_damping`)
 GRID_DAMPING = 1.0
+#: graded runs (:meth:`Runs.graded`): RODAS4's tolerance, the damping ratio of every node's shortest
+#: bending wave, and the order of convergence their Richardson extrapolation assumes (measured on the
+#: nylon line, chi 0.25, levels of 535, 1054 and 2091 links: 1.92 in the tension, 1.9 in the speed)
+GRADED_TOL = 1e-3
+GRADED_DAMPING = 0.01
+GRADED_ORDER = 2.0
+#: the coarser graded level, in bending lengths: links along the fold's path at most FOLD_LINK (at the
+#: fold's scale there, ``grading.fold_following``), at the free end TIP_LINK, the held arm HELD_LINK;
+#: the finer level halves them all
+FOLD_LINK, TIP_LINK, HELD_LINK = 1.5, 0.4, 20.0
 #: the peaks answered: (name, SI units)
 QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
 #: the mechanisms, in the order they are tried
@@ -37,11 +49,13 @@ MECHANISMS = ("bending", "drag", "end-mass", "taper", "stretching")
 
 
 def problem(sp, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
-            damping: float = 0.0, omega_min: float = 0.0):
+            damping: float = 0.0, omega_min: float = 0.0, h=None):
     """The catenary start of ``sp`` at ``chi`` on ``N`` links with the mechanisms ``on`` (the
     inextensible model's: stretching is not part of it); with bending, the grid damping of
     ratio ``damping`` on the waves faster than ``omega_min``
-    (:func:`snapping.simulate.stiffness.grid_damping`; 0: none)."""
+    (:func:`snapping.simulate.stiffness.grid_damping`; 0: none). ``h``: graded links instead
+    (nondimensional lengths, index 0 at the free end, :func:`graded_h`; masses lumped
+    ``"shared"``; ``N`` is then ignored)."""
     import numpy as np
 
     from .simulate import Body, Links, Problem
@@ -50,8 +64,11 @@ def problem(sp, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
     if "taper" in on and sp.has("taper"):
         ln, L = sp.line, sp.length
         lam = sp.mass / L
-        links = Links.from_density(np.full(N, 1.0 / N), lambda u: ln.mass_per_length * ln.ratio(L * (1.0 - u), L) ** 2
+        links = Links.from_density(np.full(N, 1.0 / N) if h is None else h,
+                                   lambda u: ln.mass_per_length * ln.ratio(L * (1.0 - u), L) ** 2
                                    / lam, tip_mass=tip, kind="line", params={"line": ln.name})
+    elif h is not None:
+        links = Links.graded(h, tip_mass=tip)
     else:
         links = Links.uniform(N, tip_mass=tip, lumping=lumping)
     kw = {}
@@ -92,6 +109,115 @@ def method_for(problem_, tol: float, stiff_tol: float = None) -> tuple[str, floa
     return "fast", tol, 0.0
 
 
+def bending_length(sp) -> float:
+    """The bending length at the free end over the line's length, nondimensional: ``sqrt(EI /
+    (lambda g L))/L`` with the free end's EI and mass per length (a taper's there), the length
+    over which bending holds a fold against tension of the order of the line's weight (the
+    nylon line: 1.0e-3, its snap's fold has radius 1.1e-3 L); 0 without bending there."""
+    import math
+
+    L = sp.length
+    ei = sp.ei(L) if callable(sp.ei) else sp.ei
+    lam = sp.mass / L
+    if sp.line is not None and sp.line.taper is not None:
+        lam = sp.line.mass_per_length * sp.line.ratio(0.0, L) ** 2
+    return math.sqrt(ei / (lam * sp.g * L)) / L if ei > 0.0 else 0.0
+
+
+def graded_h(chi: float, lb: float, level: int) -> "np.ndarray":
+    """The links of graded level ``level`` (0 or 1) of a line whose bending length is ``lb``
+    (nondimensional, :func:`bending_length`): ``grading.fold_following`` with the links along the
+    fold's path at most :data:`FOLD_LINK` lb, :data:`TIP_LINK` lb at the free end and
+    :data:`HELD_LINK` lb on the held arm (each at most 0.5 L, the fold's at most half its radius),
+    all halved on level 1 (the nylon line: 545 and 1072 links, at every chi)."""
+    from . import estimates
+    from .simulate import grading
+
+    k = 0.5 ** int(level)
+    a = estimates.catenary_parameter(chi)
+    h_max = min(0.5, HELD_LINK * lb)  # level 0's, capped before the halving: the levels stay halvings
+    h_min = min(h_max, TIP_LINK * lb)
+    frac = min(0.5, FOLD_LINK * lb / a)
+    return grading.fold_following(chi, frac=frac * k, h_min=h_min * k, h_max=h_max * k)
+
+
+#: graded links are used when the bending length is under this many links at the free end (uniform links
+#: converge at first order there: the nylon line's tension is still 6% off at 3 links per bending length,
+#: so 1% needs about 20) ...
+GRADE_LINKS = 20.0
+#: ... and without bending the fold collapses onto one link: the curvature peak times the free end's link
+#: at least this (pi/2: folded past a right angle at one node; the nylon line's drag alone: pi at N >= 200,
+#: 2.3 at 100; every other catalogue line's run without bending: at most 0.7 at N >= 100, falling as 1/N;
+#: at N = 20 they reach 1.2-2.2, and the bungee cord's, 0.8 links per bending length, is graded there)
+COLLAPSE = 1.5707963267948966
+#: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
+#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
+MAX_GRADED_LINKS = 2500
+
+
+def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without bending") -> tuple[bool, str]:
+    """``(graded, why)``: whether an answer needs graded links (:meth:`Runs.graded`) rather than
+    uniform links of length ``h_tip`` (nondimensional) at the free end. Graded when bending holds
+    the fold and the links cannot: the bending length ``lb`` (:func:`bending_length`; 0: none) is
+    under :data:`GRADE_LINKS` links, and a run on those links folds onto one link, ``kappa_h`` (its
+    curvature peak times ``h_tip``; None: not run) at least :data:`COLLAPSE` -- the run ``where``
+    (without bending: nothing else holds the fold; or with it: its fold is below the links).
+
+    >>> grading_rule(1e-3, 1e-3, 3.14)[0], grading_rule(0.0, 1e-3, 3.14)[0], grading_rule(1e-3, 1e-3, 0.5)[0]
+    (True, False, False)
+    """
+    if lb <= 0.0:
+        return False, "no bending at the free end (without it the links, not a continuum, set the fold)"
+    if lb >= GRADE_LINKS * h_tip:
+        return False, f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (>= {GRADE_LINKS:g}): resolved"
+    if kappa_h is None or kappa_h < COLLAPSE:
+        kh = kappa_h if kappa_h is not None else float("nan")
+        return False, (f"with and without bending the fold stays above the link scale (curvature peak x link "
+                       f"{kh:.3g} < pi/2): the links resolve what caps it")
+    return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
+                  f"the fold collapses onto one link (curvature peak x link {kappa_h:.3g} >= pi/2): bending sets the "
+                  f"fold, graded links resolve it")
+
+
+def grading_for(runs, N: int, present: list, graded="auto") -> dict:
+    """Whether the answer of :class:`Runs` ``runs`` on ``N`` links takes graded links
+    (:func:`grading_rule`; ``present``: the line's mechanisms; ``graded``: "auto", True or False):
+    only when the bending length is under :data:`GRADE_LINKS` links, the run without bending on N
+    links, and when its fold does not collapse, the full run on N links (the uniform answer's own)."""
+    if graded is False or "bending" not in present:
+        return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
+    lb = bending_length(runs.sp)
+    if graded is True:
+        return {"used": lb > 0.0, "why": "graded=True", "bending_length": lb}
+    kh, where = None, "without bending"
+    if 0.0 < lb < GRADE_LINKS / N:
+        kh = runs.get(tuple(m for m in present if m != "bending"), N)["kappa_peak"] / N
+        if kh < COLLAPSE:  # the full run (made anyway when not graded): its fold below the links?
+            kf = runs.get(tuple(present), N)["kappa_peak"] / N
+            if kf >= COLLAPSE:
+                kh, where = kf, "with bending"
+    used, why = grading_rule(lb, 1.0 / N, kh, where)
+    if used:
+        n = graded_h(runs.chi, lb, 1).size
+        if n > MAX_GRADED_LINKS:
+            return {"used": False, "bending_length": lb, "collapse": kh, "collapse_run": where, "too_fine": n,
+                    "why": f"{why}; but its finer level would need {n} links (> {MAX_GRADED_LINKS}): answered on "
+                           f"{N} uniform links, where the fold is NOT resolved"}
+    return {"used": used, "why": why, "bending_length": lb, "collapse": kh, "collapse_run": where}
+
+
+def richardson(coarse: float, fine: float, order: float = GRADED_ORDER, ratio: float = 2.0) -> tuple[float, float]:
+    """``(extrapolated, error)`` from two levels whose links differ by ``ratio``, converging at
+    ``order``: ``fine + (fine - coarse)/(ratio^order - 1)``; the error estimate is that correction
+    (the finer level's own error, a bound on the extrapolation's once the order holds).
+
+    >>> [round(x, 12) for x in richardson(1.0 + 0.04, 1.0 + 0.01)]      # 1 + c h^2 at h = 0.2, 0.1
+    [1.0, 0.01]
+    """
+    d = (fine - coarse) / (ratio ** order - 1.0)
+    return fine + d, abs(d)
+
+
 def _run(problem_, method: str, tol: float) -> dict:
     from .simulate import run
 
@@ -100,8 +226,8 @@ def _run(problem_, method: str, tol: float) -> dict:
     a = r.dataset.attrs
     if a.get("status") != "completed":
         raise RuntimeError(f"a run of the real model did not complete ({a.get('status')}: {a.get('stop_reason', '')})")
-    return {**{q: float(a[q]) for q in QUANTITIES}, "n_rhs": int(a["n_rhs"]), "method": str(a["method"]),
-            "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
+    return {**{q: float(a[q]) for q in QUANTITIES}, "kappa_peak": float(a["kappa_peak"]), "n_rhs": int(a["n_rhs"]),
+            "method": str(a["method"]), "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
 
 
 def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N) -> dict:
@@ -142,4 +268,21 @@ class Runs:
             self.done[key] = r
             self.log.append({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
                              "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
+        return self.done[key]
+
+    def graded(self, on, level: int) -> dict:
+        """The run with the mechanisms ``on`` on graded level ``level`` (:func:`graded_h`): RODAS4 at
+        :data:`GRADED_TOL`, every node's shortest bending wave damped at the ratio
+        :data:`GRADED_DAMPING` (it stops the release's ringing of the tiny links, which would hold
+        either method to tiny steps; its effect on the peaks vanishes as h^2 and is below 0.1% on
+        the finer nylon levels); made once."""
+        key = (tuple(on), "graded", int(level))
+        if key not in self.done:
+            h = graded_h(self.chi, bending_length(self.sp), level)
+            p = problem(self.sp, self.chi, h.size, on, damping=GRADED_DAMPING, omega_min=0.0, h=h)
+            r = _run(p, "rodas4", GRADED_TOL)
+            r["links"] = int(h.size)
+            self.done[key] = r
+            self.log.append({"run": ("+".join(on) or "ideal") + f" (graded {level})", "N": int(h.size),
+                             "method": r["method"], "tol": r["tol"], "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]

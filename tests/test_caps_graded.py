@@ -1,0 +1,82 @@
+"""Graded links in design answers (snapping.caps, snapping.caps_runs; issue 24): the rule that
+takes them, checked against the line's numbers computed by hand (the nylon line takes them, the
+ball chain does not), and the graded answer against direct runs of the same problem built here
+from the simulator's parts, with the two levels' extrapolation computed here. Small: ~2 s."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import pytest
+
+from snapping import caps, caps_runs, estimates
+from snapping.simulate import Body, Links, Problem, grading, run
+from snapping.simulate.stiffness import grid_damping
+
+# the nylon line's raw numbers (snapping.lines: 0.30 mm, 1140 kg/m^3, E = 2 GPa, 10 m)
+D, RHO, E, LN, G = 0.30e-3, 1140.0, 2.0e9, 10.0, 9.81
+
+
+def test_bending_length_of_the_nylon_line_by_hand():
+    # EI = E pi d^4/64, lambda = rho pi d^2/4: sqrt(EI/(lambda g L))/L = (d/4) sqrt(E/(rho g L))/L
+    lb = D / 4.0 * math.sqrt(E / (RHO * G * LN)) / LN
+    assert lb == pytest.approx(1.0030e-3, rel=1e-4)
+    assert caps_runs.bending_length(caps.spec("nylon-monofilament")) == pytest.approx(lb, rel=1e-12)
+    assert caps_runs.bending_length(caps.spec("ball-chain")) == 0.0
+
+
+def test_rule_takes_grading_for_nylon_like_numbers_only():
+    lb = D / 4.0 * math.sqrt(E / (RHO * G * LN)) / LN
+    for N in (100, 1000, 19000):  # under 20 links per bending length, the fold collapsing without bending
+        assert caps_runs.grading_rule(lb, 1.0 / N, math.pi)[0]
+    assert not caps_runs.grading_rule(lb, 1.0 / 20000, math.pi)[0]  # 20.06 links: resolved
+    assert not caps_runs.grading_rule(lb, 1.0 / 1000, 0.7)[0]  # a fold held above the links without bending
+    assert not caps_runs.grading_rule(0.0, 1.0 / 1000, math.pi)[0]  # no bending: the ball chain
+    # the whole rule on the lines themselves: the ball chain makes no run for it; the nylon line's drag
+    # alone on 100 links folds past a right angle at one node
+    runs = caps_runs.Runs(caps.spec("ball-chain"), 0.25, 1e-6, 1e-4, 1.0)
+    assert caps._grading(runs, 229, ["drag"], "auto")["used"] is False and runs.log == []
+    runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.25, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 100, ["bending", "drag"], "auto")
+    assert g["used"] and g["collapse"] >= math.pi / 2 and [x["run"] for x in runs.log] == ["drag"]
+    # at chi = 0.1 drag alone keeps its fold above the links, but the full run's folds onto one link
+    runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.1, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 200, ["bending", "drag"], "auto")
+    assert g["used"] and g["collapse_run"] == "with bending" and g["collapse"] >= math.pi / 2
+    assert [x["run"] for x in runs.log] == ["drag", "bending+drag"]
+    # a bending length far below the nylon line's: graded links too many, the uniform answer said unresolved
+    runs = caps_runs.Runs(caps.spec(None, length=2.0, mass=0.1, ei=1e-9, diameter=0.05), 0.3, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 16, ["bending", "drag"], "auto")
+    assert not g["used"] and g["too_fine"] > caps_runs.MAX_GRADED_LINKS and "NOT resolved" in g["why"]
+
+
+def test_graded_answer_matches_direct_runs_and_their_extrapolation():
+    Lc, Mc, chi = 1.0, 0.1, 0.5
+    lb = 0.03  # EI from the bending length: EI = lb^2 lambda g L^3
+    ei = lb ** 2 * (Mc / Lc) * G * Lc ** 3
+    kw = {"ei": ei, "diameter": 2e-3, "cd_normal": 1.2}
+    r = caps.cap(None, chi, N=12, check=False, alone=False, graded=True, length=Lc, mass=Mc, **kw)
+    g = r["graded"]
+    assert g["used"] and g["bending_length"] == pytest.approx(lb, rel=1e-12)
+    a = estimates.catenary_parameter(chi)
+    peaks = []
+    for k in (0, 1):  # fold path 1.5 lb, free end 0.4 lb, held arm 20 lb (max 0.5), halved on level 1
+        s = 0.5 ** k
+        h = grading.fold_following(chi, frac=1.5 * lb * s / a, h_min=0.4 * lb * s, h_max=min(0.5, 20 * lb * s))
+        links = Links.graded(h)
+        eta = grid_damping(h, links.m, np.full(h.size + 1, lb ** 2), 0.01)
+        body = Body.from_si(Lc, Mc, G, **kw)
+        body = Body(body.bending, damping=eta, drag_normal=body.drag_normal, drag_tangential=body.drag_tangential)
+        ds = run(Problem.catenary(chi, links=links, body=body), method="rodas4", tol=1e-3, progress=False).dataset
+        peaks.append({"v_peak": float(ds.attrs["v_peak"]) * math.sqrt(G * Lc), "a_peak": float(ds.attrs["a_peak"]) * G,
+                      "sigma_peak": float(ds.attrs["sigma_peak"]) * Mc * G})
+        assert g["levels"][k] == h.size
+    for q in caps.QUANTITIES:
+        assert g["levels_peaks"][0][q] == pytest.approx(peaks[0][q], rel=1e-9)
+        assert g["levels_peaks"][1][q] == pytest.approx(peaks[1][q], rel=1e-9)
+        assert r["real"][q] == pytest.approx(peaks[1][q] + (peaks[1][q] - peaks[0][q]) / 3.0, rel=1e-9)
+        assert g["error"][q] == pytest.approx(abs(peaks[1][q] - peaks[0][q]) / 3.0, rel=1e-9)
+    assert r["resolution"]["sigma_peak"] == pytest.approx(1.0 - peaks[0]["sigma_peak"] / peaks[1]["sigma_peak"])
+    assert [x["N"] for x in r["runs"] if "graded" in x["run"]] == g["levels"]
