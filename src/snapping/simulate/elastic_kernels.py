@@ -147,6 +147,14 @@ def jac_blocks(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E, ED, FV):
     Newton iteration of an implicit method converges for them regardless, as nothing
     depends on them."""
     tensions(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV)
+    jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E)
+
+
+@njit(cache=True, error_model="numpy")
+def jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E):
+    """:func:`jac_blocks` with the tensions ``T`` and strains ``E`` of ``z`` given (by
+    :func:`tensions` or :func:`rhs` at the same state: a Rosenbrock method's Jacobian is
+    taken where the next step's first evaluation was)."""
     B[:] = 0.0
     for i in range(N):
         B[i, 1, 0, 2] = 1.0
@@ -218,6 +226,13 @@ def measure(N, z, pin, h, m, ea, damp, tabe, tabt, tabw, g, snode, dz, T, E, ED,
     (``g sum m_i (s_i - y_i)``, zero hanging at rest unstretched) and elastic energies,
     the largest strain and the number of slack links. ``dz`` receives :func:`rhs`."""
     rhs(N, z, pin, h, 1.0 / m, ea, damp, tabe, tabt, g, dz, T, E, ED, FV)
+    measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out)
+
+
+@njit(cache=True, error_model="numpy")
+def measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out):
+    """:func:`measure` with :func:`rhs`'s ``dz``, ``T`` and ``E`` of the state ``z`` given
+    (the invariant part of a step's bookkeeping: a Rosenbrock step ends with f there)."""
     vmax = -1.0
     iv = 0
     amax = -1.0
