@@ -126,6 +126,101 @@ def wd_gradients(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV, gW, gD):
 
 
 @njit(cache=True, error_model="numpy")
+def _add_block(J, i, k, s, a00, a01, a10, a11, b00, b01, b10, b11):
+    J[i, k, 0] += s * a00
+    J[i, k, 1] += s * a01
+    J[i, k, 2] += s * a10
+    J[i, k, 3] += s * a11
+    J[i, k, 4] += s * b00
+    J[i, k, 5] += s * b01
+    J[i, k, 6] += s * b10
+    J[i, k, 7] += s * b11
+
+
+@njit(cache=True, error_model="numpy")
+def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J, gW, gD):
+    """The Jacobian the method uses, from the tensions ``T``, strains ``E`` and strain rates
+    ``ED`` of ``z`` (those :func:`elastic_kernels.rhs` left): the node blocks of
+    :func:`elastic_kernels.jac_blocks` in compact form, ``J[i, k, 0:4] = K`` and
+    ``J[i, k, 4:8] = C`` (node i's accelerations by node ``i - 1 + k``'s positions and
+    velocities, 2 x 2 row-major; the identity of ``dr/dt = v`` is implicit), and the W and D
+    rows of :func:`wd_gradients`, in one pass over the links with the same arithmetic as
+    those two (so the same numbers)."""
+    for i in range(4 * N):
+        gD[i] = 0.0
+    for k in range(4):
+        gW[k] = 0.0
+    J[:] = 0.0
+    for j in range(N):
+        if E[j] <= 0.0:
+            continue
+        ln = h[j] * (1.0 + E[j])
+        if j + 1 < N:
+            x1, y1, vx1, vy1 = z[4 * j + 4], z[4 * j + 5], z[4 * j + 6], z[4 * j + 7]
+        else:
+            x1, y1, vx1, vy1 = pin[0], pin[1], pin[2], pin[3]
+        ux = (x1 - z[4 * j]) / ln
+        uy = (y1 - z[4 * j + 1]) / ln
+        dvx = vx1 - z[4 * j + 2]
+        dvy = vy1 - z[4 * j + 3]
+        udv = ux * dvx + uy * dvy
+        px = (dvx - udv * ux) / ln
+        py = (dvy - udv * uy) / ln
+        ed = ED[j]
+        c = damp[j]
+        tj = T[j]
+        # the D row (wd_gradients)
+        if tj > 0.0:
+            gdx, gdy = 2.0 * c * ed * px, 2.0 * c * ed * py
+            gvx, gvy = 2.0 * c * ed * ux, 2.0 * c * ed * uy
+        else:
+            f, fp = EK.law(E[j], ea[j], tabe, tabt)
+            gdx, gdy = -(fp * ed * ux + f * px), -(fp * ed * uy + f * py)
+            gvx, gvy = -f * ux, -f * uy
+        gD[4 * j] -= gdx
+        gD[4 * j + 1] -= gdy
+        gD[4 * j + 2] -= gvx
+        gD[4 * j + 3] -= gvy
+        if j + 1 < N:
+            gD[4 * j + 4] += gdx
+            gD[4 * j + 5] += gdy
+            gD[4 * j + 6] += gvx
+            gD[4 * j + 7] += gvy
+        if tj == 0.0:
+            continue
+        # the node blocks (jac_given)
+        _, fp = EK.law(E[j], ea[j], tabe, tabt)
+        tdx = fp * ux / h[j] + c * (dvx - udv * ux) / (ln * h[j])
+        tdy = fp * uy / h[j] + c * (dvy - udv * uy) / (ln * h[j])
+        tvx = c * ux / h[j]
+        tvy = c * uy / h[j]
+        q = tj / ln
+        a00 = q * (1.0 - ux * ux) + ux * tdx
+        a01 = -q * ux * uy + ux * tdy
+        a10 = -q * uy * ux + uy * tdx
+        a11 = q * (1.0 - uy * uy) + uy * tdy
+        b00 = ux * tvx
+        b01 = ux * tvy
+        b10 = uy * tvx
+        b11 = uy * tvy
+        mj = invm[j]
+        _add_block(J, j, 1, -1.0 * mj, a00, a01, a10, a11, b00, b01, b10, b11)
+        if j + 1 < N:
+            _add_block(J, j, 2, 1.0 * mj, a00, a01, a10, a11, b00, b01, b10, b11)
+            mk = invm[j + 1]
+            _add_block(J, j + 1, 0, 1.0 * mk, a00, a01, a10, a11, b00, b01, b10, b11)
+            _add_block(J, j + 1, 1, -1.0 * mk, a00, a01, a10, a11, b00, b01, b10, b11)
+        else:  # the W row (wd_gradients)
+            tdx = fp * ux / h[j] + c * px / h[j]
+            tdy = fp * uy / h[j] + c * py / h[j]
+            uvp = ux * pin[2] + uy * pin[3]
+            gW[0] = -(q * (pin[2] - uvp * ux) + tdx * uvp)
+            gW[1] = -(q * (pin[3] - uvp * uy) + tdy * uvp)
+            gW[2] = -(c * ux / h[j]) * uvp
+            gW[3] = -(c * uy / h[j]) * uvp
+
+
+@njit(cache=True, error_model="numpy")
 def gradient_span(N, gD):
     """``[lo, hi)``, the indices outside which ``gD`` is zero (the D row's reach: the damped
     taut links; empty without damping)."""
@@ -136,6 +231,40 @@ def gradient_span(N, gD):
             lo = min(lo, i)
             hi = i + 1
     return lo, max(lo, hi)
+
+
+@njit(cache=True, error_model="numpy", boundscheck=False)
+def _comb(out, base, St, c, m, n):
+    """``out = base + c_0 St[1] + ... + c_{m-1} St[m]`` (1 <= m <= 5), the terms of each
+    element added in this order (as a loop over the stages adds them), in one pass."""
+    S0 = St[1]
+    c0 = c[0]
+    if m == 1:
+        for i in range(n):
+            out[i] = base[i] + c0 * S0[i]
+        return
+    S1 = St[2]
+    c1 = c[1]
+    if m == 2:
+        for i in range(n):
+            out[i] = (base[i] + c0 * S0[i]) + c1 * S1[i]
+        return
+    S2 = St[3]
+    c2 = c[2]
+    if m == 3:
+        for i in range(n):
+            out[i] = ((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]
+        return
+    S3 = St[4]
+    c3 = c[3]
+    if m == 4:
+        for i in range(n):
+            out[i] = (((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]) + c3 * S3[i]
+        return
+    S4 = St[5]
+    c4 = c[4]
+    for i in range(n):
+        out[i] = ((((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]) + c3 * S3[i]) + c4 * S4[i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -156,46 +285,35 @@ def rodas_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B
         return np.inf
     if path == ES.PATH_PIVOTED:
         ctl[C_NPIV] += 1.0
+    cc = np.empty(5)
     for st in range(6):
-        # (the sums run stage by stage over contiguous rows; each element's terms are added
-        # in the order of j, as an element-wise loop adds them)
         if st == 0:
             for i in range(n):
                 btmp[i] = St[0, i]
         else:
-            for i in range(n):
-                ytmp[i] = z0[i]
-            for j in range(st):
-                a = A_ST[st, j]
-                for i in range(n):
-                    ytmp[i] += a * St[1 + j, i]
+            _comb(ytmp, z0, St, A_ST[st], st, n)
             EK.rhs(N, ytmp, pins[st], h, invm, ea, damp, tabe, tabt, g, btmp, T, E, ED, FV)
             for j in range(st):
-                cj = C_ST[st, j] / hs
-                for i in range(n):
-                    btmp[i] += cj * St[1 + j, i]
+                cc[j] = C_ST[st, j] / hs
+            _comb(btmp, btmp, St, cc, st, n)
         if not auto and D_TIME[st] != 0.0:
             dth = D_TIME[st] * hs
             for i in range(n):
                 btmp[i] += dth * ft[i]
         ES.solve(N, B, gW, gD, dlo, dhi, gh, path, F, ab, piv, btmp, St[1 + st], w)
+    _comb(z1, z0, St, A_ST[5], 5, n)
+    S0, S1, S2, S3, S4, S6 = St[1], St[2], St[3], St[4], St[5], St[6]
+    a0, a1, a2, a3, a4 = D2[0], D2[1], D2[2], D2[3], D2[4]
+    b0, b1, b2, b3, b4 = D3[0], D3[1], D3[2], D3[3], D3[4]
+    c2 = c23[0]
+    c3 = c23[1]
     for i in range(n):
-        z1[i] = z0[i]
-        c23[0, i] = 0.0
-        c23[1, i] = 0.0
-    for j in range(5):
-        a = A_ST[5, j]
-        d2 = D2[j]
-        d3 = D3[j]
-        for i in range(n):
-            s = St[1 + j, i]
-            z1[i] += a * s
-            c23[0, i] += d2 * s
-            c23[1, i] += d3 * s
+        c2[i] = ((((0.0 + a0 * S0[i]) + a1 * S1[i]) + a2 * S2[i]) + a3 * S3[i]) + a4 * S4[i]
+        c3[i] = ((((0.0 + b0 * S0[i]) + b1 * S1[i]) + b2 * S2[i]) + b3 * S3[i]) + b4 * S4[i]
     err = 0.0
     for i in range(n):
-        z1[i] += St[6, i]
-        e = abs(St[6, i]) / (tol * (1.0 + max(abs(z0[i]), abs(z1[i]))))
+        z1[i] += S6[i]
+        e = abs(S6[i]) / (tol * (1.0 + max(abs(z0[i]), abs(z1[i]))))
         if not (e - e == 0.0):
             return np.inf
         if e > err:
@@ -216,12 +334,11 @@ def pin_at(t, pinpar, pintab, out):
 
 @njit(cache=True, error_model="numpy")
 def f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, g, f, B, gW, gD, dsp, T, E, ED, FV):
-    """``f(t, z)`` and the Jacobian there (``jac_blocks`` from the same tensions, the W and D
-    rows' gradients, ``dsp`` the D row's span): what a step needs at its start."""
+    """``f(t, z)`` and the Jacobian there (:func:`jacobian`, from the same tensions; ``B`` its
+    compact node blocks, ``dsp`` the D row's span): what a step needs at its start."""
     pin_at(t, pinpar, pintab, pin)
     EK.rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, f, T, E, ED, FV)
-    EK.jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E)
-    wd_gradients(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV, gW, gD)
+    jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, B, gW, gD)
     lo, hi = gradient_span(N, gD)
     dsp[0] = lo
     dsp[1] = hi
@@ -355,7 +472,7 @@ class RodasStepper:
         c[C_PIVOTED] = float(bool(pivoted))
         self.pinpar, self.pintab = pin_model(line)
         self.St = np.zeros((7, n))
-        self.B = np.zeros((N, 3, 4, 4))
+        self.B = np.zeros((N, 3, 8))
         self.gW, self.gD = np.zeros(4), np.zeros(4 * N)
         self.dsp = np.zeros(2)
         self.F = np.zeros((N, ES.NF))

@@ -61,8 +61,9 @@ PATH_BLOCK, PATH_PIVOTED, PATH_SINGULAR = 0, 1, 2
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def _entry(B, i, k, r, c, g, g2):
-    """Row 2i + r, column 2(i - 1 + k) + c of ``I - g^2 K - g C``."""
-    v = -g2 * B[i, k, 2 + r, c] - g * B[i, k, 2 + r, 2 + c]
+    """Row 2i + r, column 2(i - 1 + k) + c of ``I - g^2 K - g C`` (``B`` the compact blocks of
+    :func:`elastic_rodas.jacobian`: ``B[i, k, 2r + c]`` of K, ``B[i, k, 4 + 2r + c]`` of C)."""
+    v = -g2 * B[i, k, 2 * r + c] - g * B[i, k, 4 + 2 * r + c]
     if k == 1 and r == c:
         v += 1.0
     return v
@@ -143,21 +144,39 @@ def factor(N, B, gh, F, ab, piv, pivoted):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _block_solve(N, F, w):
-    """``A x = w`` in place with the block factors."""
-    y0 = w[0]
-    y1 = w[1]
-    for i in range(1, N):  # forward: y_i = w_i - L_i y_{i-1}
-        q = F[i]
-        z0 = w[2 * i] - (q[0] * y0 + q[1] * y1)
-        z1 = w[2 * i + 1] - (q[2] * y0 + q[3] * y1)
+def _rhs_v(N, B, gh, g2, b, i, r):
+    """Row 2i + r of the reduced right side ``g b_v + g^2 K b_r``."""
+    acc = gh * b[4 * i + 2 + r]
+    for k in range(3):
+        jn = i - 1 + k
+        if jn < 0 or jn >= N:
+            continue
+        acc += g2 * (B[i, k, 2 * r] * b[4 * jn] + B[i, k, 2 * r + 1] * b[4 * jn + 1])
+    return acc
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _block_solve(N, B, gh, F, b, U, w):
+    """The reduced system with the block factors, its right side formed on the way (forward:
+    ``y_i = w_i - L_i y_{i-1}``; back: ``x_i = D_i^{-1} (y_i - A_{i,i+1} x_{i+1})``), and the
+    positions' stages ``gh (b_r + U_v)``."""
+    g2 = gh * gh
+    y0 = 0.0
+    y1 = 0.0
+    for i in range(N):
+        z0 = _rhs_v(N, B, gh, g2, b, i, 0)
+        z1 = _rhs_v(N, B, gh, g2, b, i, 1)
+        if i > 0:
+            q = F[i]
+            z0 = z0 - (q[0] * y0 + q[1] * y1)
+            z1 = z1 - (q[2] * y0 + q[3] * y1)
         w[2 * i] = z0
         w[2 * i + 1] = z1
         y0 = z0
         y1 = z1
     x0 = 0.0
     x1 = 0.0
-    for i in range(N - 1, -1, -1):  # back: x_i = D_i^{-1} (y_i - A_{i,i+1} x_{i+1})
+    for i in range(N - 1, -1, -1):
         q = F[i]
         r0 = w[2 * i]
         r1 = w[2 * i + 1]
@@ -166,8 +185,10 @@ def _block_solve(N, F, w):
             r1 -= q[10] * x0 + q[11] * x1
         x0 = q[4] * r0 + q[5] * r1
         x1 = q[6] * r0 + q[7] * r1
-        w[2 * i] = x0
-        w[2 * i + 1] = x1
+        U[4 * i + 2] = x0
+        U[4 * i + 3] = x1
+        U[4 * i] = gh * (b[4 * i] + x0)
+        U[4 * i + 1] = gh * (b[4 * i + 1] + x1)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -176,25 +197,19 @@ def solve(N, B, gW, gD, dlo, dhi, gh, path, F, ab, piv, b, U, w):
     the velocities from the reduced system, the positions ``gh (b_r + U_v)``, then W and D
     (``U_w = gh (b_w + gW . U)``, ``U_d = gh (b_d + gD . U)``; ``gD`` is zero outside
     ``[dlo, dhi)``)."""
-    g2 = gh * gh
-    for i in range(N):
-        for r in range(2):
-            acc = gh * b[4 * i + 2 + r]
-            for k in range(3):
-                jn = i - 1 + k
-                if jn < 0 or jn >= N:
-                    continue
-                acc += g2 * (B[i, k, 2 + r, 0] * b[4 * jn] + B[i, k, 2 + r, 1] * b[4 * jn + 1])
-            w[2 * i + r] = acc
     if path == PATH_BLOCK:
-        _block_solve(N, F, w)
+        _block_solve(N, B, gh, F, b, U, w)
     else:
+        g2 = gh * gh
+        for i in range(N):
+            for r in range(2):
+                w[2 * i + r] = _rhs_v(N, B, gh, g2, b, i, r)
         band_solve(ab, 2 * N, KLE, KUE, piv, w)
-    for i in range(N):
-        for r in range(2):
-            uv = w[2 * i + r]
-            U[4 * i + 2 + r] = uv
-            U[4 * i + r] = gh * (b[4 * i + r] + uv)
+        for i in range(N):
+            for r in range(2):
+                uv = w[2 * i + r]
+                U[4 * i + 2 + r] = uv
+                U[4 * i + r] = gh * (b[4 * i + r] + uv)
     accd = 0.0
     for i in range(dlo, dhi):
         accd += gD[i] * U[i]
