@@ -28,6 +28,8 @@ __all__ = ["advance", "RodasRun", "NREC", "NSLOT"]
 
 #: columns of a record row: t, then elastic_solve.STEP_NAMES
 NREC = 19
+#: rows of the record buffer (a full buffer returns to Python, which drains it)
+ROWS = 4096
 #: step slots of the pool (three kept steps per peak kind, the last step, one being taken)
 NSLOT = 12
 #: the peak kinds' columns of the measures (v_max, a_max, sigma_max)
@@ -156,7 +158,7 @@ class RodasRun:
     :class:`~snapping.simulate.elastic_rodas.RodasStepper`), the pool of step slots, the
     peaks and the run's controls; :meth:`advance` runs the compiled loop to its next return."""
 
-    def __init__(self, stepper, mm0, *, t_end_given, stop_fraction, floor, E0, U0, max_rhs, energy_fail, rows=4096):
+    def __init__(self, stepper, mm0, *, t_end_given, stop_fraction, floor, E0, U0, max_rhs, energy_fail, rows=None):
         st = self.st = stepper
         n = st.y.size
         self.PY0, self.PY1 = np.zeros((NSLOT, n)), np.zeros((NSLOT, n))
@@ -172,7 +174,7 @@ class RodasRun:
         c[S_TEND], c[S_FRAC], c[S_FLOOR], c[S_RUN] = float(t_end_given), stop_fraction, floor, 0.0
         c[S_ARMED], c[S_ERR], c[S_E0], c[S_U0], c[S_MAXRHS] = np.nan, 0.0, E0, U0, max_rhs
         c[S_TSNAP], c[S_SLACK], c[S_NREC], c[S_PEAKT], c[S_PREV], c[S_EFAIL] = np.inf, np.nan, 0, 0.0, -1, energy_fail
-        self.rec = np.zeros((rows, NREC))
+        self.rec = np.zeros((ROWS if rows is None else rows, NREC))
         self.peak_z = st.y.copy()
         self.mm = np.zeros(EK.NMEAS)
         ln = st.line

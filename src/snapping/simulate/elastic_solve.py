@@ -54,6 +54,9 @@ PEAK_SAMPLES = 24
 #: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
 #: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
 ENERGY_ERROR_FAIL = 0.1
+#: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
+#: below, one step a call (the reference the compiled loop equals, bit for bit)
+COMPILED_LOOP = True
 #: the per-step record's columns (the Dataset's step variables, in this order)
 STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
               "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
@@ -295,7 +298,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
-    if method == "rodas4":
+    if method == "rodas4" and COMPILED_LOOP:
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
             solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
