@@ -201,8 +201,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
         elif code == EA.R_ENERGY:
             status, stop_reason = "failed", _ENERGY_MSG
         break
-    for k, (val, tp, keep) in zip(peaks.COLS, run.peaks().values()):
-        peaks.best[k], peaks.keep[k] = (val, tp), keep
+    for k, best in zip(peaks.COLS, run.refined_peaks(PEAK_SAMPLES).values()):
+        peaks.best[k], peaks.keep[k] = best, []  # (refined: refine() returns them)
     sc = run.sctl
     if sc[EA.S_RUN] > 0.0:
         peak_state = (float(sc[EA.S_PEAKT]), run.peak_z.copy())
