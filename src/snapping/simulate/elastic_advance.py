@@ -222,6 +222,13 @@ class RodasRun:
     def last_dense(self):
         return self.dense(int(self.sctl[S_PREV]))
 
+    def segments(self):
+        """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
+        (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
+        return {k: (float(self.best[k, 0]), float(self.best[k, 1]),
+                    [(float(self.PT[s, 0]), self.PY0[s].copy(), float(self.PT[s, 1]), self.dense(int(s)))
+                     for s in self.keep[k, :self.nkeep[k]]]) for k in range(3)}
+
     def refined_peaks(self, samples):
         """{kind index: (value, time)}: the peaks refined on their kept steps at ``samples - 1``
         inner points each (``_Peaks.refine``'s, compiled)."""

@@ -43,7 +43,6 @@ steps).
 
 from __future__ import annotations
 
-
 import numpy as np
 from numba import njit
 
