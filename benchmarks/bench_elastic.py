@@ -95,7 +95,8 @@ def main(argv=None):
                         print(f"{N:>5} {c:>6g} {zeta:>5g} {m:>7} {tol:>7.0e} {s['n_steps']:>7} {s['n_rhs']:>9} "
                               f"{s['n_jac']:>6} {s['n_lu']:>7} {w:>8.2f} {rel[0]:>9.2e} {rel[1]:>9.2e} {rel[2]:>9.2e} "
                               f"{acc[0]:>9.2e} {acc[1]:>9.2e} {acc[2]:>9.2e}{ok} {s['n_rhs'] / ref['n_rhs']:>6.1f} "
-                              f"{w / wf:>7.1f}  {s['status']} ({s['stop_reason']}), load {os.getloadavg()[0]:.1f}",
+                              f"{w / wf:>7.1f}  {s['status']} ({s['stop_reason']}), load {os.getloadavg()[0]:.1f}"
+                              f"{', pivoted LU ' + str(s['n_lu_pivoted']) if s.get('n_lu_pivoted') else ''}",
                               flush=True)
 
 

@@ -99,36 +99,68 @@ def tensions(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV):
             FV[j] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, dz, T, E, ED, FV):
     """The time derivative ``dz`` of the state: velocities, accelerations
     ``(sum of link forces)/m_i + g e2``, the held end's power ``T_{N-1} d_{N-1}.v_pin/l_{N-1}``
-    and the dissipation rate ``sum_j h_j (T_j - f_j(e_j)) edot_j`` (>= 0)."""
-    tensions(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV)
-    for i in range(N):
-        dz[4 * i] = z[4 * i + 2]
-        dz[4 * i + 1] = z[4 * i + 3]
-        dz[4 * i + 2] = 0.0
-        dz[4 * i + 3] = 0.0
+    and the dissipation rate ``sum_j h_j (T_j - f_j(e_j)) edot_j`` (>= 0); ``T, E, ED, FV``
+    receive :func:`tensions`.
+
+    The arithmetic is :func:`tensions`' and, per node, ``(0 - F_{i-1}/m_i) + F_i/m_i`` with
+    ``F_j = T_j u_j`` (zero for a slack link), in loops without branches where the divisions
+    are (the geometry first, into ``dz``'s acceleration slots, then the law, then the
+    forces), so that the compiler can vectorise them."""
+    for j in range(N - 1):
+        dx = z[4 * j + 4] - z[4 * j]
+        dy = z[4 * j + 5] - z[4 * j + 1]
+        ln = math.sqrt(dx * dx + dy * dy)
+        e = ln / h[j] - 1.0
+        E[j] = e
+        ED[j] = (dx * (z[4 * j + 6] - z[4 * j + 2]) + dy * (z[4 * j + 7] - z[4 * j + 3])) / (ln * h[j])
+        lu = h[j] * (1.0 + e)
+        dz[4 * j + 2] = dx / lu
+        dz[4 * j + 3] = dy / lu
+    j = N - 1
+    dx = pin[0] - z[4 * j]
+    dy = pin[1] - z[4 * j + 1]
+    ln = math.sqrt(dx * dx + dy * dy)
+    e = ln / h[j] - 1.0
+    E[j] = e
+    ED[j] = (dx * (pin[2] - z[4 * j + 2]) + dy * (pin[3] - z[4 * j + 3])) / (ln * h[j])
+    lu = h[j] * (1.0 + e)
+    dz[4 * j + 2] = dx / lu
+    dz[4 * j + 3] = dy / lu
     diss = 0.0
     for j in range(N):
-        tj = T[j]
+        e = E[j]
+        if e > 0.0:
+            f, _ = law(e, ea[j], tabe, tabt)
+            t = f + damp[j] * ED[j]
+            tj = t if t > 0.0 else 0.0
+            FV[j] = f
+        else:
+            tj = 0.0
+            FV[j] = 0.0
+        T[j] = tj
         # (also where the damping cancels the tension, T = 0 < f: there the rate is -h f edot)
         diss += h[j] * (tj - FV[j]) * ED[j]
         if tj == 0.0:
-            continue
-        ln = h[j] * (1.0 + E[j])
-        x1 = z[4 * j + 4] if j + 1 < N else pin[0]
-        y1 = z[4 * j + 5] if j + 1 < N else pin[1]
-        ux = (x1 - z[4 * j]) / ln
-        uy = (y1 - z[4 * j + 1]) / ln
-        dz[4 * j + 2] += tj * ux * invm[j]
-        dz[4 * j + 3] += tj * uy * invm[j]
-        if j + 1 < N:
-            dz[4 * j + 6] -= tj * ux * invm[j + 1]
-            dz[4 * j + 7] -= tj * uy * invm[j + 1]
+            dz[4 * j + 2] = 0.0
+            dz[4 * j + 3] = 0.0
+        else:
+            dz[4 * j + 2] = tj * dz[4 * j + 2]
+            dz[4 * j + 3] = tj * dz[4 * j + 3]
+    fx0 = 0.0
+    fy0 = 0.0
     for i in range(N):
-        dz[4 * i + 3] += g
+        fx = dz[4 * i + 2]
+        fy = dz[4 * i + 3]
+        dz[4 * i] = z[4 * i + 2]
+        dz[4 * i + 1] = z[4 * i + 3]
+        dz[4 * i + 2] = (0.0 - fx0 * invm[i]) + fx * invm[i]
+        dz[4 * i + 3] = ((0.0 - fy0 * invm[i]) + fy * invm[i]) + g
+        fx0 = fx
+        fy0 = fy
     # the held end's power on the line, and the dissipation rate
     j = N - 1
     if T[j] > 0.0:
@@ -147,6 +179,14 @@ def jac_blocks(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E, ED, FV):
     Newton iteration of an implicit method converges for them regardless, as nothing
     depends on them."""
     tensions(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV)
+    jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E)
+
+
+@njit(cache=True, error_model="numpy")
+def jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E):
+    """:func:`jac_blocks` with the tensions ``T`` and strains ``E`` of ``z`` given (by
+    :func:`tensions` or :func:`rhs` at the same state: a Rosenbrock method's Jacobian is
+    taken where the next step's first evaluation was)."""
     B[:] = 0.0
     for i in range(N):
         B[i, 1, 0, 2] = 1.0
@@ -218,6 +258,13 @@ def measure(N, z, pin, h, m, ea, damp, tabe, tabt, tabw, g, snode, dz, T, E, ED,
     (``g sum m_i (s_i - y_i)``, zero hanging at rest unstretched) and elastic energies,
     the largest strain and the number of slack links. ``dz`` receives :func:`rhs`."""
     rhs(N, z, pin, h, 1.0 / m, ea, damp, tabe, tabt, g, dz, T, E, ED, FV)
+    measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out)
+
+
+@njit(cache=True, error_model="numpy")
+def measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out):
+    """:func:`measure` with :func:`rhs`'s ``dz``, ``T`` and ``E`` of the state ``z`` given
+    (the invariant part of a step's bookkeeping: a Rosenbrock step ends with f there)."""
     vmax = -1.0
     iv = 0
     amax = -1.0

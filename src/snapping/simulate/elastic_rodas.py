@@ -16,11 +16,18 @@ velocities: with ``g = gamma h``,
 
     (I - g^2 K - g C) U_v = g b_v + g^2 K b_r,   U_r = g (b_r + U_v),
 
-a 2N x 2N system of 2 x 2 blocks, bandwidth 3 each side, factored once per step by the banded
-LU with partial pivoting of :mod:`snapping.simulate.banded` (O(N)); W's and D's stages follow
-as ``U_w = g (b_w + grad_w . U)``. A step costs five evaluations of the right-hand side, one
-more at the accepted end (the next step's first stage), one Jacobian and one factorisation;
-a moving held end one more evaluation for ``df/dt`` (a forward difference).
+a 2N x 2N system of 2 x 2 blocks, block tridiagonal, factored once per step without pivoting
+(:mod:`snapping.simulate.elastic_stage`: scaled by the masses it is symmetric positive
+definite, and nearly so with damping; a guard falls back to the pivoted band LU); W's and D's
+stages follow as ``U_w = g (b_w + grad_w . U)``. A step costs five evaluations of the
+right-hand side, one more at the accepted end (the next step's first stage, whose tensions
+the Jacobian there reuses), one Jacobian and one factorisation; a moving held end one more
+evaluation for ``df/dt`` (a forward difference).
+
+The attempts of a step (:func:`rodas_accept`) are compiled; :class:`RodasStepper` takes one
+accepted step per call (scipy's ``OdeSolver`` interface), and
+:func:`snapping.simulate.elastic_advance.advance` takes many, with the run's bookkeeping,
+between two returns to Python.
 
 Slack-taut transitions are met by the error control, not by events: the tension's derivative
 jumps there (with damping, the tension itself), the estimate ``U_6`` sees it and the step
@@ -36,184 +43,214 @@ steps).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
 from . import elastic_kernels as EK
-from .banded import band_lu, band_solve
+from . import elastic_stage as ES
+from .elastic_jacobian import full_jacobian, gradient_span, jacobian, wd_gradients  # noqa: F401 (re-exported)
+from . import general as G
 from .rosenbrock import A_ST, C_NODE, C_ST, D2, D3, D_TIME, GAMMA
 
-__all__ = ["RodasStepper", "wd_gradients", "stage_system", "stage_solve", "rodas_step", "full_jacobian"]
+__all__ = ["RodasStepper", "RodasDense", "wd_gradients", "rodas_step", "rodas_accept", "f_and_jacobian",
+           "full_jacobian", "pin_model", "NCTL"]
 
-#: the reduced stage matrix's bandwidths (2 x 2 blocks, interleaved x, y)
-KLE = KUE = 3
-WIDTH = 2 * KLE + KUE + 1
 SAFE, FAC_MIN, FAC_MAX = 0.9, 0.2, 6.0
+#: the stepper's controls and counts (``ctl``): time, the last step's start, the next step,
+#: the end, tol, the predictive controller's last step and error (none while <= 0), counts
+#: of evaluations, Jacobians, factorisations, rejected steps and pivoted factorisations,
+#: status, the step that failed, "always pivot" and "autonomous" (a fixed held end)
+(C_T, C_TOLD, C_H, C_TB, C_TOL, C_HACC, C_ERRACC, C_NFEV, C_NJEV, C_NLU, C_NREJ, C_NPIV, C_STATUS, C_HFAIL,
+ C_PIVOTED, C_AUTO) = range(16)
+NCTL = 16
+RUNNING, FINISHED, FAILED = 0.0, 1.0, 2.0
 
 
-@njit(cache=True)
-def wd_gradients(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV, gW, gD):
-    """The gradients of the W row (the held end's power ``T u . v_pin`` of link N-1) and of
-    the D row (``sum_j h_j (T_j - f_j) edot_j``) by the node state (x, y, vx, vy per node):
-    ``gW`` (4 entries, node N-1's), ``gD`` (4N). ``T, E, ED, FV`` are those of ``z``
-    (:func:`elastic_kernels.tensions`)."""
-    for i in range(4 * N):
-        gD[i] = 0.0
-    for k in range(4):
-        gW[k] = 0.0
-    for j in range(N):
-        if E[j] <= 0.0:
-            continue
-        ln = h[j] * (1.0 + E[j])
-        if j + 1 < N:
-            x1, y1, vx1, vy1 = z[4 * j + 4], z[4 * j + 5], z[4 * j + 6], z[4 * j + 7]
-        else:
-            x1, y1, vx1, vy1 = pin[0], pin[1], pin[2], pin[3]
-        ux = (x1 - z[4 * j]) / ln
-        uy = (y1 - z[4 * j + 1]) / ln
-        dvx = vx1 - z[4 * j + 2]
-        dvy = vy1 - z[4 * j + 3]
-        udv = ux * dvx + uy * dvy
-        # d(edot)/dd = (dv - (u.dv) u)/(l h), d(edot)/d(dv) = u/h
-        px = (dvx - udv * ux) / ln
-        py = (dvy - udv * uy) / ln
-        ed = ED[j]
-        c = damp[j]
-        if T[j] > 0.0:  # rate h c edot^2
-            gdx, gdy = 2.0 * c * ed * px, 2.0 * c * ed * py
-            gvx, gvy = 2.0 * c * ed * ux, 2.0 * c * ed * uy
-        else:  # the damping cancels the tension: rate -h f edot
-            f, fp = EK.law(E[j], ea[j], tabe, tabt)
-            gdx, gdy = -(fp * ed * ux + f * px), -(fp * ed * uy + f * py)
-            gvx, gvy = -f * ux, -f * uy
-        # by node j (d = r_{j+1} - r_j: minus) and node j+1 (plus)
-        gD[4 * j] -= gdx
-        gD[4 * j + 1] -= gdy
-        gD[4 * j + 2] -= gvx
-        gD[4 * j + 3] -= gvy
-        if j + 1 < N:
-            gD[4 * j + 4] += gdx
-            gD[4 * j + 5] += gdy
-            gD[4 * j + 6] += gvx
-            gD[4 * j + 7] += gvy
-        if j == N - 1 and T[j] > 0.0:
-            # W' = G . v_pin with G = T u: dG/dd = T/l (I - u u^T) + u (dT/dd)^T, dG/d(dv) = u (dT/d(dv))^T
-            _, fp = EK.law(E[j], ea[j], tabe, tabt)
-            tdx = fp * ux / h[j] + c * px / h[j]
-            tdy = fp * uy / h[j] + c * py / h[j]
-            uvp = ux * pin[2] + uy * pin[3]
-            q = T[j] / ln
-            gW[0] = -(q * (pin[2] - uvp * ux) + tdx * uvp)
-            gW[1] = -(q * (pin[3] - uvp * uy) + tdy * uvp)
-            gW[2] = -(c * ux / h[j]) * uvp
-            gW[3] = -(c * uy / h[j]) * uvp
+@njit(cache=True, error_model="numpy", boundscheck=False)
+def _comb(out, base, St, c, m, n):
+    """``out = base + c_0 St[1] + ... + c_{m-1} St[m]`` (1 <= m <= 5), the terms of each
+    element added in this order (as a loop over the stages adds them), in one pass."""
+    S0 = St[1]
+    c0 = c[0]
+    if m == 1:
+        for i in range(n):
+            out[i] = base[i] + c0 * S0[i]
+        return
+    S1 = St[2]
+    c1 = c[1]
+    if m == 2:
+        for i in range(n):
+            out[i] = (base[i] + c0 * S0[i]) + c1 * S1[i]
+        return
+    S2 = St[3]
+    c2 = c[2]
+    if m == 3:
+        for i in range(n):
+            out[i] = ((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]
+        return
+    S3 = St[4]
+    c3 = c[3]
+    if m == 4:
+        for i in range(n):
+            out[i] = (((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]) + c3 * S3[i]
+        return
+    S4 = St[5]
+    c4 = c[4]
+    for i in range(n):
+        out[i] = ((((base[i] + c0 * S0[i]) + c1 * S1[i]) + c2 * S2[i]) + c3 * S3[i]) + c4 * S4[i]
 
 
-@njit(cache=True)
-def stage_system(N, B, gh, ab):
-    """The reduced stage matrix ``I - g^2 K - g C`` (``g = gh``) from the Jacobian's blocks
-    ``B`` (:func:`elastic_kernels.jac_blocks`) in the band storage of :func:`banded.band_lu`
-    (row i, column j at ``ab[i, j - i + KLE]``)."""
-    ab[:, :] = 0.0
-    g2 = gh * gh
-    for i in range(N):
-        for k in range(3):
-            jn = i - 1 + k
-            if jn < 0 or jn >= N:
-                continue
-            for r in range(2):
-                row = 2 * i + r
-                for c in range(2):
-                    v = -g2 * B[i, k, 2 + r, c] - gh * B[i, k, 2 + r, 2 + c]
-                    if k == 1 and r == c:
-                        v += 1.0
-                    ab[row, 2 * jn + c - row + KLE] = v
-
-
-@njit(cache=True)
-def stage_solve(N, B, gW, gD, gh, ab, piv, b, U, w):
-    """``U = (I/gh - J)^{-1} b`` with the factored reduced matrix ``ab``: the velocities
-    from the banded solve, the positions ``gh (b_r + U_v)``, then W and D."""
-    g2 = gh * gh
-    for i in range(N):
-        for r in range(2):
-            acc = gh * b[4 * i + 2 + r]
-            for k in range(3):
-                jn = i - 1 + k
-                if jn < 0 or jn >= N:
-                    continue
-                acc += g2 * (B[i, k, 2 + r, 0] * b[4 * jn] + B[i, k, 2 + r, 1] * b[4 * jn + 1])
-            w[2 * i + r] = acc
-    band_solve(ab, 2 * N, KLE, KUE, piv, w)
-    for i in range(N):
-        for r in range(2):
-            uv = w[2 * i + r]
-            U[4 * i + 2 + r] = uv
-            U[4 * i + r] = gh * (b[4 * i + r] + uv)
-    accd = 0.0
-    for i in range(4 * N):
-        accd += gD[i] * U[i]
-    accw = 0.0
-    for k in range(4):
-        accw += gW[k] * U[4 * (N - 1) + k]
-    U[4 * N] = gh * (b[4 * N] + accw)
-    U[4 * N + 1] = gh * (b[4 * N + 1] + accd)
-
-
-@njit(cache=True)
-def rodas_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B, gW, gD, ab, piv, St, ytmp,
-               btmp, w, z1, c23, tol, T, E, ED, FV):
+@njit(cache=True, error_model="numpy")
+def rodas_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B, gW, gD, dlo, dhi, F, ab, piv,
+               pivoted, St, ytmp, btmp, w, z1, c23, tol, T, E, ED, FV, ctl):
     """One RODAS4 step of size ``hs`` from (t, z0) with ``St[0] = f(t, z0)`` and the Jacobian
-    (``B, gW, gD``) there; ``pins[s]`` the held end's state at the stage times ``t + c_s hs``,
-    ``ft`` df/dt (used unless ``auto``). Stages into ``St[1:7]``, the new state into ``z1``,
-    the dense output's ``c2, c3`` into ``c23``. Returns the scaled error (max norm; inf when
-    the stage matrix is singular or a value not finite)."""
+    (``B, gW, gD``; ``gD`` zero outside ``[dlo, dhi)``) there; ``pins[s]`` the held end's
+    state at the stage times ``t + c_s hs``, ``ft`` df/dt (used unless ``auto``). The stage
+    matrix is factored by :func:`elastic_stage.factor` (pivot-free unless its guard fails or
+    ``pivoted``; a pivoted factorisation counts in ``ctl[C_NPIV]``). Stages into ``St[1:7]``,
+    the new state into ``z1``, the dense output's ``c2, c3`` into ``c23``. Returns the scaled
+    error (max norm; inf when the stage matrix is singular or a value not finite)."""
     n = z0.shape[0]
     gh = GAMMA * hs
-    stage_system(N, B, gh, ab)
-    if band_lu(ab, 2 * N, KLE, KUE, piv) != 0:
+    path = ES.factor(N, B, gh, F, ab, piv, pivoted)
+    if path == ES.PATH_SINGULAR:
+        ctl[C_NPIV] += 1.0
         return np.inf
+    if path == ES.PATH_PIVOTED:
+        ctl[C_NPIV] += 1.0
+    cc = np.empty(5)
     for st in range(6):
         if st == 0:
             for i in range(n):
                 btmp[i] = St[0, i]
         else:
-            for i in range(n):
-                acc = z0[i]
-                for j in range(st):
-                    acc += A_ST[st, j] * St[1 + j, i]
-                ytmp[i] = acc
+            _comb(ytmp, z0, St, A_ST[st], st, n)
             EK.rhs(N, ytmp, pins[st], h, invm, ea, damp, tabe, tabt, g, btmp, T, E, ED, FV)
-            for i in range(n):
-                acc = btmp[i]
-                for j in range(st):
-                    acc += C_ST[st, j] / hs * St[1 + j, i]
-                btmp[i] = acc
+            for j in range(st):
+                cc[j] = C_ST[st, j] / hs
+            _comb(btmp, btmp, St, cc, st, n)
         if not auto and D_TIME[st] != 0.0:
+            dth = D_TIME[st] * hs
             for i in range(n):
-                btmp[i] += D_TIME[st] * hs * ft[i]
-        stage_solve(N, B, gW, gD, gh, ab, piv, btmp, St[1 + st], w)
+                btmp[i] += dth * ft[i]
+        ES.solve(N, B, gW, gD, dlo, dhi, gh, path, F, ab, piv, btmp, St[1 + st], w)
+    _comb(z1, z0, St, A_ST[5], 5, n)
+    S0, S1, S2, S3, S4, S6 = St[1], St[2], St[3], St[4], St[5], St[6]
+    a0, a1, a2, a3, a4 = D2[0], D2[1], D2[2], D2[3], D2[4]
+    b0, b1, b2, b3, b4 = D3[0], D3[1], D3[2], D3[3], D3[4]
+    c2 = c23[0]
+    c3 = c23[1]
+    for i in range(n):
+        c2[i] = ((((0.0 + a0 * S0[i]) + a1 * S1[i]) + a2 * S2[i]) + a3 * S3[i]) + a4 * S4[i]
+        c3[i] = ((((0.0 + b0 * S0[i]) + b1 * S1[i]) + b2 * S2[i]) + b3 * S3[i]) + b4 * S4[i]
     err = 0.0
     for i in range(n):
-        acc = z0[i]
-        for j in range(5):
-            acc += A_ST[5, j] * St[1 + j, i]
-        z1[i] = acc + St[6, i]
-        e = abs(St[6, i]) / (tol * (1.0 + max(abs(z0[i]), abs(z1[i]))))
+        z1[i] += S6[i]
+        e = abs(S6[i]) / (tol * (1.0 + max(abs(z0[i]), abs(z1[i]))))
         if not (e - e == 0.0):
             return np.inf
         if e > err:
             err = e
-        c2 = 0.0
-        c3 = 0.0
-        for j in range(5):
-            c2 += D2[j] * St[1 + j, i]
-            c3 += D3[j] * St[1 + j, i]
-        c23[0, i] = c2
-        c23[1, i] = c3
     return err
+
+
+@njit(cache=True, error_model="numpy")
+def pin_at(t, pinpar, pintab, out):
+    """The held end's (x, y, vx, vy) at ``t`` into ``out`` (:func:`general.pin_kinematics`,
+    which :meth:`PinMotion.kinematics` evaluates; position and velocity are continuous)."""
+    x, y, vx, vy, _, _ = G.pin_kinematics(t, pinpar, pintab)
+    out[0] = x
+    out[1] = y
+    out[2] = vx
+    out[3] = vy
+
+
+@njit(cache=True, error_model="numpy")
+def f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, g, f, B, gW, gD, dsp, T, E, ED, FV):
+    """``f(t, z)`` and the Jacobian there (:func:`jacobian`, from the same tensions; ``B`` its
+    compact node blocks, ``dsp`` the D row's span): what a step needs at its start."""
+    pin_at(t, pinpar, pintab, pin)
+    EK.rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, f, T, E, ED, FV)
+    jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, B, gW, gD)
+    lo, hi = gradient_span(N, gD)
+    dsp[0] = lo
+    dsp[1] = hi
+
+
+@njit(cache=True, error_model="numpy")
+def rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g,
+                 ytmp, btmp, w, ft, z1, y0d, c23, ctl, T, E, ED, FV):
+    """Attempt RODAS4 steps from ``(ctl[C_T], y)`` (``St[0] = f`` and the Jacobian there) with
+    the step ``ctl[C_H]`` and shrink it until one is accepted: then ``y0d`` holds the old
+    state, ``y`` (and ``z1``) the new, ``c23`` its dense output, ``St[0]`` and the Jacobian
+    are those of the new state, ``ctl`` the new time, the next step and the counts. Returns 0,
+    or 1 when the step fell below 1e-14 |t| (``ctl[C_STATUS] = FAILED``, the step in
+    ``ctl[C_HFAIL]``). The step rule of ``rodas.f`` with Gustafsson's predictive controller."""
+    n = y.shape[0]
+    t = ctl[C_T]
+    tb = ctl[C_TB]
+    auto = ctl[C_AUTO] != 0.0
+    pivoted = ctl[C_PIVOTED] != 0.0
+    tol = ctl[C_TOL]
+    reject = False
+    while True:
+        hs = ctl[C_H]
+        last = t + hs >= tb or t + 1.01 * hs >= tb
+        if last:
+            hs = tb - t
+        if hs <= 1e-14 * max(1.0, abs(t)):
+            ctl[C_STATUS] = FAILED
+            ctl[C_HFAIL] = hs
+            return 1
+        if auto:
+            for s in range(6):
+                pin_at(t, pinpar, pintab, pins[s])
+        else:
+            for s in range(6):
+                pin_at(t + C_NODE[s] * hs, pinpar, pintab, pins[s])
+            dt = 1e-7 * max(1.0, abs(t))
+            pin_at(t + dt, pinpar, pintab, pins[6])
+            EK.rhs(N, y, pins[6], h, invm, ea, damp, tabe, tabt, g, ft, T, E, ED, FV)
+            ctl[C_NFEV] += 1.0
+            for i in range(n):
+                ft[i] = (ft[i] - St[0, i]) / dt
+        ctl[C_NLU] += 1.0
+        ctl[C_NFEV] += 5.0
+        err = rodas_step(N, t, hs, y, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B, gW, gD, int(dsp[0]),
+                         int(dsp[1]), F, ab, piv, pivoted, St, ytmp, btmp, w, z1, c23, tol, T, E, ED, FV, ctl)
+        if not (err - err == 0.0):
+            ctl[C_NREJ] += 1.0
+            ctl[C_H] = 0.1 * hs
+            reject = True
+            continue
+        fac = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, err ** 0.25 / SAFE))
+        hnew = hs / fac
+        if err <= 1.0:
+            if ctl[C_HACC] > 0.0:  # Gustafsson's predictive controller (rodas.f, PRED)
+                facg = (ctl[C_HACC] / hs) * (err * err / ctl[C_ERRACC]) ** 0.25 / SAFE
+                facg = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, facg))
+                hnew = hs / max(fac, facg)
+            ctl[C_HACC] = hs
+            ctl[C_ERRACC] = max(1e-2, err)
+            if reject:
+                hnew = min(hnew, hs)
+            tn = tb if last else t + hs
+            for i in range(n):
+                y0d[i] = y[i]
+                y[i] = z1[i]
+            ctl[C_TOLD] = t
+            ctl[C_T] = tn
+            f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
+                           dsp, T, E, ED, FV)
+            ctl[C_NFEV] += 1.0
+            ctl[C_NJEV] += 1.0
+            ctl[C_H] = hnew
+            if last:
+                ctl[C_STATUS] = FINISHED
+            return 0
+        ctl[C_NREJ] += 1.0
+        reject = True
+        ctl[C_H] = hnew
 
 
 class RodasDense:
@@ -229,63 +266,83 @@ class RodasDense:
         return self.y0 * (1.0 - x) + x * (self.y1 + (1.0 - x) * (self.c2 + x * self.c3))
 
 
-def full_jacobian(line, t, z):
-    """The dense Jacobian the method uses at (t, z): ``jac_blocks``'s node part with the W and
-    D rows of :func:`wd_gradients` (for tests against differences)."""
-    J = line.jac(t, z).toarray()
-    N = line.N
-    gW, gD = np.zeros(4), np.zeros(4 * N)
-    T, E, ED, FV = (np.zeros(N) for _ in range(4))
-    EK.tensions(N, z, line.pin_state(t), line.h, line.ea, line.damp, line.tabe, line.tabt, T, E, ED, FV)
-    wd_gradients(N, z, line.pin_state(t), line.h, line.ea, line.damp, line.tabe, line.tabt, T, E, ED, FV, gW, gD)
-    J[4 * N, 4 * (N - 1):4 * N] = gW
-    J[4 * N + 1, :4 * N] = gD
-    return J
+def pin_model(line):
+    """The compiled held end of ``line``: ``(par, tab)`` of :func:`general.pin_kinematics`."""
+    mdl = G.make_model(np.ones(1), np.ones(1), **line.pin.model_args())
+    return mdl[0], mdl[-1]
 
 
 class RodasStepper:
     """RODAS4 on an :class:`ElasticLine` with the interface of scipy's ``OdeSolver`` that
     :func:`elastic_solve.solve` uses: ``step()``, ``t``, ``t_old``, ``y``, ``status``,
-    ``dense_output()``, ``nfev``, ``njev``, ``nlu`` (and ``nrej``, rejected steps)."""
+    ``dense_output()``, ``h`` (the next step, settable), ``nfev``, ``njev``, ``nlu`` (and
+    ``nrej``, rejected steps, ``npiv``, pivoted factorisations). ``pivoted=True`` factors
+    every stage matrix with partial pivoting (the reference of the pivot-free path)."""
 
-    def __init__(self, line, t0, z0, t_bound, tol, h0=None):
-        self.line, self.t, self.t_old, self.t_bound, self.tol = line, float(t0), None, float(t_bound), float(tol)
+    def __init__(self, line, t0, z0, t_bound, tol, h0=None, *, pivoted=False):
+        self.line = line
         self.y = np.array(z0, dtype=float)
         N = self.N = line.N
         n = self.y.size
-        self.auto = line.pin.kind == "fixed"
+        self.ctl = np.zeros(NCTL)
+        c = self.ctl
+        c[C_T], c[C_TOLD], c[C_TB], c[C_TOL], c[C_HACC] = float(t0), np.nan, float(t_bound), float(tol), -1.0
+        c[C_AUTO] = float(line.pin.kind == "fixed")
+        c[C_PIVOTED] = float(bool(pivoted))
+        self.pinpar, self.pintab = pin_model(line)
         self.St = np.zeros((7, n))
-        self.B = np.zeros((N, 3, 4, 4))
+        self.B = np.zeros((N, 3, 8))
         self.gW, self.gD = np.zeros(4), np.zeros(4 * N)
-        self.ab = np.zeros((2 * N, WIDTH))
+        self.dsp = np.zeros(2)
+        self.F = np.zeros((N, ES.NF))
+        self.ab = np.zeros((2 * N, ES.WIDTH))
         self.piv = np.zeros(2 * N, dtype=np.int64)
-        self.ytmp, self.btmp, self.z1, self.ft = (np.zeros(n) for _ in range(4))
+        self.ytmp, self.btmp, self.z1, self.ft, self.y0d = (np.zeros(n) for _ in range(5))
         self.w = np.zeros(2 * N)
         self.c23 = np.zeros((2, n))
         self.work = tuple(np.zeros(N) for _ in range(4))
-        self.pins = np.zeros((6, 4))
-        self.nfev = self.njev = self.nlu = self.nrej = 0
-        self.status = "running"
+        self.pins = np.zeros((7, 4))
         self._dense = None
-        self._hacc = self._erracc = None
-        self._f(self.t, self.y, self.St[0])
-        self._jac(self.t, self.y)
-        self.h = h0 if h0 is not None else self._initial_step()
+        self.f_and_jacobian()
+        c[C_NFEV] += 1.0
+        c[C_NJEV] += 1.0
+        c[C_H] = h0 if h0 is not None else self._initial_step()
 
-    def _args(self):
+    def args(self):
+        """The line's arrays, as the compiled functions take them."""
         ln = self.line
         return ln.h, ln._invm, ln.ea, ln.damp, ln.tabe, ln.tabt, ln.g
 
-    def _f(self, t, z, out):
-        self.nfev += 1
-        h, invm, ea, damp, tabe, tabt, g = self._args()
-        EK.rhs(self.N, z, self.line.pin_state(t), h, invm, ea, damp, tabe, tabt, g, out, *self.work)
+    def f_and_jacobian(self):
+        """f and the Jacobian at the current (t, y) (not counted)."""
+        f_and_jacobian(self.N, self.ctl[C_T], self.y, self.pinpar, self.pintab, self.pins[6], *self.args(), self.St[0],
+                       self.B, self.gW, self.gD, self.dsp, *self.work)
 
-    def _jac(self, t, z):
-        self.njev += 1
-        ln, pin = self.line, self.line.pin_state(t)
-        EK.jac_blocks(self.N, z, pin, ln.h, ln._invm, ln.ea, ln.damp, ln.tabe, ln.tabt, self.B, *self.work)
-        wd_gradients(self.N, z, pin, ln.h, ln.ea, ln.damp, ln.tabe, ln.tabt, *self.work, self.gW, self.gD)
+    # the state and counts
+    t = property(lambda self: float(self.ctl[C_T]))
+    t_old = property(lambda self: None if np.isnan(self.ctl[C_TOLD]) else float(self.ctl[C_TOLD]))
+    t_bound = property(lambda self: float(self.ctl[C_TB]))
+    tol = property(lambda self: float(self.ctl[C_TOL]))
+    nfev = property(lambda self: int(self.ctl[C_NFEV]))
+    njev = property(lambda self: int(self.ctl[C_NJEV]))
+    nlu = property(lambda self: int(self.ctl[C_NLU]))
+    nrej = property(lambda self: int(self.ctl[C_NREJ]))
+    npiv = property(lambda self: int(self.ctl[C_NPIV]))
+    status = property(lambda self: {RUNNING: "running", FINISHED: "finished", FAILED: "failed"}[self.ctl[C_STATUS]])
+
+    @property
+    def h(self):
+        return float(self.ctl[C_H])
+
+    @h.setter
+    def h(self, value):
+        self.ctl[C_H] = float(value)
+
+    def _f(self, t, z, out):
+        self.ctl[C_NFEV] += 1.0
+        pin = np.zeros(4)
+        pin_at(float(t), self.pinpar, self.pintab, pin)
+        EK.rhs(self.N, z, pin, *self.args(), out, *self.work)
 
     def _norm(self, v):
         return float(np.max(np.abs(v) / (self.tol * (1.0 + np.abs(self.y)))))
@@ -309,56 +366,11 @@ class RodasStepper:
         message when the step fails."""
         if self.status != "running":
             raise RuntimeError("the stepper is not running")
-        t, y = self.t, self.y
-        h, invm, ea, damp, tabe, tabt, g = self._args()
-        reject = False
-        while True:
-            hs = self.h
-            last = t + hs >= self.t_bound or t + 1.01 * hs >= self.t_bound
-            if last:
-                hs = self.t_bound - t
-            if hs <= 1e-14 * max(1.0, abs(t)):
-                self.status = "failed"
-                return f"step size {hs:.3g} too small at t = {t:.9g}"
-            if self.auto:
-                self.pins[:] = self.line.pin_state(t)
-            else:
-                for s in range(6):
-                    self.pins[s] = self.line.pin_state(t + C_NODE[s] * hs)
-                dt = 1e-7 * max(1.0, abs(t))
-                self._f(t + dt, y, self.ft)
-                self.ft -= self.St[0]
-                self.ft /= dt
-            self.nlu += 1
-            self.nfev += 5
-            err = rodas_step(self.N, t, hs, y, self.ft, self.auto, self.pins, h, invm, ea, damp, tabe, tabt, g,
-                             self.B, self.gW, self.gD, self.ab, self.piv, self.St, self.ytmp, self.btmp, self.w,
-                             self.z1, self.c23, self.tol, *self.work)
-            if not np.isfinite(err):
-                self.nrej += 1
-                self.h = 0.1 * hs
-                reject = True
-                continue
-            fac = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, err ** 0.25 / SAFE))
-            hnew = hs / fac
-            if err <= 1.0:
-                if self._hacc is not None:  # Gustafsson's predictive controller (rodas.f, PRED)
-                    facg = (self._hacc / hs) * (err * err / self._erracc) ** 0.25 / SAFE
-                    facg = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, facg))
-                    hnew = hs / max(fac, facg)
-                self._hacc, self._erracc = hs, max(1e-2, err)
-                if reject:
-                    hnew = min(hnew, hs)
-                tn = self.t_bound if last else t + hs
-                y1 = self.z1.copy()
-                self._dense = RodasDense(t, tn, y.copy(), y1, self.c23)
-                self.t_old, self.t, self.y = t, tn, y1
-                self._f(tn, y1, self.St[0])
-                self._jac(tn, y1)
-                self.h = hnew
-                if last:
-                    self.status = "finished"
-                return None
-            self.nrej += 1
-            reject = True
-            self.h = hnew
+        t = self.t
+        if rodas_accept(self.N, self.y, self.St, self.B, self.gW, self.gD, self.dsp, self.F, self.ab, self.piv,
+                        self.pins, self.pinpar, self.pintab, *self.args(), self.ytmp, self.btmp, self.w, self.ft,
+                        self.z1, self.y0d, self.c23, self.ctl, *self.work) != 0:
+            return f"step size {self.ctl[C_HFAIL]:.3g} too small at t = {t:.9g}"
+        self._dense = RodasDense(self.t_old, self.t, self.y0d.copy(), self.y.copy(), self.c23)
+        self.y = self.y.copy()  # (a new array per step, as scipy's solvers give)
+        return None

@@ -9,7 +9,9 @@ right-hand side) is there to compare: its steps are bounded by stability, dt ~ h
 ``"rodas4"`` is a compiled RODAS4 (:mod:`snapping.simulate.elastic_rodas`: the exact banded
 Jacobian, W and D rows included, the stage system reduced to the velocities, O(N) a step):
 as many evaluations as Radau for the same peak accuracy or fewer (5x fewer at N = 100, c = 300)
-and 10-70x less wall time.
+and 10-70x less wall time. Its step loop and the bookkeeping below (records, peaks, snapshots,
+the stop rule) are compiled (:mod:`snapping.simulate.elastic_advance`; Python runs once per
+snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = False``).
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -38,6 +40,8 @@ from scipy.integrate import DOP853, Radau
 
 from .. import _validate as V
 from .. import schema
+from . import elastic_advance as EA
+from . import elastic_rodas as ER
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
 
@@ -52,6 +56,9 @@ PEAK_SAMPLES = 24
 #: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
 #: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
 ENERGY_ERROR_FAIL = 0.1
+#: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
+#: below, one step a call (the reference the compiled loop equals, bit for bit)
+COMPILED_LOOP = True
 #: the per-step record's columns (the Dataset's step variables, in this order)
 STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
               "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
@@ -157,6 +164,51 @@ def _initial(line, start, initial):
     return line.pack(x, y, vx, vy)
 
 
+_ENERGY_MSG = (f"energy error above {ENERGY_ERROR_FAIL:g} of the line's energy (the steps do not resolve the "
+               "motion: tighten tol)")
+
+
+def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, **kw):
+    """The step loop of :func:`solve` for RODAS4, compiled (:func:`elastic_advance.advance`:
+    the same bookkeeping, many steps a call). Returns the record rows (t first), the running
+    peak's state, the first slack time, when the stop rule was armed, status and reason; the
+    snapshots and the peaks' kept steps are filled in."""
+    run = EA.RodasRun(solver, mm0, energy_fail=ENERGY_ERROR_FAIL, **kw)
+    chunks, status = [], "completed"
+    while True:
+        code = run.advance(snaps[0] if snaps else np.inf)
+        chunks.append(run.drain())
+        if code == EA.R_STEP_FAILED:
+            status, stop_reason = "failed", f"step failed: step size {solver.ctl[ER.C_HFAIL]:.3g} too small at " \
+                f"t = {solver.t:.9g}"
+            break
+        t, dense = solver.t, None
+        while snaps and snaps[0] <= t:
+            ts = snaps.pop(0)
+            if ts >= 0.0:
+                dense = dense or run.last_dense()
+                snap_t.append(ts)
+                snap_z.append(dense(ts) if ts < t else solver.y.copy())
+                snap_kind.append("requested")
+        if code in (EA.R_SNAPSHOT, EA.R_BUFFER):
+            continue
+        if code == EA.R_SNAP:
+            stop_reason = "snap"
+        elif code == EA.R_NONFINITE:
+            status, stop_reason = "failed", "non-finite state"
+        elif code == EA.R_MAXRHS:
+            status, stop_reason = "failed", f"more than max_rhs={kw['max_rhs']} right-hand-side evaluations"
+        elif code == EA.R_ENERGY:
+            status, stop_reason = "failed", _ENERGY_MSG
+        break
+    for k, best in zip(peaks.COLS, run.refined_peaks(PEAK_SAMPLES).values()):
+        peaks.best[k], peaks.keep[k] = best, []  # (refined: refine() returns them)
+    sc = run.sctl
+    if sc[EA.S_RUN] > 0.0:
+        peak_state = (float(sc[EA.S_PEAKT]), run.peak_z.copy())
+    return np.concatenate(chunks), peak_state, float(sc[EA.S_SLACK]), float(sc[EA.S_ARMED]), status, stop_reason
+
+
 def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float = 1e-8, method: str = "radau",
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
           snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None) -> ElasticRun:
@@ -248,44 +300,50 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
-    while solver.status == "running":
-        msg = solver.step()
-        if solver.status == "failed":
-            status, stop_reason = "failed", f"step failed: {msg}"
-            break
-        t, z = float(solver.t), solver.y
-        dense = solver.dense_output()
-        while snaps and snaps[0] <= t:
-            ts = snaps.pop(0)
-            if ts >= 0.0:
-                snap_t.append(ts)
-                snap_z.append(dense(ts) if ts < t else z.copy())
-                snap_kind.append("requested")
-        mm = line.measure(t, z)
-        rows.append(_record(line, t, z, t - solver.t_old, mm))
-        times.append(t)
-        peaks.update(t, mm, dense)
-        if mm[16] > 0 and np.isnan(first_slack):
-            first_slack = t
-        if mm[0] > running:
-            running, peak_state = mm[0], (t, z.copy())
-        if not np.all(np.isfinite(z)):
-            status, stop_reason = "failed", "non-finite state"
-            break
-        if max(count[0], solver.nfev) > max_rhs:
-            status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
-            break
-        row = rows[-1]
-        err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
-        if np.isnan(t_armed) and running >= floor:
-            t_armed = t
-        if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
-            stop_reason = "snap"
-            break
-        if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
-            status, stop_reason = "failed", (f"energy error above {ENERGY_ERROR_FAIL:g} of the line's energy (the "
-                                             "steps do not resolve the motion: tighten tol)")
-            break
+    if method == "rodas4" and COMPILED_LOOP:
+        rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
+            solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason,
+            t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
+        rows += rec_steps[:, 1:].tolist()
+        times += rec_steps[:, 0].tolist()
+    else:
+        while solver.status == "running":
+            msg = solver.step()
+            if solver.status == "failed":
+                status, stop_reason = "failed", f"step failed: {msg}"
+                break
+            t, z = float(solver.t), solver.y
+            dense = solver.dense_output()
+            while snaps and snaps[0] <= t:
+                ts = snaps.pop(0)
+                if ts >= 0.0:
+                    snap_t.append(ts)
+                    snap_z.append(dense(ts) if ts < t else z.copy())
+                    snap_kind.append("requested")
+            mm = line.measure(t, z)
+            rows.append(_record(line, t, z, t - solver.t_old, mm))
+            times.append(t)
+            peaks.update(t, mm, dense)
+            if mm[16] > 0 and np.isnan(first_slack):
+                first_slack = t
+            if mm[0] > running:
+                running, peak_state = mm[0], (t, z.copy())
+            if not np.all(np.isfinite(z)):
+                status, stop_reason = "failed", "non-finite state"
+                break
+            if max(count[0], solver.nfev) > max_rhs:
+                status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
+                break
+            row = rows[-1]
+            err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
+            if np.isnan(t_armed) and running >= floor:
+                t_armed = t
+            if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
+                stop_reason = "snap"
+                break
+            if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
+                status, stop_reason = "failed", _ENERGY_MSG
+                break
     t_final = times[-1]
     zf = solver.y.copy()
     snap_t += [peak_state[0], t_final]
@@ -310,6 +368,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
         "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
         "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
+        "n_lu_pivoted": int(getattr(solver, "npiv", 0)),
         "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
         "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
         "t_stop_armed": float(t_armed),

@@ -1,0 +1,250 @@
+"""The elastic line's RODAS4 run loop, compiled: many steps and their bookkeeping between two
+returns to Python (``elastic.solve(..., method="rodas4")``).
+
+:func:`advance` takes accepted steps (:func:`snapping.simulate.elastic_rodas.rodas_accept`)
+and after each does what :func:`snapping.simulate.elastic_solve.solve`'s step loop does for
+the other methods, in the same order and with the same arithmetic: the per-state measures
+(:func:`elastic_kernels.measure_given`, from the step's last evaluation: the next step's
+first stage is ``f`` at the new state, so its tensions and accelerations are already there),
+one row of the step record, the running maxima of v, a and sigma with the continuous
+extensions of the steps around each (kept in a pool of step slots, without copies), the
+first slack link, the running peak of v_max and its state, then the checks: a non-finite
+state, ``max_rhs``, the energy balance, the stop rule (v_max below ``stop_fraction`` of its
+running peak once that peak is above the floor), the energy-error failure. It returns to
+Python at the end, at a stop or failure, after the step that passes the next snapshot time,
+and when the record buffer is full (:class:`RodasRun` then drains it). The peaks are then
+refined on the kept steps (:func:`refine`, the arithmetic of ``_Peaks.refine``, compiled).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from . import elastic_kernels as EK
+from . import elastic_rodas as ER
+
+__all__ = ["advance", "RodasRun", "NREC", "NSLOT"]
+
+#: columns of a record row: t, then elastic_solve.STEP_NAMES
+NREC = 19
+#: rows of the record buffer (a full buffer returns to Python, which drains it)
+ROWS = 4096
+#: step slots of the pool (three kept steps per peak kind, the last step, one being taken)
+NSLOT = 12
+#: the peak kinds' columns of the measures (v_max, a_max, sigma_max)
+KCOL = np.array([0, 2, 4])
+#: the run's controls (``sctl``): t_end given, stop_fraction, the stop floor, the running peak
+#: of v_max, when the stop rule was armed, the largest energy error, E(0), U(0), max_rhs, the
+#: next snapshot time, the first slack time, rows in the buffer, the running peak's time, the
+#: last step's slot, the energy error's failure fraction
+(S_TEND, S_FRAC, S_FLOOR, S_RUN, S_ARMED, S_ERR, S_E0, S_U0, S_MAXRHS, S_TSNAP, S_SLACK, S_NREC, S_PEAKT,
+ S_PREV, S_EFAIL) = range(15)
+NSCTL = 15
+#: what :func:`advance` returns
+(R_FINISHED, R_SNAP, R_STEP_FAILED, R_NONFINITE, R_MAXRHS, R_ENERGY, R_SNAPSHOT, R_BUFFER) = range(8)
+
+
+@njit(cache=True, error_model="numpy")
+def _hold(ref, keep, nkeep, k, s):
+    keep[k, nkeep[k]] = s
+    nkeep[k] += 1
+    ref[s] += 1
+
+
+@njit(cache=True, error_model="numpy")
+def _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best):
+    """``_Peaks.update`` of elastic_solve on slots: a new maximum keeps the step before it and
+    its own, and the step after it once taken."""
+    for k in range(3):
+        c = KCOL[k]
+        if after[k]:
+            _hold(ref, keep, nkeep, k, s)
+            after[k] = False
+        if mm[c] > best[k, 0]:
+            best[k, 0] = mm[c]
+            best[k, 1] = t
+            for q in range(nkeep[k]):
+                ref[keep[k, q]] -= 1
+            nkeep[k] = 0
+            if prev >= 0:
+                _hold(ref, keep, nkeep, k, prev)
+            _hold(ref, keep, nkeep, k, s)
+            after[k] = True
+    if prev >= 0:
+        ref[prev] -= 1
+    ref[s] += 1
+
+
+@njit(cache=True, error_model="numpy")
+def advance(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, ytmp,
+            btmp, w, ft, ctl, T, E, ED, FV, m, tabw, snode, s_node, s_link, mm, PY0, PY1, PC, PT, ref, keep, nkeep,
+            after, best, sctl, rec, peak_z):
+    """Accepted steps from ``(ctl[C_T], y)`` and their bookkeeping until one of the ``R_*``
+    codes (see the module). Slot ``s`` of the pool holds a step's start ``PY0[s]``, end
+    ``PY1[s]``, dense output ``PC[s]`` and ``PT[s] = (t_old, t)``; ``ref[s]`` counts its users
+    (the kept steps of the peaks, the last step)."""
+    n = y.shape[0]
+    pin = pins[6]
+    tend = sctl[S_TEND] != 0.0
+    while True:
+        s = 0
+        while ref[s] > 0:
+            s += 1
+        if ER.rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe,
+                           tabt, g, ytmp, btmp, w, ft, PY1[s], PY0[s], PC[s], ctl, T, E, ED, FV) != 0:
+            return R_STEP_FAILED
+        t = ctl[ER.C_T]
+        PT[s, 0] = ctl[ER.C_TOLD]
+        PT[s, 1] = t
+        # St[0] = f(t, y) and T, E its tensions and strains, with the held end at t (pins[6])
+        EK.measure_given(N, y, pin, h, m, ea, tabe, tabt, tabw, g, snode, St[0], T, E, mm)
+        r = int(sctl[S_NREC])
+        row = rec[r]
+        W = y[4 * N]
+        D = y[4 * N + 1]
+        row[0] = t
+        row[1] = t - ctl[ER.C_TOLD]
+        row[2] = mm[0]
+        row[3] = mm[2]
+        row[4] = mm[4]
+        row[5] = s_node[int(mm[1])]
+        row[6] = s_node[int(mm[3])]
+        row[7] = s_link[int(mm[5])]
+        row[8] = mm[6]
+        row[9] = mm[8]
+        row[10] = mm[9]
+        row[11] = mm[10]
+        row[12] = mm[11]
+        row[13] = mm[12] + mm[13] + mm[14]
+        row[14] = mm[14]
+        row[15] = W
+        row[16] = D
+        row[17] = mm[15]
+        row[18] = mm[16]
+        sctl[S_NREC] = r + 1
+        prev = int(sctl[S_PREV])
+        _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best)
+        sctl[S_PREV] = s
+        if mm[16] > 0 and np.isnan(sctl[S_SLACK]):
+            sctl[S_SLACK] = t
+        if mm[0] > sctl[S_RUN]:
+            sctl[S_RUN] = mm[0]
+            sctl[S_PEAKT] = t
+            for i in range(n):
+                peak_z[i] = y[i]
+        for i in range(n):
+            if not (y[i] - y[i] == 0.0):
+                return R_NONFINITE
+        if ctl[ER.C_NFEV] > sctl[S_MAXRHS]:
+            return R_MAXRHS
+        sctl[S_ERR] = max(sctl[S_ERR], abs(row[13] - W + D - sctl[S_E0]))
+        if np.isnan(sctl[S_ARMED]) and sctl[S_RUN] >= sctl[S_FLOOR]:
+            sctl[S_ARMED] = t
+        if not tend and not np.isnan(sctl[S_ARMED]) and mm[0] < sctl[S_FRAC] * sctl[S_RUN]:
+            return R_SNAP
+        if not tend and sctl[S_ERR] > sctl[S_EFAIL] * (abs(sctl[S_E0]) + abs(W) + sctl[S_U0]):
+            return R_ENERGY
+        if ctl[ER.C_STATUS] == ER.FINISHED:
+            return R_FINISHED
+        if t >= sctl[S_TSNAP]:
+            return R_SNAPSHOT
+        if r + 1 == rec.shape[0]:
+            return R_BUFFER
+
+
+@njit(cache=True, error_model="numpy")
+def refine(N, c, val, tp, ts, t_old, t, y0, y1, c23, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode,
+           y, dz, pin, T, E, ED, FV, mm):
+    """``_Peaks.refine`` of elastic_solve on one kept step: the measure ``c`` at the times ``ts``
+    on its continuous extension (``RodasDense``'s arithmetic); returns the running (value, time)."""
+    n = y0.shape[0]
+    for q in range(ts.shape[0]):
+        tt = ts[q]
+        x = (tt - t_old) / (t - t_old)
+        for i in range(n):
+            y[i] = y0[i] * (1.0 - x) + x * (y1[i] + (1.0 - x) * (c23[0, i] + x * c23[1, i]))
+        ER.pin_at(tt, pinpar, pintab, pin)
+        EK.measure(N, y, pin, h, m, ea, damp, tabe, tabt, tabw, g, snode, dz, T, E, ED, FV, mm)
+        if mm[c] > val:
+            val = mm[c]
+            tp = tt
+    return val, tp
+
+
+class RodasRun:
+    """A RODAS4 run of :func:`elastic_solve.solve`: the stepper's state (a
+    :class:`~snapping.simulate.elastic_rodas.RodasStepper`), the pool of step slots, the
+    peaks and the run's controls; :meth:`advance` runs the compiled loop to its next return."""
+
+    def __init__(self, stepper, mm0, *, t_end_given, stop_fraction, floor, E0, U0, max_rhs, energy_fail, rows=None):
+        st = self.st = stepper
+        n = st.y.size
+        self.PY0, self.PY1 = np.zeros((NSLOT, n)), np.zeros((NSLOT, n))
+        self.PC = np.zeros((NSLOT, 2, n))
+        self.PT = np.zeros((NSLOT, 2))
+        self.ref = np.zeros(NSLOT, dtype=np.int64)
+        self.keep = np.full((3, 3), -1, dtype=np.int64)
+        self.nkeep = np.zeros(3, dtype=np.int64)
+        self.after = np.ones(3, dtype=np.bool_)  # (as _Peaks.update(0, mm0, None) leaves them)
+        self.best = np.array([[mm0[c], 0.0] for c in KCOL])
+        self.sctl = np.zeros(NSCTL)
+        c = self.sctl
+        c[S_TEND], c[S_FRAC], c[S_FLOOR], c[S_RUN] = float(t_end_given), stop_fraction, floor, 0.0
+        c[S_ARMED], c[S_ERR], c[S_E0], c[S_U0], c[S_MAXRHS] = np.nan, 0.0, E0, U0, max_rhs
+        c[S_TSNAP], c[S_SLACK], c[S_NREC], c[S_PEAKT], c[S_PREV], c[S_EFAIL] = np.inf, np.nan, 0, 0.0, -1, energy_fail
+        self.rec = np.zeros((ROWS if rows is None else rows, NREC))
+        self.peak_z = st.y.copy()
+        self.mm = np.zeros(EK.NMEAS)
+        ln = st.line
+        self.model = (ln.m, ln.tabw, ln.snode, np.concatenate([ln.snode, [0.0]]), ln.snode - 0.5 * ln.h)
+
+    def advance(self, t_snapshot=np.inf) -> int:
+        """Steps until the next return code (``R_*``), the next snapshot time ``t_snapshot``."""
+        st = self.st
+        self.sctl[S_TSNAP] = t_snapshot
+        return advance(st.N, st.y, st.St, st.B, st.gW, st.gD, st.dsp, st.F, st.ab, st.piv, st.pins, st.pinpar,
+                       st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.ctl, *st.work, *self.model, self.mm,
+                       self.PY0, self.PY1, self.PC, self.PT, self.ref, self.keep, self.nkeep, self.after, self.best,
+                       self.sctl, self.rec, self.peak_z)
+
+    def drain(self) -> np.ndarray:
+        """The record rows since the last drain (t first, then STEP_NAMES)."""
+        k = int(self.sctl[S_NREC])
+        out = self.rec[:k].copy()
+        self.sctl[S_NREC] = 0
+        return out
+
+    def dense(self, s):
+        """The continuous extension of the step in slot ``s``."""
+        return ER.RodasDense(self.PT[s, 0], self.PT[s, 1], self.PY0[s].copy(), self.PY1[s].copy(), self.PC[s])
+
+    def last_dense(self):
+        return self.dense(int(self.sctl[S_PREV]))
+
+    def segments(self):
+        """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
+        (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
+        return {k: (float(self.best[k, 0]), float(self.best[k, 1]),
+                    [(float(self.PT[s, 0]), self.PY0[s].copy(), float(self.PT[s, 1]), self.dense(int(s)))
+                     for s in self.keep[k, :self.nkeep[k]]]) for k in range(3)}
+
+    def refined_peaks(self, samples):
+        """{kind index: (value, time)}: the peaks refined on their kept steps at ``samples - 1``
+        inner points each (``_Peaks.refine``'s, compiled)."""
+        st = self.st
+        ln = st.line
+        n = st.y.size
+        y, dz = np.zeros(n), np.zeros(n)
+        pin = np.zeros(4)
+        out = {}
+        for k in range(3):
+            val, tp = float(self.best[k, 0]), float(self.best[k, 1])
+            for s in self.keep[k, :self.nkeep[k]]:
+                t_old, t = self.PT[s]
+                ts = np.linspace(t_old, t, samples + 1)[1:-1]
+                val, tp = refine(st.N, int(KCOL[k]), val, tp, ts, t_old, t, self.PY0[s], self.PY1[s], self.PC[s],
+                                 st.pinpar, st.pintab, ln.h, ln.m, ln.ea, ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g,
+                                 ln.snode, y, dz, pin, *st.work, self.mm)
+            out[k] = (float(val), float(tp))
+        return out
