@@ -41,11 +41,24 @@ def test_rule_takes_grading_for_nylon_like_numbers_only():
     runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.25, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 100, ["bending", "drag"], "auto")
     assert g["used"] and g["collapse"] >= math.pi / 2 and [x["run"] for x in runs.log] == ["drag"]
-    # at chi = 0.1 drag alone keeps its fold above the links, but the full run's folds onto one link
+    # at chi = 0.1 drag alone keeps its fold above the links (it narrows as they halve), but the full
+    # run's folds onto one link
     runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.1, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 200, ["bending", "drag"], "auto")
     assert g["used"] and g["collapse_run"] == "with bending" and g["collapse"] >= math.pi / 2
-    assert [x["run"] for x in runs.log] == ["drag", "bending+drag"]
+    assert [(x["run"], x["N"]) for x in runs.log] == [("drag", 200), ("drag", 400), ("bending+drag", 200)]
+    # at chi = 0.2 on 100 links drag alone turns by less than pi/2 at one node, but it turns more on
+    # 200: a fold that does not narrow with the links (the nylon line at design's chi 0.2)
+    runs = caps_runs.Runs(caps.spec("nylon-monofilament"), 0.2, 1e-6, 1e-4, 1.0)
+    g = caps._grading(runs, 100, ["bending", "drag"], "auto")
+    assert g["used"] and g["collapse"] < math.pi / 2 and g["halved"] >= g["collapse"]
+    assert [(x["run"], x["N"]) for x in runs.log] == [("drag", 100), ("drag", 200)]
+    # the rule itself on those numbers, and on a fold that narrows (the fly line's drag at chi 0.2)
+    assert caps_runs.grading_rule(lb, 1.0 / 100, 0.61, halved=1.50)[0]
+    assert not caps_runs.grading_rule(lb, 1.0 / 100, 0.56, halved=0.36)[0]
+    assert caps_runs.grading_rule(lb, 1.0 / 100, 0.61, halved=0.62)[0]  # the boundary: does not fall ...
+    assert not caps_runs.grading_rule(lb, 1.0 / 100, 0.61, halved=0.60)[0]  # ... falls
+    assert not caps_runs.grading_rule(lb, 1.0 / 100, 0.56, halved=None)[0]
     # a bending length far below the nylon line's: graded links too many, the uniform answer said unresolved
     runs = caps_runs.Runs(caps.spec(None, length=2.0, mass=0.1, ei=1e-9, diameter=0.05), 0.3, 1e-6, 1e-4, 1.0)
     g = caps._grading(runs, 16, ["bending", "drag"], "auto")

@@ -17,7 +17,10 @@ only moves every peak of every catalogue answer by at most 0.07% (N 100-1000,
 
 from __future__ import annotations
 
+import math
 import time
+
+import numpy as np
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
            "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
@@ -114,7 +117,6 @@ def bending_length(sp) -> float:
     (lambda g L))/L`` with the free end's EI and mass per length (a taper's there), the length
     over which bending holds a fold against tension of the order of the line's weight (the
     nylon line: 1.0e-3, its snap's fold has radius 1.1e-3 L); 0 without bending there."""
-    import math
 
     L = sp.length
     ei = sp.ei(L) if callable(sp.ei) else sp.ei
@@ -124,7 +126,7 @@ def bending_length(sp) -> float:
     return math.sqrt(ei / (lam * sp.g * L)) / L if ei > 0.0 else 0.0
 
 
-def graded_h(chi: float, lb: float, level: int) -> "np.ndarray":
+def graded_h(chi: float, lb: float, level: int) -> np.ndarray:
     """The links of graded level ``level`` (0 or 1) of a line whose bending length is ``lb``
     (nondimensional, :func:`bending_length`): ``grading.fold_following`` with the links along the
     fold's path at most :data:`FOLD_LINK` lb, :data:`TIP_LINK` lb at the free end and
@@ -148,32 +150,46 @@ GRADE_LINKS = 20.0
 #: ... and without bending the fold collapses onto one link: the curvature peak times the free end's link
 #: at least this (pi/2: folded past a right angle at one node; the nylon line's drag alone: pi at N >= 200,
 #: 2.3 at 100; every other catalogue line's run without bending: at most 0.7 at N >= 100, falling as 1/N;
-#: at N = 20 they reach 1.2-2.2, and the bungee cord's, 0.8 links per bending length, is graded there)
+#: at N = 20 they reach 1.2-2.2, and the bungee cord's, 0.8 links per bending length, is graded there).
+#: Below it, a fold that collapses is told by links half as long: its curvature peak times the link does
+#: not fall (the nylon line's drag alone at chi 0.2: 0.61 on 100 links, 1.50 on 200, 3.14 on 400), where a
+#: fold held above the links narrows with them (every other catalogue line's, chi 0.1-0.5, 25-400 links:
+#: by a factor 0.5-0.8 per halving)
 COLLAPSE = 1.5707963267948966
 #: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
 #: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
 MAX_GRADED_LINKS = 2500
 
 
-def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without bending") -> tuple[bool, str]:
+def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without bending",
+                 halved=None) -> tuple[bool, str]:
     """``(graded, why)``: whether an answer needs graded links (:meth:`Runs.graded`) rather than
     uniform links of length ``h_tip`` (nondimensional) at the free end. Graded when bending holds
     the fold and the links cannot: the bending length ``lb`` (:func:`bending_length`; 0: none) is
-    under :data:`GRADE_LINKS` links, and a run on those links folds onto one link, ``kappa_h`` (its
-    curvature peak times ``h_tip``; None: not run) at least :data:`COLLAPSE` -- the run ``where``
-    (without bending: nothing else holds the fold; or with it: its fold is below the links).
+    under :data:`GRADE_LINKS` links, and a run on those links folds onto one link -- ``kappa_h`` (its
+    curvature peak times ``h_tip``; None: not run) at least :data:`COLLAPSE`, or ``halved`` (the same
+    on links half as long; None: not run) not below ``kappa_h``, a fold that does not narrow as the
+    links do -- the run ``where`` (without bending: nothing else holds the fold; or with it: its fold
+    is below the links).
 
     >>> grading_rule(1e-3, 1e-3, 3.14)[0], grading_rule(0.0, 1e-3, 3.14)[0], grading_rule(1e-3, 1e-3, 0.5)[0]
     (True, False, False)
+    >>> grading_rule(1e-3, 1e-2, 0.61, halved=1.5)[0], grading_rule(1e-3, 1e-2, 0.56, halved=0.36)[0]
+    (True, False)
     """
     if lb <= 0.0:
         return False, "no bending at the free end (without it the links, not a continuum, set the fold)"
     if lb >= GRADE_LINKS * h_tip:
         return False, f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (>= {GRADE_LINKS:g}): resolved"
+    kh = kappa_h if kappa_h is not None else float("nan")
+    if halved is not None and kappa_h is not None and kappa_h < COLLAPSE and halved >= kappa_h:
+        return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
+                      f"the fold does not narrow as the links halve (curvature peak x link {kh:.3g}, then "
+                      f"{halved:.3g}): it collapses onto the links; bending sets it, graded links resolve it")
     if kappa_h is None or kappa_h < COLLAPSE:
-        kh = kappa_h if kappa_h is not None else float("nan")
         return False, (f"with and without bending the fold stays above the link scale (curvature peak x link "
-                       f"{kh:.3g} < pi/2): the links resolve what caps it")
+                       f"{kh:.3g} < pi/2" + (f", {halved:.3g} on links half as long" if halved is not None else "")
+                       + "): the links resolve what caps it")
     return True, (f"the bending length ({lb:.3g} L) is {lb / h_tip:.3g} links (< {GRADE_LINKS:g}) and {where} "
                   f"the fold collapses onto one link (curvature peak x link {kappa_h:.3g} >= pi/2): bending sets the "
                   f"fold, graded links resolve it")
@@ -183,27 +199,32 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
     """Whether the answer of :class:`Runs` ``runs`` on ``N`` links takes graded links
     (:func:`grading_rule`; ``present``: the line's mechanisms; ``graded``: "auto", True or False):
     only when the bending length is under :data:`GRADE_LINKS` links, the run without bending on N
-    links, and when its fold does not collapse, the full run on N links (the uniform answer's own)."""
+    links; when its fold stays under pi/2 at one node, the same on 2N links (does it narrow with them?);
+    when it does, the full run on N links (the uniform answer's own)."""
     if graded is False or "bending" not in present:
         return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
     lb = bending_length(runs.sp)
     if graded is True:
         return {"used": lb > 0.0, "why": "graded=True", "bending_length": lb}
-    kh, where = None, "without bending"
+    kh, kh2, where = None, None, "without bending"
     if 0.0 < lb < GRADE_LINKS / N:
-        kh = runs.get(tuple(m for m in present if m != "bending"), N)["kappa_peak"] / N
-        if kh < COLLAPSE:  # the full run (made anyway when not graded): its fold below the links?
-            kf = runs.get(tuple(present), N)["kappa_peak"] / N
-            if kf >= COLLAPSE:
-                kh, where = kf, "with bending"
-    used, why = grading_rule(lb, 1.0 / N, kh, where)
+        bare = tuple(m for m in present if m != "bending")
+        kh = runs.get(bare, N)["kappa_peak"] / N
+        if kh < COLLAPSE:  # on links half as long: a fold above the links narrows with them (kappa h falls)
+            kh2 = runs.get(bare, 2 * N)["kappa_peak"] / (2 * N)
+            if kh2 < kh:  # it does: the full run (made anyway when not graded), its fold below the links?
+                kf = runs.get(tuple(present), N)["kappa_peak"] / N
+                if kf >= COLLAPSE:
+                    kh, kh2, where = kf, None, "with bending"
+    used, why = grading_rule(lb, 1.0 / N, kh, where, halved=kh2)
     if used:
         n = graded_h(runs.chi, lb, 1).size
         if n > MAX_GRADED_LINKS:
-            return {"used": False, "bending_length": lb, "collapse": kh, "collapse_run": where, "too_fine": n,
+            return {"used": False, "bending_length": lb, "collapse": kh, "halved": kh2, "collapse_run": where,
+                    "too_fine": n,
                     "why": f"{why}; but its finer level would need {n} links (> {MAX_GRADED_LINKS}): answered on "
                            f"{N} uniform links, where the fold is NOT resolved"}
-    return {"used": used, "why": why, "bending_length": lb, "collapse": kh, "collapse_run": where}
+    return {"used": used, "why": why, "bending_length": lb, "collapse": kh, "halved": kh2, "collapse_run": where}
 
 
 def richardson(coarse: float, fine: float, order: float = GRADED_ORDER, ratio: float = 2.0) -> tuple[float, float]:
