@@ -44,7 +44,8 @@ from .elastic_rodas import RodasStepper
 __all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
 METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
-#: points per step at which the dense output is sampled around each peak
+#: intervals per step at whose interior points the steps around each peak are sampled (states
+#: integrated from the step's start: :class:`_Peaks`)
 PEAK_SAMPLES = 24
 #: an automatic run (no t_end) fails once its energy error exceeds this fraction of the line's
 #: energy |E(0)| + |W| + U(0) (0.255 for chi = 0.25): the snap can no longer be told from the
@@ -83,8 +84,17 @@ def _record(line, t, z, dt, mm):
 
 
 class _Peaks:
-    """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the dense
-    output of the steps on either side of each, to refine them afterwards."""
+    """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the steps on
+    either side of each (start time and state, end time), to refine them afterwards.
+
+    The refinement samples ``PEAK_SAMPLES - 1`` interior times of each kept step with states
+    integrated from the step's start by the run's own method and tolerance (``restep``), not read
+    off the dense output: the dense output (RODAS4's is of order 3) carries an error along the
+    links of about the tolerance times the motion, and the tension EA e and the acceleration
+    of a node of mass m, (EA/(h m)) times a length error, multiply it by up to 2 c^2 N^2. At chi
+    0.25, N = 100, c = 10000, tol 1e-7 that raised a_peak by 8.5e-5 (relative) above the
+    states the steps themselves reach (``benchmarks/elastic_ea_limit.py``: the EA -> infinity
+    plateau of a_peak)."""
 
     COLS = {"v": 0, "a": 2, "sigma": 4}
 
@@ -94,25 +104,35 @@ class _Peaks:
         self.after = dict.fromkeys(self.COLS, False)
         self.prev = None
 
-    def update(self, t, mm, dense):
+    def update(self, t, mm, seg):
+        """Record the accepted step ``seg = (t_old, y_old, t)`` (None for the initial state)
+        ending at ``t`` with the measures ``mm``."""
         for k, c in self.COLS.items():
-            if self.after[k] and dense is not None:
-                self.keep[k].append(dense)
+            if self.after[k] and seg is not None:
+                self.keep[k].append(seg)
                 self.after[k] = False
             if mm[c] > self.best[k][0]:
                 self.best[k] = (float(mm[c]), float(t))
-                self.keep[k] = [d for d in (self.prev, dense) if d is not None]
+                self.keep[k] = [d for d in (self.prev, seg) if d is not None]
                 self.after[k] = True
-        self.prev = dense
+        self.prev = seg
 
-    def refine(self, line):
+    def refine(self, line, restep):
+        """The refined peaks {name: (value, time)}; ``restep(t0, y0, t1)`` the state at ``t1``
+        integrated from ``(t0, y0)`` (None if that fails: the sample is left out). Each sampled
+        state is computed once for all three."""
         out = {}
+        cache = {}
         for k, c in self.COLS.items():
             val, tp = self.best[k]
-            for d in self.keep[k]:
-                for tt in np.linspace(d.t_old, d.t, PEAK_SAMPLES + 1)[1:-1]:
-                    mm = line.measure(tt, d(tt))
-                    if mm[c] > val:
+            for t_old, y_old, t_new in self.keep[k]:
+                for tt in np.linspace(t_old, t_new, PEAK_SAMPLES + 1)[1:-1]:
+                    key = (t_old, float(tt))
+                    if key not in cache:
+                        y = restep(t_old, y_old, tt)
+                        cache[key] = None if y is None else line.measure(tt, y)
+                    mm = cache[key]
+                    if mm is not None and mm[c] > val:
                         val, tp = float(mm[c]), float(tt)
             out[k] = (val, tp)
         return out
@@ -248,23 +268,39 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
+    t_prev, z_prev = 0.0, z0.copy()
+    n_restep = [0]
+
+    def restep(t0, y0, t1):  # the state at t1 integrated from (t0, y0) with the run's method and tol
+        if method == "rodas4":
+            st = RodasStepper(line, t0, y0, t1, tol, h0=t1 - t0)
+        else:
+            kw = {"jac": line.jac} if method == "radau" else {}
+            st = METHODS[method](line.rhs, t0, y0, t1, rtol=tol, atol=tol, first_step=t1 - t0, **kw)
+        while st.status == "running":
+            st.step()
+        n_restep[0] += st.nfev
+        return st.y if st.status == "finished" else None
+
     while solver.status == "running":
         msg = solver.step()
         if solver.status == "failed":
             status, stop_reason = "failed", f"step failed: {msg}"
             break
         t, z = float(solver.t), solver.y
-        dense = solver.dense_output()
         while snaps and snaps[0] <= t:
             ts = snaps.pop(0)
             if ts >= 0.0:
+                zs = restep(t_prev, z_prev, ts) if t_prev < ts < t else None
                 snap_t.append(ts)
-                snap_z.append(dense(ts) if ts < t else z.copy())
+                snap_z.append(z.copy() if ts >= t else z_prev.copy() if ts <= t_prev else
+                              zs if zs is not None else solver.dense_output()(ts))
                 snap_kind.append("requested")
         mm = line.measure(t, z)
         rows.append(_record(line, t, z, t - solver.t_old, mm))
         times.append(t)
-        peaks.update(t, mm, dense)
+        peaks.update(t, mm, (t_prev, z_prev, t))
+        t_prev, z_prev = t, z.copy()
         if mm[16] > 0 and np.isnan(first_slack):
             first_slack = t
         if mm[0] > running:
@@ -292,7 +328,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     snap_z += [peak_state[1], zf]
     snap_kind += ["peak", "final"]
     rec = np.asarray(rows, dtype=float)
-    ref = peaks.refine(line)
+    ref = peaks.refine(line, restep)
     wall = time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
@@ -308,7 +344,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "t_first_slack": float(first_slack), "n_slack_steps": int(slack_rows.size),
         "energy_initial": float(E0), "energy_drift": float(np.abs(en - en[0]).max()),
         "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
-        "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
+        "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev) + n_restep[0],
         "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
         "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
         "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
