@@ -44,9 +44,11 @@ from .elastic_rodas import RodasStepper
 __all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
 METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
-#: intervals per step at whose interior points the steps around each peak are sampled (states
-#: integrated from the step's start: :class:`_Peaks`)
+#: intervals per step at whose interior points the dense output around each peak is sampled
 PEAK_SAMPLES = 24
+#: samples on either side of the dense output's best one whose states are integrated from the
+#: step's start (:class:`_Peaks`)
+PEAK_RESTEP = 1
 #: an automatic run (no t_end) fails once its energy error exceeds this fraction of the line's
 #: energy |E(0)| + |W| + U(0) (0.255 for chi = 0.25): the snap can no longer be told from the
 #: error (measured, chi = 0.25, N = 30 and 60, c = 30-300, tol 1e-2 and 3e-3: Radau/RODAS4 runs
@@ -85,16 +87,18 @@ def _record(line, t, z, dt, mm):
 
 class _Peaks:
     """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the steps on
-    either side of each (start time and state, end time), to refine them afterwards.
+    either side of each (start time and state, end time, dense output), to refine them
+    afterwards.
 
-    The refinement samples ``PEAK_SAMPLES - 1`` interior times of each kept step with states
-    integrated from the step's start by the run's own method and tolerance (``restep``), not read
-    off the dense output: the dense output (RODAS4's is of order 3) carries an error along the
-    links of about the tolerance times the motion, and the tension EA e and the acceleration
-    of a node of mass m, (EA/(h m)) times a length error, multiply it by up to 2 c^2 N^2. At chi
-    0.25, N = 100, c = 10000, tol 1e-7 that raised a_peak by 8.5e-5 (relative) above the
-    states the steps themselves reach (``benchmarks/elastic_ea_limit.py``: the EA -> infinity
-    plateau of a_peak)."""
+    The dense output only guides the refinement: it is sampled at ``PEAK_SAMPLES - 1`` interior
+    times of each kept step, and the state at its best sample and the ``PEAK_RESTEP`` samples on
+    either side is integrated from the step's start by the run's own method and tolerance
+    (``restep``); the peak is the largest of those and of the step ends. The dense output's own
+    values are not used: it (RODAS4's and Radau's are of order 3) carries an error along the
+    links of about the tolerance, which the tension ``EA e`` and a node's acceleration
+    (``EA/(h m)`` times a length error) multiply by up to ``2 c^2 N^2``. At chi 0.25, N = 100,
+    c = 10000, tol 1e-7 (RODAS4) that raised a_peak by 8.5e-5 (relative) above the states the
+    steps reach: the "plateau" of a_peak as EA -> infinity (``benchmarks/elastic_ea_limit.py``)."""
 
     COLS = {"v": 0, "a": 2, "sigma": 4}
 
@@ -105,8 +109,8 @@ class _Peaks:
         self.prev = None
 
     def update(self, t, mm, seg):
-        """Record the accepted step ``seg = (t_old, y_old, t)`` (None for the initial state)
-        ending at ``t`` with the measures ``mm``."""
+        """Record the accepted step ``seg = (t_old, y_old, t, dense)`` (None for the initial
+        state) ending at ``t`` with the measures ``mm``."""
         for k, c in self.COLS.items():
             if self.after[k] and seg is not None:
                 self.keep[k].append(seg)
@@ -119,21 +123,30 @@ class _Peaks:
 
     def refine(self, line, restep):
         """The refined peaks {name: (value, time)}; ``restep(t0, y0, t1)`` the state at ``t1``
-        integrated from ``(t0, y0)`` (None if that fails: the sample is left out). Each sampled
-        state is computed once for all three."""
+        integrated from ``(t0, y0)`` (None if that fails: the sample is left out)."""
         out = {}
         cache = {}
         for k, c in self.COLS.items():
             val, tp = self.best[k]
-            for t_old, y_old, t_new in self.keep[k]:
-                for tt in np.linspace(t_old, t_new, PEAK_SAMPLES + 1)[1:-1]:
-                    key = (t_old, float(tt))
-                    if key not in cache:
-                        y = restep(t_old, y_old, tt)
-                        cache[key] = None if y is None else line.measure(tt, y)
-                    mm = cache[key]
-                    if mm is not None and mm[c] > val:
-                        val, tp = float(mm[c]), float(tt)
+            guide, gval = None, -np.inf
+            for seg in self.keep[k]:
+                grid = np.linspace(seg[0], seg[2], PEAK_SAMPLES + 1)
+                for i in range(1, PEAK_SAMPLES):
+                    m = line.measure(grid[i], seg[3](grid[i]))[c]
+                    if m > gval:
+                        guide, gval = (seg, grid, i), m
+            if guide is None:
+                out[k] = (val, tp)
+                continue
+            (t_old, y_old, _, _), grid, i = guide
+            for j in range(max(1, i - PEAK_RESTEP), min(PEAK_SAMPLES - 1, i + PEAK_RESTEP) + 1):
+                key = (t_old, j)
+                if key not in cache:
+                    y = restep(t_old, y_old, grid[j])
+                    cache[key] = None if y is None else line.measure(grid[j], y)
+                mm = cache[key]
+                if mm is not None and mm[c] > val:
+                    val, tp = float(mm[c]), float(grid[j])
             out[k] = (val, tp)
         return out
 
@@ -299,7 +312,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         mm = line.measure(t, z)
         rows.append(_record(line, t, z, t - solver.t_old, mm))
         times.append(t)
-        peaks.update(t, mm, (t_prev, z_prev, t))
+        peaks.update(t, mm, (t_prev, z_prev, t, solver.dense_output()))
         t_prev, z_prev = t, z.copy()
         if mm[16] > 0 and np.isnan(first_slack):
             first_slack = t
