@@ -7,6 +7,18 @@ tension sits (arclength from the held end, time, slack links in the step before 
 release wave; :func:`snapping.simulate.elastic_statics.matched`), ``stretched`` (default) from
 the static equilibrium with both ends held.
 
+From the matched start every peak converges as c^-2 once the snap is slow against the links'
+longitudinal period (chi 0.25, N = 200, 3000 -> 10000: rates 2.08 (v), 2.01 (a), 2.13 (sigma);
+da/a +1.40e-4, +1.23e-5): along a taut link the strain follows T/EA with corrections of relative
+size (omega tau)^-2, omega ~ c/h, and the matched start's ringing has a tension amplitude
+T''(0)/omega^2, both O(c^-2) in tension and in acceleration. A floor in a_peak (+1.4e-4 at
+c = 3000 and 10000, measured before) was the peak search reading RODAS4's order-3 dense output,
+whose error dl along a link becomes 2 c^2 N^2 dl at the free end's acceleration; the peaks are
+now refined on integrated states (``benchmarks/elastic_peak_dense.py`` compares the two). From
+the stretched start the release's front, a strain step T_end/EA moving at c with the particle
+velocity T_end/(lambda c) across a few links, carries an acceleration that does not depend on c:
+a floor that is physics (docs/guide/elastic.md, "EA -> infinity").
+
 Usage::
 
     PYTHONPATH=src python benchmarks/elastic_ea_limit.py --N 100 --c 30 100 300 1000 3000 --grid-damping 1

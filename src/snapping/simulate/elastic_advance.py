@@ -13,7 +13,8 @@ state, ``max_rhs``, the energy balance, the stop rule (v_max below ``stop_fracti
 running peak once that peak is above the floor), the energy-error failure. It returns to
 Python at the end, at a stop or failure, after the step that passes the next snapshot time,
 and when the record buffer is full (:class:`RodasRun` then drains it). The peaks are then
-refined on the kept steps (:func:`refine`, the arithmetic of ``_Peaks.refine``, compiled).
+refined on the kept steps by ``elastic_solve._Peaks.refine`` (:meth:`RodasRun.segments`: the
+dense output guides it, the states are integrated from the step's start).
 """
 
 from __future__ import annotations
@@ -153,25 +154,6 @@ def advance(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm,
             return R_BUFFER
 
 
-@njit(cache=True, error_model="numpy")
-def refine(N, c, val, tp, ts, t_old, t, y0, y1, c23, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode,
-           y, dz, pin, T, E, ED, FV, mm):
-    """``_Peaks.refine`` of elastic_solve on one kept step: the measure ``c`` at the times ``ts``
-    on its continuous extension (``RodasDense``'s arithmetic); returns the running (value, time)."""
-    n = y0.shape[0]
-    for q in range(ts.shape[0]):
-        tt = ts[q]
-        x = (tt - t_old) / (t - t_old)
-        for i in range(n):
-            y[i] = y0[i] * (1.0 - x) + x * (y1[i] + (1.0 - x) * (c23[0, i] + x * c23[1, i]))
-        ER.pin_at(tt, pinpar, pintab, pin)
-        EK.measure(N, y, pin, h, m, ea, damp, tabe, tabt, tabw, g, snode, dz, T, E, ED, FV, mm)
-        if mm[c] > val:
-            val = mm[c]
-            tp = tt
-    return val, tp
-
-
 class RodasRun:
     """A RODAS4 run of :func:`elastic_solve.solve`: the stepper's state (a
     :class:`~snapping.simulate.elastic_rodas.RodasStepper`), the pool of step slots, the
@@ -228,23 +210,3 @@ class RodasRun:
         return {k: (float(self.best[k, 0]), float(self.best[k, 1]),
                     [(float(self.PT[s, 0]), self.PY0[s].copy(), float(self.PT[s, 1]), self.dense(int(s)))
                      for s in self.keep[k, :self.nkeep[k]]]) for k in range(3)}
-
-    def refined_peaks(self, samples):
-        """{kind index: (value, time)}: the peaks refined on their kept steps at ``samples - 1``
-        inner points each (``_Peaks.refine``'s, compiled)."""
-        st = self.st
-        ln = st.line
-        n = st.y.size
-        y, dz = np.zeros(n), np.zeros(n)
-        pin = np.zeros(4)
-        out = {}
-        for k in range(3):
-            val, tp = float(self.best[k, 0]), float(self.best[k, 1])
-            for s in self.keep[k, :self.nkeep[k]]:
-                t_old, t = self.PT[s]
-                ts = np.linspace(t_old, t, samples + 1)[1:-1]
-                val, tp = refine(st.N, int(KCOL[k]), val, tp, ts, t_old, t, self.PY0[s], self.PY1[s], self.PC[s],
-                                 st.pinpar, st.pintab, ln.h, ln.m, ln.ea, ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g,
-                                 ln.snode, y, dz, pin, *st.work, self.mm)
-            out[k] = (float(val), float(tp))
-        return out

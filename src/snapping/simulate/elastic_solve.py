@@ -48,8 +48,11 @@ from .elastic_rodas import RodasStepper
 __all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
 METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
-#: points per step at which the dense output is sampled around each peak
+#: intervals per step at whose interior points the dense output around each peak is sampled
 PEAK_SAMPLES = 24
+#: samples on either side of the dense output's best one whose states are integrated from the
+#: step's start (:class:`_Peaks`)
+PEAK_RESTEP = 1
 #: an automatic run (no t_end) fails once its energy error exceeds this fraction of the line's
 #: energy |E(0)| + |W| + U(0) (0.255 for chi = 0.25): the snap can no longer be told from the
 #: error (measured, chi = 0.25, N = 30 and 60, c = 30-300, tol 1e-2 and 3e-3: Radau/RODAS4 runs
@@ -90,8 +93,19 @@ def _record(line, t, z, dt, mm):
 
 
 class _Peaks:
-    """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the dense
-    output of the steps on either side of each, to refine them afterwards."""
+    """The running maxima of v_max, a_max, sigma_max over accepted steps, keeping the steps on
+    either side of each (start time and state, end time, dense output), to refine them
+    afterwards.
+
+    The dense output only guides the refinement: it is sampled at ``PEAK_SAMPLES - 1`` interior
+    times of each kept step, and the state at its best sample and the ``PEAK_RESTEP`` samples on
+    either side is integrated from the step's start by the run's own method and tolerance
+    (``restep``); the peak is the largest of those and of the step ends. The dense output's own
+    values are not used: it (RODAS4's and Radau's are of order 3) carries an error along the
+    links of about the tolerance, which the tension ``EA e`` and a node's acceleration
+    (``EA/(h m)`` times a length error) multiply by up to ``2 c^2 N^2``. At chi 0.25, N = 100,
+    c = 10000, tol 1e-7 (RODAS4) that raised a_peak by 8.5e-5 (relative) above the states the
+    steps reach: the "plateau" of a_peak as EA -> infinity (``benchmarks/elastic_ea_limit.py``)."""
 
     COLS = {"v": 0, "a": 2, "sigma": 4}
 
@@ -101,26 +115,45 @@ class _Peaks:
         self.after = dict.fromkeys(self.COLS, False)
         self.prev = None
 
-    def update(self, t, mm, dense):
+    def update(self, t, mm, seg):
+        """Record the accepted step ``seg = (t_old, y_old, t, dense)`` (None for the initial
+        state) ending at ``t`` with the measures ``mm``."""
         for k, c in self.COLS.items():
-            if self.after[k] and dense is not None:
-                self.keep[k].append(dense)
+            if self.after[k] and seg is not None:
+                self.keep[k].append(seg)
                 self.after[k] = False
             if mm[c] > self.best[k][0]:
                 self.best[k] = (float(mm[c]), float(t))
-                self.keep[k] = [d for d in (self.prev, dense) if d is not None]
+                self.keep[k] = [d for d in (self.prev, seg) if d is not None]
                 self.after[k] = True
-        self.prev = dense
+        self.prev = seg
 
-    def refine(self, line):
+    def refine(self, line, restep):
+        """The refined peaks {name: (value, time)}; ``restep(t0, y0, t1)`` the state at ``t1``
+        integrated from ``(t0, y0)`` (None if that fails: the sample is left out)."""
         out = {}
+        cache = {}
         for k, c in self.COLS.items():
             val, tp = self.best[k]
-            for d in self.keep[k]:
-                for tt in np.linspace(d.t_old, d.t, PEAK_SAMPLES + 1)[1:-1]:
-                    mm = line.measure(tt, d(tt))
-                    if mm[c] > val:
-                        val, tp = float(mm[c]), float(tt)
+            guide, gval = None, -np.inf
+            for seg in self.keep[k]:
+                grid = np.linspace(seg[0], seg[2], PEAK_SAMPLES + 1)
+                for i in range(1, PEAK_SAMPLES):
+                    m = line.measure(grid[i], seg[3](grid[i]))[c]
+                    if m > gval:
+                        guide, gval = (seg, grid, i), m
+            if guide is None:
+                out[k] = (val, tp)
+                continue
+            (t_old, y_old, _, _), grid, i = guide
+            for j in range(max(1, i - PEAK_RESTEP), min(PEAK_SAMPLES - 1, i + PEAK_RESTEP) + 1):
+                key = (t_old, j)
+                if key not in cache:
+                    y = restep(t_old, y_old, grid[j])
+                    cache[key] = None if y is None else line.measure(grid[j], y)
+                mm = cache[key]
+                if mm is not None and mm[c] > val:
+                    val, tp = float(mm[c]), float(grid[j])
             out[k] = (val, tp)
         return out
 
@@ -168,11 +201,23 @@ _ENERGY_MSG = (f"energy error above {ENERGY_ERROR_FAIL:g} of the line's energy (
                "motion: tighten tol)")
 
 
-def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, **kw):
+def _snapshot(ts, t_old, y_old, t, y, restep, dense):
+    """The state at ``ts`` in the step ``(t_old, y_old) -> (t, y)``: a step end, or the state
+    integrated from the step's start (``restep``), not the dense output (see :class:`_Peaks`);
+    ``dense()`` only if that integration fails."""
+    if ts >= t:
+        return y.copy()
+    if ts <= t_old:
+        return y_old.copy()
+    zs = restep(t_old, y_old, ts)
+    return zs if zs is not None else dense()(ts)
+
+
+def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep, **kw):
     """The step loop of :func:`solve` for RODAS4, compiled (:func:`elastic_advance.advance`:
     the same bookkeeping, many steps a call). Returns the record rows (t first), the running
     peak's state, the first slack time, when the stop rule was armed, status and reason; the
-    snapshots and the peaks' kept steps are filled in."""
+    snapshots and the peaks' kept steps (refined by :meth:`_Peaks.refine`) are filled in."""
     run = EA.RodasRun(solver, mm0, energy_fail=ENERGY_ERROR_FAIL, **kw)
     chunks, status = [], "completed"
     while True:
@@ -188,7 +233,7 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
             if ts >= 0.0:
                 dense = dense or run.last_dense()
                 snap_t.append(ts)
-                snap_z.append(dense(ts) if ts < t else solver.y.copy())
+                snap_z.append(_snapshot(ts, dense.t_old, dense.y0, t, solver.y, restep, lambda: dense))
                 snap_kind.append("requested")
         if code in (EA.R_SNAPSHOT, EA.R_BUFFER):
             continue
@@ -201,8 +246,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
         elif code == EA.R_ENERGY:
             status, stop_reason = "failed", _ENERGY_MSG
         break
-    for k, best in zip(peaks.COLS, run.refined_peaks(PEAK_SAMPLES).values()):
-        peaks.best[k], peaks.keep[k] = best, []  # (refined: refine() returns them)
+    for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
+        peaks.best[k], peaks.keep[k] = (val, tp), segs
     sc = run.sctl
     if sc[EA.S_RUN] > 0.0:
         peak_state = (float(sc[EA.S_PEAKT]), run.peak_z.copy())
@@ -300,9 +345,23 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
+    t_prev, z_prev = 0.0, z0.copy()
+    n_restep = [0]
+
+    def restep(t0, y0, t1):  # the state at t1 integrated from (t0, y0) with the run's method and tol
+        if method == "rodas4":
+            st = RodasStepper(line, t0, y0, t1, tol, h0=t1 - t0)
+        else:
+            kw = {"jac": line.jac} if method == "radau" else {}
+            st = METHODS[method](line.rhs, t0, y0, t1, rtol=tol, atol=tol, first_step=t1 - t0, **kw)
+        while st.status == "running":
+            st.step()
+        n_restep[0] += st.nfev
+        return st.y if st.status == "finished" else None
+
     if method == "rodas4" and COMPILED_LOOP:
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
-            solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason,
+            solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
         rows += rec_steps[:, 1:].tolist()
         times += rec_steps[:, 0].tolist()
@@ -313,17 +372,17 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
                 status, stop_reason = "failed", f"step failed: {msg}"
                 break
             t, z = float(solver.t), solver.y
-            dense = solver.dense_output()
             while snaps and snaps[0] <= t:
                 ts = snaps.pop(0)
                 if ts >= 0.0:
                     snap_t.append(ts)
-                    snap_z.append(dense(ts) if ts < t else z.copy())
+                    snap_z.append(_snapshot(ts, t_prev, z_prev, t, z, restep, solver.dense_output))
                     snap_kind.append("requested")
             mm = line.measure(t, z)
             rows.append(_record(line, t, z, t - solver.t_old, mm))
             times.append(t)
-            peaks.update(t, mm, dense)
+            peaks.update(t, mm, (t_prev, z_prev, t, solver.dense_output()))
+            t_prev, z_prev = t, z.copy()
             if mm[16] > 0 and np.isnan(first_slack):
                 first_slack = t
             if mm[0] > running:
@@ -350,7 +409,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     snap_z += [peak_state[1], zf]
     snap_kind += ["peak", "final"]
     rec = np.asarray(rows, dtype=float)
-    ref = peaks.refine(line)
+    ref = peaks.refine(line, restep)
     wall = time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
@@ -366,7 +425,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "t_first_slack": float(first_slack), "n_slack_steps": int(slack_rows.size),
         "energy_initial": float(E0), "energy_drift": float(np.abs(en - en[0]).max()),
         "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
-        "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev),
+        "t_final": t_final, "n_steps": len(times) - 1, "n_rhs": int(solver.nfev) + n_restep[0],
         "n_jac": int(getattr(solver, "njev", 0)), "n_lu": int(getattr(solver, "nlu", 0)),
         "n_lu_pivoted": int(getattr(solver, "npiv", 0)),
         "dt_min_accepted": float(rec[1:, 0].min()) if len(times) > 1 else np.nan,
