@@ -72,6 +72,8 @@ def main(argv=None):
         slack = int(es["n_slack"].values[max(k - 1, 0)])
         print(f"{c:>7g} {rel[0]:>10.3e} {rel[1]:>10.3e} {rel[2]:>10.3e} {s['t_snap_sigma']:>9.6f} "
               f"{s['s_sigma_peak']:>8.4f} {slack:>7d} {s['strain_peak']:>9.2e} {s['n_rhs']:>9d} {w:>7.1f}", flush=True)
+    if len(a.c) < 2:
+        return
     errs = np.abs(np.asarray(errs))
     lc = np.log(np.asarray(a.c))
     for j, k in enumerate(keys):
