@@ -36,6 +36,7 @@ def test_stretching_cell_runs_the_study_settings(monkeypatch):
     monkeypatch.setattr(E, "solve", spy)
     level = {"n_links": 4, "frac": 0.25}
     row = R._run_task(0.5, "stretching", 0.1, level, 1e-5, damping=0.7)
+    assert seen["start"] == S.STRETCH_START == "matched"  # the study's start by default
     assert seen["grid_damping"] == 0.7 and seen["ea"] == pytest.approx(100.0, rel=1e-12)  # EA = lambda c^2, c = 10
     assert seen["method"] == S.STRETCH_METHOD == "rodas4"
     assert seen["stop_floor"] == S.STRETCH_STOP_FLOOR
@@ -47,17 +48,26 @@ def test_study_records_the_elastic_settings(monkeypatch):
 
     calls = []
 
-    def fake(chi, mech, number, level, tol, damping=None):
-        calls.append((mech, damping))
+    def fake(chi, mech, number, level, tol, damping=None, start=None):
+        calls.append((mech, damping, start))
         return {**{q: 1.0 for q in QUANTITIES}, "n_links": 1, "n_rhs": 1, "cpu_time": 0.0}
 
     monkeypatch.setattr(R, "_run_task", fake)
     ds = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, damping=0.5, progress=False)
     assert ds.attrs["damping"] == 0.5 and ds.attrs["elastic_method"] == S.STRETCH_METHOD
     assert ds.attrs["stop_floor"] == S.STRETCH_STOP_FLOOR
-    assert ("stretching", 0.5) in calls  # the cells get the study's grid damping
+    assert ("stretching", 0.5, "matched") in calls  # the cells get the study's grid damping and start
+    assert ds.attrs["elastic_start"] == "matched" and '"elastic_start": "matched"' in ds.attrs["regimes_study"]
     key = R._study_key("stretching", [0.5], [0.1], {"damping": 1.0}, 0.5)
     assert key != R._study_key("stretching", [0.5], [0.1], {"damping": 0.5}, 0.5)
+    calls.clear()
+    old = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, damping=0.5, start="stretched", progress=False)
+    assert ("stretching", 0.5, "stretched") in calls and old.attrs["elastic_start"] == "stretched"
+    # the stop-29 study (run from "stretched") had no start in its key: the same key, so it resumes
+    assert "elastic_start" not in old.attrs["regimes_study"]
+    for bad in ("released", 1, None):
+        with pytest.raises(SnappingInputError, match="start"):
+            R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, start=bad, progress=False)
 
 
 # ------------------------------------------------------------------ solve's stop floor
