@@ -23,6 +23,7 @@ Usage::
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
     python benchmarks/bench_regimes.py --study stretching --chis 0.1 --out lo.nc   # a part (some chi) ...
     python benchmarks/bench_regimes.py --study stretching --merge lo.nc hi.nc       # ... put into the shipped file
+    python benchmarks/bench_regimes.py --starts 0.3:38 0.5:7.5 0.2:196 --level -3  # matched vs stretched start
 """
 
 from __future__ import annotations
@@ -283,6 +284,25 @@ def cell(mech: str, chi: float, number: float, levels, first: int = -3, tol: flo
                   f"{r['cpu_time']:.2f} s CPU", flush=True)
 
 
+def starts(cells, level: int, tol: float = 1e-6, damping: float = 4.0) -> None:
+    """The two releases of the stretching study side by side: each cell (chi, c) at one fold level from
+    the ``matched`` and the ``stretched`` start (the study's own runs, :func:`snapping.regimes._run_task`),
+    each peak over the ideal chain's on the same links, and the two ratios' relative difference."""
+    from snapping.continuum import level_parameters
+    from snapping.regimes import _run_task
+
+    lv = level_parameters(1, 0.5, first=level)[0]
+    for chi, c in cells:
+        ideal = _run_task(chi, None, 0.0, lv, tol)
+        r = {st: _run_task(chi, "stretching", 1.0 / c, lv, tol, damping, st) for st in ("matched", "stretched")}
+        for q in ("v_peak", "a_peak", "sigma_peak"):
+            m, s_ = r["matched"][q] / ideal[q], r["stretched"][q] / ideal[q]
+            print(f"chi {chi:g} c {c:g} level {level} ({ideal['n_links']} links) {q}: ratio matched {m:.6f}, "
+                  f"stretched {s_:.6f}, difference {(s_ - m) / m:+.2e}", flush=True)
+        print("  cost: " + "; ".join(f"{st} {x['n_rhs']} evaluations, {x['cpu_time']:.1f} s CPU" for st, x in r.items())
+              + f"; ideal {ideal['n_rhs']}", flush=True)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", choices=sorted(STUDIES))
@@ -300,11 +320,16 @@ def main(argv=None) -> None:
     ap.add_argument("--figures", default=None, help="write the regime maps there (regimes_MECH.png)")
     ap.add_argument("--cell", nargs="+", type=float, default=None, metavar="X",
                     help="--cell CHI NUMBER LEVEL...: one cell of --study MECH at these fold levels (first -3)")
+    ap.add_argument("--starts", nargs="+", default=None, metavar="CHI:C",
+                    help="the matched and stretched starts at these stretching cells (chi:c) at --level")
+    ap.add_argument("--level", type=int, default=-4)
     ap.add_argument("--chi", type=float, default=0.3)
     ap.add_argument("--beta", type=float, default=1e-4)
     ap.add_argument("--workers", type=int, default=1)
     a = ap.parse_args(argv)
     print(f"load {os.getloadavg()[0]:.1f}")
+    if a.starts:
+        starts([tuple(float(x) for x in cs.split(":")) for cs in a.starts], a.level)
     if a.cell:
         cell(a.study, a.cell[0], a.cell[1], [int(k) for k in a.cell[2:]])
     elif a.study and a.merge:

@@ -68,6 +68,10 @@ def test_study_records_the_elastic_settings(monkeypatch):
     for bad in ("released", 1, None):
         with pytest.raises(SnappingInputError, match="start"):
             R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, start=bad, progress=False)
+    # no damping given: each mechanism's own default (stretching's tip links chatter slack at 1)
+    calls.clear()
+    dflt = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, progress=False)
+    assert dflt.attrs["damping"] == S.STRETCH_DAMPING == 4.0 and ("stretching", 4.0, "matched") in calls
 
 
 # ------------------------------------------------------------------ solve's stop floor
