@@ -157,6 +157,46 @@ def extend(mech: str, workers: int, seeds=()) -> None:
     study(mech, workers)
 
 
+def reuse(old_path: str, out: str) -> None:
+    """Start the stretching study's file ``out`` with the runs of an earlier stretching study file
+    whose runs are the same computations: the same chi, numbers, levels, start, grid damping and tol,
+    its key lacking only ``tol_c`` (:func:`snapping.regimes_spec.stretch_tol`, added after it): every
+    ideal run and every run of c <= STRETCH_TOL_C (the same tolerance) is copied; the stiffer lines'
+    runs (now at a smaller tolerance) are left to the study. Then ``--study stretching --out OUT``
+    resumes it."""
+    import json
+
+    from snapping import regimes as R
+    from snapping.regimes_spec import STRETCH_TOL_C
+    from snapping.sweep_files import atomic_to_netcdf
+
+    old = R.load_study(old_path)
+    s = dict(STUDIES["stretching"])
+    chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"))
+    acc = dict(R.ACCURACY[s.pop("accuracy")])
+    start, damping = s.pop("start"), s.pop("damping")
+    acc.update(s, damping=damping, elastic_method=R.STRETCH_METHOD, stop_floor=R.STRETCH_STOP_FLOOR,
+               elastic_start=start)
+    want = json.loads(R._study_key("stretching", chis, numbers, acc, 0.5))
+    have = json.loads(old.attrs["regimes_study"])
+    if have != want:
+        raise SystemExit(f"{old_path} is not this study's earlier run: {have} against {want}")
+    acc["tol_c"] = STRETCH_TOL_C
+    lev, ilev = R._levels("fold", acc, 0.5), R._levels("fold", acc, 0.5)
+    ds = R._empty("stretching", chis, numbers, lev, ilev, R._study_key("stretching", chis, numbers, acc, 0.5), acc, 0.5)
+    ds.attrs["elastic_start"] = start
+    keep = np.array([1.0 / n <= STRETCH_TOL_C for n in numbers])
+    copied = 0
+    for name in [v for v in old.data_vars if v.endswith("_level")]:
+        if "ideal" in name:
+            ds[name].values[...] = old[name].values
+        else:
+            ds[name].values[:, keep, :] = old[name].values[:, keep, :]
+    copied = int(np.isfinite(ds.v_peak_level.values).sum() + np.isfinite(ds.v_peak_ideal_level.values).sum())
+    atomic_to_netcdf(R._finish(ds), out)
+    print(f"stretching: {copied} runs copied from {old_path} into {out} (c <= {STRETCH_TOL_C:g} and the ideal's)")
+
+
 def cost(mech: str, path=None) -> dict:
     """What a study file's scan cost (CPU s, evaluations), by level and chi, and its error bars."""
     from snapping.regimes import load_study
@@ -309,6 +349,8 @@ def main(argv=None) -> None:
     ap.add_argument("--chis", default=None, help="--study: only these chi (comma-separated) into --out")
     ap.add_argument("--out", default=None, help="--study: the file of a part study (with --chis)")
     ap.add_argument("--merge", nargs="+", default=None, help="part study files to merge into the shipped --cost/--study MECH")
+    ap.add_argument("--reuse", default=None, metavar="OLD",
+                    help="start --out with the same runs of an earlier stretching study file OLD (before tol_c)")
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
                     "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
@@ -334,6 +376,8 @@ def main(argv=None) -> None:
         cell(a.study, a.cell[0], a.cell[1], [int(k) for k in a.cell[2:]])
     elif a.study and a.merge:
         merge(a.study, a.merge)
+    elif a.reuse:
+        reuse(a.reuse, a.out)
     elif a.study:
         study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out)
     if a.extend:

@@ -66,7 +66,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_START, STRETCH_STOP_FLOOR)
+                           STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TOL_C, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
@@ -177,8 +177,9 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     if mechanism == "stretching" and number > 0:
         from .simulate.elastic import Elastic, solve
 
-        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping), tol=tol,
-                   method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR, start=start, max_rhs=STRETCH_MAX_RHS).dataset
+        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
+                   tol=stretch_tol(tol, 1.0 / number), method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR,
+                   start=start, max_rhs=STRETCH_MAX_RHS).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
         ds = run(problem, method=method, tol=tol, progress=False).dataset
@@ -396,6 +397,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         acc.update(elastic_method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR)
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
             acc["elastic_start"] = start
+            acc["tol_c"] = STRETCH_TOL_C  # stiffer lines' runs at tol (tol_c/c)^2 (regimes_spec.stretch_tol)
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
