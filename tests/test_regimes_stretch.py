@@ -43,6 +43,28 @@ def test_stretching_cell_runs_the_study_settings(monkeypatch):
     assert row["v_peak"] > S.STRETCH_STOP_FLOOR  # the snap was judged (stopped there, not at t = 10)
 
 
+def test_stiff_lines_run_at_a_tolerance_scaled_as_c_squared(monkeypatch):
+    """Above c = 450 a run's tolerance is the study's times (450/c)^2 (the tip links' stretch, ~ c^-2)."""
+    import snapping.simulate.elastic as E
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def spy(problem, elastic, **kw):
+        seen.append(kw["tol"])
+        raise Stop
+
+    monkeypatch.setattr(E, "solve", spy)
+    level = {"n_links": 4, "frac": 0.25}
+    for c in (100.0, 450.0, 1000.0, 4500.0):
+        with pytest.raises(Stop):
+            R._run_task(0.5, "stretching", 1.0 / c, level, 1e-6)
+    assert seen[:2] == [1e-6, 1e-6]
+    assert seen[2] == pytest.approx(1e-6 * 0.45**2, rel=1e-12) and seen[3] == pytest.approx(1e-8, rel=1e-12)
+
+
 def test_study_records_the_elastic_settings(monkeypatch):
     from snapping.continuum import QUANTITIES
 
@@ -105,9 +127,10 @@ def shipped():
 def test_shipped_study_is_the_stretching_scan(shipped):
     ds = shipped
     assert ds.attrs["mechanism"] == "stretching" and ds.attrs["number_name"] == "inverse_stretching"
-    assert ds.attrs["elastic_method"] == "rodas4" and ds.attrs["damping"] == 1.0
-    assert list(ds.chi.values) == [0.2, 0.3, 0.5] and ds.sizes["number"] == 7
-    assert ds.number.values[0] == pytest.approx(2.26e-3) and ds.number.values[-1] == pytest.approx(0.3)
+    assert ds.attrs["elastic_method"] == "rodas4" and ds.attrs["damping"] == S.STRETCH_DAMPING
+    assert ds.attrs["elastic_start"] == "matched" and ds.attrs["tol_c"] == S.STRETCH_TOL_C
+    assert list(ds.chi.values) == [0.1, 0.2, 0.3, 0.5] and ds.sizes["number"] == 8
+    assert ds.number.values[0] == pytest.approx(1e-3) and ds.number.values[-1] == pytest.approx(0.3)
 
 
 def test_shipped_ideal_limits_agree_with_the_end_mass_study(shipped):
