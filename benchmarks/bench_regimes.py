@@ -62,12 +62,14 @@ def _numbers(v):
     return [float(f"{x:.3g}") for x in v]  # as the command line passes them (3 digits)
 
 
-def study(mech: str, workers: int, chis=None, out=None) -> None:
+def study(mech: str, workers: int, chis=None, out=None, levels=None) -> None:
     """Run (or resume) the study of ``mech``; ``chis`` and ``out``: a part of it (some chi) in a
     file of its own, to be put into the shipped study by :func:`merge` (cells are the same runs)."""
     from snapping.regimes import regimes
 
     s = dict(STUDIES[mech])
+    if levels:
+        s["levels"] = levels
     os.makedirs(DATA, exist_ok=True)
     out = out or os.path.join(DATA, f"{mech}.nc")
     all_chis = s.pop("chis")
@@ -105,12 +107,14 @@ def merge(mech: str, parts) -> None:
     print(f"{mech}: merged {len(parts)} part(s) into {out}; status {whole.attrs['status']}")
 
 
-def extend(mech: str, workers: int, seeds=()) -> None:
+def extend(mech: str, workers: int, seeds=(), old_path=None, out=None, levels=None) -> None:
     """Refine a shipped study by more levels (STUDIES[mech]["levels"]) without redoing its runs: the
     shipped file's levels, and any of the same runs in ``seeds`` (benchmarks/bench_bendconv.py's JSON
     files, keys "chi beta k" with frac = 0.04 * 2**-k), are copied into the new study's file, then
     :func:`snapping.regimes.regimes` computes only the runs missing. Every copied run is the same
-    computation (same links, tolerance and grid damping): checked bit for bit on one."""
+    computation (same links, tolerance and grid damping): checked bit for bit on one. ``old_path``,
+    ``out``: the study file to refine and the new one (default both the shipped file); ``levels``:
+    instead of STUDIES[mech]["levels"]."""
     import json
 
     from snapping import regimes as R
@@ -118,12 +122,19 @@ def extend(mech: str, workers: int, seeds=()) -> None:
     from snapping.sweep_files import atomic_to_netcdf
 
     s = dict(STUDIES[mech])
+    if levels:
+        s["levels"] = levels
     chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"))
-    old = R.load_study(os.path.join(DATA, f"{mech}.nc"))
+    old = R.load_study(old_path or os.path.join(DATA, f"{mech}.nc"))
     acc = dict(R.ACCURACY[s.pop("accuracy")])
     acc.update(s)
     if mech == "bending":
         acc["damping"] = R.GRID_DAMPING
+    if mech == "stretching":  # the key regimes() makes (the matched start's)
+        from snapping.regimes_spec import STRETCH_TOL_C
+
+        acc.update(elastic_method=R.STRETCH_METHOD, stop_floor=R.STRETCH_STOP_FLOOR,
+                   elastic_start=acc.pop("start"), tol_c=STRETCH_TOL_C)
     lev, ilev = R._levels(R.MECHANISMS[mech][1], acc, 0.5), R._levels("fold", acc, 0.5)
     ds = R._empty(mech, chis, numbers, lev, ilev, R._study_key(mech, chis, numbers, acc, 0.5), acc, 0.5)
     names = [f"{q}_level" for q in QUANTITIES + ("n_rhs", "cpu_time", "n_links")]
@@ -151,10 +162,13 @@ def extend(mech: str, workers: int, seeds=()) -> None:
                 else:
                     ds[f"{q}_level"].values[i, numbers.index(beta), k] = row[q]
             seeded += 1
-    out = os.path.join(DATA, f"{mech}.nc")
+    out = out or os.path.join(DATA, f"{mech}.nc")
+    if mech == "stretching":
+        ds.attrs["elastic_start"] = acc["elastic_start"]
     atomic_to_netcdf(R._finish(ds), out)
-    print(f"{mech}: {copied} levels copied from the shipped file, {seeded} runs from {list(seeds)}; resuming")
-    study(mech, workers)
+    print(f"{mech}: {copied} levels copied from {old_path or 'the shipped file'}, {seeded} runs from {list(seeds)}; "
+          f"resuming")
+    study(mech, workers, out=out, levels=levels)
 
 
 def reuse(old_path: str, out: str) -> None:
@@ -224,6 +238,17 @@ def cost(mech: str, path=None) -> dict:
         worst[q] = float(np.nanmax(np.where(ok, rel, np.nan))) if ok.any() else float("nan")
         print(f"  {q}: {int(ok.sum())}/{ok.size} cells resolved; largest error bar of those {worst[q]:.2%}; "
               f"median {np.nanmedian(np.where(ok, rel, np.nan)):.2%}; {int(np.sum(ok & (rel <= 0.01)))} cells within 1%")
+    if ds.attrs["mechanism"] == "stretching":  # its verdicts use the same-links ratios, extrapolated
+        from snapping.regimes_analysis import level_ratios
+
+        for q in ("v_peak", "sigma_peak"):
+            lr = level_ratios(ds, q)
+            for chi, r in lr["chi"].items():
+                ok = np.isfinite(r["ratio"]) & np.isfinite(r["error"])
+                rel = np.abs(r["error"] / r["ratio"])
+                print(f"  {q} same-links ratio, chi {chi:g}: {int(ok.sum())} cells extrapolated, "
+                      f"{int(np.sum(ok & (rel <= 0.01)))} within 1%; error bars "
+                      + " ".join("-" if not k else f"{x:.1%}" for k, x in zip(ok, rel)))
     return {"cpu": float(np.nansum(cpu) + np.nansum(ic)), "worst": worst}
 
 
@@ -355,6 +380,7 @@ def main(argv=None) -> None:
     ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
                     "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
     ap.add_argument("--seed", nargs="*", default=[])
+    ap.add_argument("--levels", type=int, default=None, help="--study/--extend: levels instead of STUDIES'")
     ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
     ap.add_argument("--damping-check", action="store_true")
     ap.add_argument("--report", nargs="*", default=None, metavar="MECH",
@@ -379,9 +405,9 @@ def main(argv=None) -> None:
     elif a.reuse:
         reuse(a.reuse, a.out)
     elif a.study:
-        study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out)
+        study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out, a.levels)
     if a.extend:
-        extend(a.extend, a.workers, a.seed)
+        extend(a.extend, a.workers, a.seed, a.file, a.out, a.levels)
     if a.cost:
         cost(a.cost, a.file)
     if a.damping_check:
