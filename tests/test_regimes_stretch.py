@@ -220,6 +220,30 @@ def test_level_ratios_extrapolate_the_same_links_ratio(shipped):
     assert n >= 5
 
 
+def test_ratio_map_flags_the_unconverged_ratios(shipped):
+    """The map's "?" (with_level_ratios' converged) marks the same-links ratios whose error bar (the
+    last Richardson correction, |d2|/(2^p - 1), by hand) exceeds 5% of them, or that failed."""
+    from snapping.regimes_analysis import with_level_ratios
+
+    m = with_level_ratios(shipped)
+    flags = {0: 0, 1: 0}
+    for i, chi in enumerate(shipped.chi.values):
+        c = shipped.sel(chi=chi)
+        for j in range(shipped.sizes["number"]):
+            r = c.v_peak_level.values[j] / c.v_peak_ideal_level.values
+            d1, d2 = r[1] - r[0], r[2] - r[1]
+            want = 0
+            if np.all(np.isfinite(r)) and d1 * d2 > 0 and abs(d2) < abs(d1):
+                p = math.log2(d1 / d2)
+                lim = r[2] + d2 / (2**p - 1)
+                want = int(0.0 < lim < 2.0 and abs(d2) / (2**p - 1) <= 0.05 * lim)
+            elif np.all(np.isfinite(r)) and np.isfinite(m.v_peak_ratio.values[i, j]):
+                continue  # levels that agree or oscillate: the extrapolation's own rule
+            assert int(m.converged.values[i, j]) == want, (chi, j)
+            flags[want] += 1
+    assert flags[0] >= 1 and flags[1] >= 5
+
+
 def test_report_section_gives_the_stretching_verdict(shipped):
     from snapping.caps_report import ideal_speeds, report_section, stretching_speeds
     from snapping.regimes_analysis import level_ratios

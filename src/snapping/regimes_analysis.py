@@ -406,11 +406,17 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
 def with_level_ratios(ds, quantity: str = "v_peak"):
     """A copy of the study whose ``{quantity}_ratio`` (and ``_error``) are the same-links ratios
     extrapolated across the levels (:func:`level_ratios`): the regime map of a study whose limits
-    are not resolved apart (stretching)."""
+    are not resolved apart (stretching). Its ``converged`` flag is the ratio's: an error bar within
+    :data:`MAX_REL_ERROR` of the ratio (the map's "?" marks the others)."""
     lr = level_ratios(ds, quantity)
     out = ds.copy()
-    out[f"{quantity}_ratio"] = (("chi", "number"), np.array([lr["chi"][float(c)]["ratio"] for c in ds.chi.values]))
-    out[f"{quantity}_ratio_error"] = (("chi", "number"),
-                                      np.array([lr["chi"][float(c)]["error"] for c in ds.chi.values]))
+    r = np.array([lr["chi"][float(c)]["ratio"] for c in ds.chi.values])
+    e = np.array([lr["chi"][float(c)]["error"] for c in ds.chi.values])
+    out[f"{quantity}_ratio"] = (("chi", "number"), r)
+    out[f"{quantity}_ratio_error"] = (("chi", "number"), e)
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(r) & np.isfinite(e) & (np.abs(e) <= MAX_REL_ERROR * np.abs(r))
+    out["converged"] = (("chi", "number"), ok.astype(np.int8),
+                        {"long_name": f"1: the same-links ratio's error bar is within {MAX_REL_ERROR:.0%} of it"})
     out.attrs["mechanism"] = f"{ds.attrs['mechanism']}, same-links ratios"
     return out
