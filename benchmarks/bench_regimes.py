@@ -23,6 +23,7 @@ Usage::
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
     python benchmarks/bench_regimes.py --study stretching --chis 0.1 --out lo.nc   # a part (some chi) ...
     python benchmarks/bench_regimes.py --study stretching --merge lo.nc hi.nc       # ... put into the shipped file
+    python benchmarks/bench_regimes.py --starts 0.3:38 0.5:7.5 0.2:196 --level -3  # matched vs stretched start
 """
 
 from __future__ import annotations
@@ -44,16 +45,16 @@ STUDIES = {
     # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
                 "levels": 4},
-    # stretching (number sqrt(gL)/c): the elastic line by RODAS4 with the grid damping zeta = 1 and the stop
-    # floor of regimes_spec (before: scipy Radau, undamped, the stop rule never armed on fold-graded links: one
-    # run of 284 links at chi = 0.3, c = 30 did not finish in 70 s; now 9.4 s, 196620 evaluations). Numbers:
-    # c = 442 down to 3.3 (7 of geomspace(1e-3, 0.3, 8): c = 1000 dropped, its runs cost 7x those at 442),
-    # bracketing the crossover at every chi; fold levels first -4 (chi = 0.3: 70-166 links). chi = 0.1 is
-    # not in the shipped file: its runs cost most (c = 1000, 160 links: > 80 s of CPU, not finished; c = 100,
-    # 267 links: 24 s); `--study stretching --chis 0.1 --out lo.nc` then `--merge lo.nc <shipped file>` and
-    # chis [0.1, 0.2, 0.3, 0.5] here add it
-    "stretching": {"chis": [0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8)[1:], "accuracy": "coarse",
-                   "first": -4, "levels": 3, "tol": 1e-6},
+    # stretching (number sqrt(gL)/c): the elastic line by RODAS4 from the matched start (no release wave: the
+    # study measures the snap's own stretching), grid damping zeta = 4 (regimes_spec.STRETCH_DAMPING: at 1 the
+    # tip links chatter slack/taut, 12x the evaluations at chi = 0.3, c = 442) and the stop floor of
+    # regimes_spec; tol 1e-6 (1e-5 leaves the slow manifold: the tip links chatter from t = 0.04, chi = 0.3,
+    # c = 442). c = 1000 down to 3.3 (geomspace(1e-3, 0.3, 8)); fold levels first -4 (chi = 0.1: 155-493 links).
+    # Stop 29's partial study (stretched start, zeta 1, chi 0.2-0.5, 7 numbers) is reproduced by
+    # {"chis": [0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8)[1:], "damping": 1.0, "start": "stretched"}
+    # with the other settings as here
+    "stretching": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8), "accuracy": "coarse",
+                   "first": -4, "levels": 3, "tol": 1e-6, "damping": 4.0, "start": "matched"},
 }
 
 
@@ -61,12 +62,14 @@ def _numbers(v):
     return [float(f"{x:.3g}") for x in v]  # as the command line passes them (3 digits)
 
 
-def study(mech: str, workers: int, chis=None, out=None) -> None:
+def study(mech: str, workers: int, chis=None, out=None, levels=None) -> None:
     """Run (or resume) the study of ``mech``; ``chis`` and ``out``: a part of it (some chi) in a
     file of its own, to be put into the shipped study by :func:`merge` (cells are the same runs)."""
     from snapping.regimes import regimes
 
     s = dict(STUDIES[mech])
+    if levels:
+        s["levels"] = levels
     os.makedirs(DATA, exist_ok=True)
     out = out or os.path.join(DATA, f"{mech}.nc")
     all_chis = s.pop("chis")
@@ -104,12 +107,14 @@ def merge(mech: str, parts) -> None:
     print(f"{mech}: merged {len(parts)} part(s) into {out}; status {whole.attrs['status']}")
 
 
-def extend(mech: str, workers: int, seeds=()) -> None:
+def extend(mech: str, workers: int, seeds=(), old_path=None, out=None, levels=None) -> None:
     """Refine a shipped study by more levels (STUDIES[mech]["levels"]) without redoing its runs: the
     shipped file's levels, and any of the same runs in ``seeds`` (benchmarks/bench_bendconv.py's JSON
     files, keys "chi beta k" with frac = 0.04 * 2**-k), are copied into the new study's file, then
     :func:`snapping.regimes.regimes` computes only the runs missing. Every copied run is the same
-    computation (same links, tolerance and grid damping): checked bit for bit on one."""
+    computation (same links, tolerance and grid damping): checked bit for bit on one. ``old_path``,
+    ``out``: the study file to refine and the new one (default both the shipped file); ``levels``:
+    instead of STUDIES[mech]["levels"]."""
     import json
 
     from snapping import regimes as R
@@ -117,12 +122,19 @@ def extend(mech: str, workers: int, seeds=()) -> None:
     from snapping.sweep_files import atomic_to_netcdf
 
     s = dict(STUDIES[mech])
+    if levels:
+        s["levels"] = levels
     chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"))
-    old = R.load_study(os.path.join(DATA, f"{mech}.nc"))
+    old = R.load_study(old_path or os.path.join(DATA, f"{mech}.nc"))
     acc = dict(R.ACCURACY[s.pop("accuracy")])
     acc.update(s)
     if mech == "bending":
         acc["damping"] = R.GRID_DAMPING
+    if mech == "stretching":  # the key regimes() makes (the matched start's)
+        from snapping.regimes_spec import STRETCH_TOL_C
+
+        acc.update(elastic_method=R.STRETCH_METHOD, stop_floor=R.STRETCH_STOP_FLOOR,
+                   elastic_start=acc.pop("start"), tol_c=STRETCH_TOL_C)
     lev, ilev = R._levels(R.MECHANISMS[mech][1], acc, 0.5), R._levels("fold", acc, 0.5)
     ds = R._empty(mech, chis, numbers, lev, ilev, R._study_key(mech, chis, numbers, acc, 0.5), acc, 0.5)
     names = [f"{q}_level" for q in QUANTITIES + ("n_rhs", "cpu_time", "n_links")]
@@ -150,10 +162,53 @@ def extend(mech: str, workers: int, seeds=()) -> None:
                 else:
                     ds[f"{q}_level"].values[i, numbers.index(beta), k] = row[q]
             seeded += 1
-    out = os.path.join(DATA, f"{mech}.nc")
+    out = out or os.path.join(DATA, f"{mech}.nc")
+    if mech == "stretching":
+        ds.attrs["elastic_start"] = acc["elastic_start"]
     atomic_to_netcdf(R._finish(ds), out)
-    print(f"{mech}: {copied} levels copied from the shipped file, {seeded} runs from {list(seeds)}; resuming")
-    study(mech, workers)
+    print(f"{mech}: {copied} levels copied from {old_path or 'the shipped file'}, {seeded} runs from {list(seeds)}; "
+          f"resuming")
+    study(mech, workers, out=out, levels=levels)
+
+
+def reuse(old_path: str, out: str) -> None:
+    """Start the stretching study's file ``out`` with the runs of an earlier stretching study file
+    whose runs are the same computations: the same chi, numbers, levels, start, grid damping and tol,
+    its key lacking only ``tol_c`` (:func:`snapping.regimes_spec.stretch_tol`, added after it): every
+    ideal run and every run of c <= STRETCH_TOL_C (the same tolerance) is copied; the stiffer lines'
+    runs (now at a smaller tolerance) are left to the study. Then ``--study stretching --out OUT``
+    resumes it."""
+    import json
+
+    from snapping import regimes as R
+    from snapping.regimes_spec import STRETCH_TOL_C
+    from snapping.sweep_files import atomic_to_netcdf
+
+    old = R.load_study(old_path)
+    s = dict(STUDIES["stretching"])
+    chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"))
+    acc = dict(R.ACCURACY[s.pop("accuracy")])
+    start, damping = s.pop("start"), s.pop("damping")
+    acc.update(s, damping=damping, elastic_method=R.STRETCH_METHOD, stop_floor=R.STRETCH_STOP_FLOOR,
+               elastic_start=start)
+    want = json.loads(R._study_key("stretching", chis, numbers, acc, 0.5))
+    have = json.loads(old.attrs["regimes_study"])
+    if have != want:
+        raise SystemExit(f"{old_path} is not this study's earlier run: {have} against {want}")
+    acc["tol_c"] = STRETCH_TOL_C
+    lev, ilev = R._levels("fold", acc, 0.5), R._levels("fold", acc, 0.5)
+    ds = R._empty("stretching", chis, numbers, lev, ilev, R._study_key("stretching", chis, numbers, acc, 0.5), acc, 0.5)
+    ds.attrs["elastic_start"] = start
+    keep = np.array([1.0 / n <= STRETCH_TOL_C for n in numbers])
+    copied = 0
+    for name in [v for v in old.data_vars if v.endswith("_level")]:
+        if "ideal" in name:
+            ds[name].values[...] = old[name].values
+        else:
+            ds[name].values[:, keep, :] = old[name].values[:, keep, :]
+    copied = int(np.isfinite(ds.v_peak_level.values).sum() + np.isfinite(ds.v_peak_ideal_level.values).sum())
+    atomic_to_netcdf(R._finish(ds), out)
+    print(f"stretching: {copied} runs copied from {old_path} into {out} (c <= {STRETCH_TOL_C:g} and the ideal's)")
 
 
 def cost(mech: str, path=None) -> dict:
@@ -183,6 +238,17 @@ def cost(mech: str, path=None) -> dict:
         worst[q] = float(np.nanmax(np.where(ok, rel, np.nan))) if ok.any() else float("nan")
         print(f"  {q}: {int(ok.sum())}/{ok.size} cells resolved; largest error bar of those {worst[q]:.2%}; "
               f"median {np.nanmedian(np.where(ok, rel, np.nan)):.2%}; {int(np.sum(ok & (rel <= 0.01)))} cells within 1%")
+    if ds.attrs["mechanism"] == "stretching":  # its verdicts use the same-links ratios, extrapolated
+        from snapping.regimes_analysis import level_ratios
+
+        for q in ("v_peak", "sigma_peak"):
+            lr = level_ratios(ds, q)
+            for chi, r in lr["chi"].items():
+                ok = np.isfinite(r["ratio"]) & np.isfinite(r["error"])
+                rel = np.abs(r["error"] / r["ratio"])
+                print(f"  {q} same-links ratio, chi {chi:g}: {int(ok.sum())} cells extrapolated, "
+                      f"{int(np.sum(ok & (rel <= 0.01)))} within 1%; error bars "
+                      + " ".join("-" if not k else f"{x:.1%}" for k, x in zip(ok, rel)))
     return {"cpu": float(np.nansum(cpu) + np.nansum(ic)), "worst": worst}
 
 
@@ -283,16 +349,38 @@ def cell(mech: str, chi: float, number: float, levels, first: int = -3, tol: flo
                   f"{r['cpu_time']:.2f} s CPU", flush=True)
 
 
+def starts(cells, level: int, tol: float = 1e-6, damping: float = 4.0) -> None:
+    """The two releases of the stretching study side by side: each cell (chi, c) at one fold level from
+    the ``matched`` and the ``stretched`` start (the study's own runs, :func:`snapping.regimes._run_task`),
+    each peak over the ideal chain's on the same links, and the two ratios' relative difference."""
+    from snapping.continuum import level_parameters
+    from snapping.regimes import _run_task
+
+    lv = level_parameters(1, 0.5, first=level)[0]
+    for chi, c in cells:
+        ideal = _run_task(chi, None, 0.0, lv, tol)
+        r = {st: _run_task(chi, "stretching", 1.0 / c, lv, tol, damping, st) for st in ("matched", "stretched")}
+        for q in ("v_peak", "a_peak", "sigma_peak"):
+            m, s_ = r["matched"][q] / ideal[q], r["stretched"][q] / ideal[q]
+            print(f"chi {chi:g} c {c:g} level {level} ({ideal['n_links']} links) {q}: ratio matched {m:.6f}, "
+                  f"stretched {s_:.6f}, difference {(s_ - m) / m:+.2e}", flush=True)
+        print("  cost: " + "; ".join(f"{st} {x['n_rhs']} evaluations, {x['cpu_time']:.1f} s CPU" for st, x in r.items())
+              + f"; ideal {ideal['n_rhs']}", flush=True)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", choices=sorted(STUDIES))
     ap.add_argument("--chis", default=None, help="--study: only these chi (comma-separated) into --out")
     ap.add_argument("--out", default=None, help="--study: the file of a part study (with --chis)")
     ap.add_argument("--merge", nargs="+", default=None, help="part study files to merge into the shipped --cost/--study MECH")
+    ap.add_argument("--reuse", default=None, metavar="OLD",
+                    help="start --out with the same runs of an earlier stretching study file OLD (before tol_c)")
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
                     "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
     ap.add_argument("--seed", nargs="*", default=[])
+    ap.add_argument("--levels", type=int, default=None, help="--study/--extend: levels instead of STUDIES'")
     ap.add_argument("--file", default=None, help="the study file of --cost (default: the shipped one)")
     ap.add_argument("--damping-check", action="store_true")
     ap.add_argument("--report", nargs="*", default=None, metavar="MECH",
@@ -300,19 +388,26 @@ def main(argv=None) -> None:
     ap.add_argument("--figures", default=None, help="write the regime maps there (regimes_MECH.png)")
     ap.add_argument("--cell", nargs="+", type=float, default=None, metavar="X",
                     help="--cell CHI NUMBER LEVEL...: one cell of --study MECH at these fold levels (first -3)")
+    ap.add_argument("--starts", nargs="+", default=None, metavar="CHI:C",
+                    help="the matched and stretched starts at these stretching cells (chi:c) at --level")
+    ap.add_argument("--level", type=int, default=-4)
     ap.add_argument("--chi", type=float, default=0.3)
     ap.add_argument("--beta", type=float, default=1e-4)
     ap.add_argument("--workers", type=int, default=1)
     a = ap.parse_args(argv)
     print(f"load {os.getloadavg()[0]:.1f}")
+    if a.starts:
+        starts([tuple(float(x) for x in cs.split(":")) for cs in a.starts], a.level)
     if a.cell:
         cell(a.study, a.cell[0], a.cell[1], [int(k) for k in a.cell[2:]])
     elif a.study and a.merge:
         merge(a.study, a.merge)
+    elif a.reuse:
+        reuse(a.reuse, a.out)
     elif a.study:
-        study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out)
+        study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out, a.levels)
     if a.extend:
-        extend(a.extend, a.workers, a.seed)
+        extend(a.extend, a.workers, a.seed, a.file, a.out, a.levels)
     if a.cost:
         cost(a.cost, a.file)
     if a.damping_check:

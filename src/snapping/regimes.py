@@ -27,8 +27,10 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
 * ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``);
   fold-following graded chains.
-* ``stretching``: the extensible line (:func:`snapping.simulate.elastic.solve`, released
-  stretched at rest from its hanging equilibrium) of wave speed c; the number scanned is the
+* ``stretching``: the extensible line (:func:`snapping.simulate.elastic.solve`, from the start
+  ``start``, default ``STRETCH_START`` = ``"matched"``: at rest at the catenary, stretched to the
+  rigid chain's tensions just after release, so that no release wave rings; ``"stretched"``, the
+  hanging equilibrium let go, was the study of stop 29) of wave speed c; the number scanned is the
   *inverse* stretching number ``sqrt(g L)/c`` (so that number -> 0 is the inextensible
   ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4
   (``STRETCH_METHOD``) and the elastic grid damping ``damping`` (the shortest longitudinal
@@ -63,7 +65,8 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
-from .regimes_spec import ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_METHOD, STRETCH_STOP_FLOOR
+from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
+                           STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TOL_C, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
@@ -164,8 +167,9 @@ def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping
     return Problem.catenary(chi, links=Links.graded(h, lumping=lumping, tip_mass=tip), chords="exact", body=body)
 
 
-def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING):
-    """Worker: one run of one cell at one level; its peaks and cost (no file: the study keeps them)."""
+def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=STRETCH_START):
+    """Worker: one run of one cell at one level; its peaks and cost (no file: the study keeps them).
+    ``start``: the elastic line's (stretching only)."""
     from .simulate import run
 
     problem = cell_problem(chi, mechanism, number, level, damping=damping)
@@ -173,8 +177,9 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING):
     if mechanism == "stretching" and number > 0:
         from .simulate.elastic import Elastic, solve
 
-        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping), tol=tol,
-                   method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR).dataset
+        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
+                   tol=stretch_tol(tol, 1.0 / number), method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR,
+                   start=start, max_rhs=STRETCH_MAX_RHS).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
         ds = run(problem, method=method, tol=tol, progress=False).dataset
@@ -309,7 +314,8 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 
 def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
             first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
-            damping: float = GRID_DAMPING, workers: int = 1, scheduler=None, out=None, progress: bool = True) -> xr.Dataset:
+            damping: float | None = None, start: str = STRETCH_START, workers: int = 1, scheduler=None, out=None,
+            progress: bool = True) -> xr.Dataset:
     """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
 
     Parameters
@@ -329,9 +335,14 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         fast method's tolerance.
     ratio : float
         Resolution ratio from one level to the next.
-    damping : float
-        Bending only: the grid damping ratio of every node's shortest wave (vanishing as h^2,
-        see the module; 0: none, the fast method's choice instead of RODAS4).
+    damping : float, optional
+        Bending (default ``GRID_DAMPING``, 1): the grid damping ratio of every node's shortest wave (vanishing as h^2,
+        see the module; 0: none, the fast method's choice instead of RODAS4). Stretching: the
+        elastic grid damping ratio of the shortest longitudinal mode (default ``STRETCH_DAMPING``, 4).
+    start : {"matched", "stretched", "unstretched"}
+        Stretching only: the elastic line's start (:func:`snapping.simulate.elastic.solve`),
+        stored as the attribute ``elastic_start`` (and, other than ``"stretched"``, in the
+        study's key: a stop-29 file, run from ``"stretched"``, is resumed by that value).
     workers : int
         Local worker processes (the sweep's, :mod:`snapping._workers`).
     scheduler : str or dask.distributed.Client, optional
@@ -371,13 +382,22 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     acc["n0"] = V.integer("n0", acc["n0"], 2, 10**6)
     acc["tol"] = V.open_interval("tol", acc["tol"], 0.0, 1e-2)
     ratio = V.open_interval("ratio", ratio, 0.0, 1.0)
+    if damping is None:
+        damping = STRETCH_DAMPING if mechanism == "stretching" else GRID_DAMPING
     damping = V.real("damping", damping)
     if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
     if mechanism in ("bending", "stretching"):
         acc["damping"] = damping
     if mechanism == "stretching":
+        from .simulate.elastic_model import STARTS
+
+        if not isinstance(start, str) or start not in STARTS:
+            raise V.SnappingInputError(f"start={start!r} is not one of {STARTS} (the elastic line's starts)")
         acc.update(elastic_method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR)
+        if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
+            acc["elastic_start"] = start
+            acc["tol_c"] = STRETCH_TOL_C  # stiffer lines' runs at tol (tol_c/c)^2 (regimes_spec.stretch_tol)
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
@@ -407,6 +427,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
                                            f"this one is {key}: give another path (it is not replaced)")
             ds = old
         lock = locked(out, name="out")
+    if mechanism == "stretching":
+        ds.attrs["elastic_start"] = start
     # the runs still to do: (chi index, number index or None for the ideal, level index)
     todo = []
     for i, chi in enumerate(chis):
@@ -430,7 +452,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         if j is None:
             calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
         else:
-            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping)
+            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start)
     for args in calls.values():  # every run's problem is checked before any starts
         cell_problem(*args[:4], damping=damping)
 

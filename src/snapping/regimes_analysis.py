@@ -32,7 +32,7 @@ import numpy as np
 
 from . import _validate as V
 
-__all__ = ["power_law", "crossover", "crossover_law", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR",
+__all__ = ["power_law", "crossover", "crossover_law", "resolved", "analyze", "report", "regime_map", "LEVEL", "MAX_REL_ERROR", "RATIO_MAX_ERROR",
            "level_ratios", "with_level_ratios"]
 
 #: the crossover: the peak 10% below the ideal's
@@ -361,13 +361,20 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
     return fig
 
 
+#: level_ratios: an extrapolated same-links ratio whose error bar (its last Richardson correction) exceeds
+#: this fraction of it is no limit and is left out (the stretching study at chi = 0.1: orders 0.2-0.3, bars
+#: 56-114% of the ratio, the ideal's own peak still growing 17.2, 22.0, 26.7 over the levels)
+RATIO_MAX_ERROR = 0.5
+
+
 def level_ratios(ds, quantity: str = "v_peak") -> dict:
     """The peak over the ideal's *on the same links*, level by level, extrapolated across the levels
     (:func:`snapping.continuum.extrapolate`) -- for a study whose levels are too coarse for each
     limit apart (the stretching study's: its ideal limits carry 3-40% error bars, their observed
     orders 0.2-0.3) while the ratio, its discretisation errors shared, moves by 1-2% from level to
     level. Per chi: ``ratio``, ``error`` and ``order`` per number (nan where the extrapolated ratio
-    leaves (0, 2): an order near 0, a failed extrapolation), and :func:`crossover` on them.
+    leaves (0, 2) or its error bar exceeds :data:`RATIO_MAX_ERROR` of it: an order near 0, a failed
+    extrapolation), and :func:`crossover` on them.
 
     Returns
     -------
@@ -388,7 +395,8 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
         for j in range(nums.size):
             if np.all(np.isfinite(lv[j])):
                 x = extrapolate(res, lv[j])
-                if 0.0 < x["limit"] < 2.0:  # else a failed extrapolation (an order near 0): left out
+                # else a failed extrapolation (an order near 0, a correction of the ratio's own size): left out
+                if 0.0 < x["limit"] < 2.0 and abs(x["error"]) <= RATIO_MAX_ERROR * x["limit"]:
                     r[j], e[j], o[j] = x["limit"], x["error"], x["order"]
         ok = np.isfinite(r) & np.isfinite(e)
         cross = crossover(nums[ok], r[ok], e[ok])
@@ -406,11 +414,17 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
 def with_level_ratios(ds, quantity: str = "v_peak"):
     """A copy of the study whose ``{quantity}_ratio`` (and ``_error``) are the same-links ratios
     extrapolated across the levels (:func:`level_ratios`): the regime map of a study whose limits
-    are not resolved apart (stretching)."""
+    are not resolved apart (stretching). Its ``converged`` flag is the ratio's: an error bar within
+    :data:`MAX_REL_ERROR` of the ratio (the map's "?" marks the others)."""
     lr = level_ratios(ds, quantity)
     out = ds.copy()
-    out[f"{quantity}_ratio"] = (("chi", "number"), np.array([lr["chi"][float(c)]["ratio"] for c in ds.chi.values]))
-    out[f"{quantity}_ratio_error"] = (("chi", "number"),
-                                      np.array([lr["chi"][float(c)]["error"] for c in ds.chi.values]))
+    r = np.array([lr["chi"][float(c)]["ratio"] for c in ds.chi.values])
+    e = np.array([lr["chi"][float(c)]["error"] for c in ds.chi.values])
+    out[f"{quantity}_ratio"] = (("chi", "number"), r)
+    out[f"{quantity}_ratio_error"] = (("chi", "number"), e)
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(r) & np.isfinite(e) & (np.abs(e) <= MAX_REL_ERROR * np.abs(r))
+    out["converged"] = (("chi", "number"), ok.astype(np.int8),
+                        {"long_name": f"1: the same-links ratio's error bar is within {MAX_REL_ERROR:.0%} of it"})
     out.attrs["mechanism"] = f"{ds.attrs['mechanism']}, same-links ratios"
     return out

@@ -6,7 +6,9 @@ line can build its parser, and answer a table query, without importing them.
 
 from __future__ import annotations
 
-__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_STOP_FLOOR"]
+__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_STOP_FLOOR", "STRETCH_START",
+           "STRETCH_DAMPING", "STRETCH_MAX_RHS",
+           "STRETCH_TOL_C", "stretch_tol"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -43,3 +45,42 @@ STRETCH_METHOD = "rodas4"
 #: the fall's own speed passes 1 only at t ~ 1, the release's ringing adding far less (the fall's
 #: v_max 0.397 at t = 0.36 against g t = 0.36, chi = 0.5, c = 30)
 STRETCH_STOP_FLOOR = 1.0
+
+#: stretching: the elastic line's start in a study (:func:`snapping.simulate.elastic.solve`'s ``start``):
+#: ``"matched"``, the line at rest at the catenary stretched to the rigid chain's tensions just after
+#: release (no release wave: what the study measures is the snap's own stretching, not the release's
+#: ringing); ``"stretched"`` (the hanging equilibrium let go: the study file of stop 29) is kept
+#: reproducible by ``regimes(start="stretched")``. Stored in the study's attributes (``elastic_start``);
+#: a study file without it was run from ``"stretched"``
+STRETCH_START = "matched"
+
+#: stretching: the study's default elastic grid damping (the damping ratio of each link's shortest
+#: longitudinal mode; it vanishes with the links, so the continuum extrapolation removes it). 4, not 1:
+#: at 1 the fold-graded tip links (1e-5 to 1e-4 long, tension ~ their own tiny mass) are knocked slack by
+#: the step's error and chatter slack/taut at steps of 1e-7 (chi = 0.3, c = 442, 108 links, matched
+#: start, tol 1e-6: 1,054,295 evaluations, 108,601 of 125,498 steps with a slack link); at 4 no link
+#: goes slack there: 83,633 evaluations, v_peak 7.89554 against 7.89520 (4e-5)
+STRETCH_DAMPING = 4.0
+#: stretching: a run stops (failed, the study goes on without it and says so) after this many
+#: evaluations: a line whose tip links chatter slack/taut (chi = 0.1, c = 1000, 267 links at tol 1e-6:
+#: 1.5 million evaluations for the first 0.17 of the 1.19 time units to the snap) would otherwise
+#: hold a worker for hours; a study resumed with a larger cap redoes only the runs missing
+STRETCH_MAX_RHS = 2_500_000
+
+#: stretching: the wave speed (units sqrt(g L)) above which a run's tolerance is the study's times
+#: ``(STRETCH_TOL_C / c)^2`` (:func:`stretch_tol`)
+STRETCH_TOL_C = 450.0
+
+
+def stretch_tol(tol: float, c: float) -> float:
+    """The tolerance of a stretching run of wave speed ``c``: the study's ``tol`` up to
+    ``STRETCH_TOL_C``, then ``tol (STRETCH_TOL_C / c)^2``. Why: the tip links of a fold-graded line
+    carry a tension of the order of their own tiny mass, so their elastic stretch, T/EA ~ c^-2, is
+    what the step's position error must stay below; above it the error knocks them slack and they
+    chatter slack/taut at steps of 1e-8 to 1e-7. Measured (chi = 0.5, c = 1000, 91 links, matched
+    start, grid damping 4): tol 1e-6 took 2,354,092 evaluations, tol 2e-7 252,651 (v_peak 4.37868).
+
+    >>> stretch_tol(1e-6, 100.0), round(stretch_tol(1e-6, 900.0), 12)
+    (1e-06, 2.5e-07)
+    """
+    return tol if c <= STRETCH_TOL_C else tol * (STRETCH_TOL_C / c) ** 2

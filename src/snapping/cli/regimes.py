@@ -41,8 +41,11 @@ def _add_regimes(sub) -> None:
     p.add_argument("--levels", type=int, default=None, help="override the preset's refinement levels")
     p.add_argument("--first", type=int, default=None, help="override the preset's first fold-graded level")
     p.add_argument("--n0", type=int, default=None, help="override the preset's links of the first uniform level")
-    p.add_argument("--damping", type=float, default=1.0,
-                   help="bending: grid damping ratio of the shortest waves (vanishes as h^2; default 1)")
+    p.add_argument("--damping", type=float, default=None,
+                   help="grid damping ratio of the shortest waves (vanishes with the links): bending (default 1), "
+                        "stretching (the longitudinal waves; default 4)")
+    p.add_argument("--start", default="matched", choices=["matched", "stretched", "unstretched"],
+                   help="stretching: the elastic line's start (default matched: no release wave)")
     p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     p.add_argument("-o", "--output", default=None, metavar="FILE", help="the study file (netCDF), resumable")
@@ -75,7 +78,7 @@ def _cmd_regimes(args) -> int:
         if missing:
             raise SnappingInputError(f"regimes needs {', '.join(missing)} (or --load FILE)")
         ds = R.regimes(args.mechanism, args.chi, args.numbers, accuracy=args.accuracy, levels=args.levels,
-                       first=args.first, n0=args.n0, damping=args.damping, workers=args.workers, scheduler=args.scheduler,
+                       first=args.first, n0=args.n0, damping=args.damping, start=args.start, workers=args.workers, scheduler=args.scheduler,
                        out=args.output, progress=not args.no_progress)
     if args.json:
         out = {q: A.analyze(ds, q) for q in ("v_peak", "a_peak", "sigma_peak")}
