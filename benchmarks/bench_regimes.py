@@ -150,6 +150,8 @@ def extend(mech: str, workers: int, seeds=(), old_path=None, out=None, levels=No
     seeded = 0
     for path in seeds:
         for key, row in json.load(open(path)).items():
+            if len(key.split()) != 3:  # bench_bendconv's runs at another tolerance: not the study's runs
+                continue
             chi, beta, kk = float(key.split()[0]), float(key.split()[1]), int(key.split()[2])
             k = kk - acc["first"]
             if chi not in chis or not 0 <= k < len(lev) or (beta and beta not in numbers):

@@ -22,7 +22,10 @@ fourth level leaves by 25 error bars; at beta = 1e-8 they climb 31.9, 35.5, 39.3
 beta = 5.2e-7: 16.25, 17.23, 17.55, 17.65 at 0.41-1.47; chi = 0.3: 1.03) the levels are
 monotone with differences shrinking at order 1.7-1.8. Resolution is necessary, not sufficient:
 chi = 0.1, beta = 5.2e-7 reaches 2.47 and its differences still grow (+1.37, +2.12); the order
-test flags it.
+test flags it. Two finer levels (frac 0.005, 0.0025; RODAS4 at tol 1e-5, the study's 1e-7 being
+unaffordable there) settle the chi = 0.1 cells once ``l_B / h_fold`` passes ~1: beta = 7.2e-8 goes
+57.19, 56.95, 57.02 (0.92, 1.85, 3.69; x1.729 of the ideal), beta = 5.2e-7 55.09, 55.41 and
+beta = 1e-8 42.18, 42.37 (docs/guide/regimes.md, "Does a small stiffness raise the peak?").
 
 :func:`converged` is the per-cell flag the study stores (``converged``, with
 ``bending_resolution``, by :func:`snapping.regimes.regimes`) and that
