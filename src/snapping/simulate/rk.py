@@ -92,8 +92,14 @@ ERR_EXPONENT = -1.0 / 8.0
  Q_STEPS_PER_CALL, Q_TEND, Q_TRET, Q_VUP, Q_VDOWN, Q_STOPFRAC, Q_E0, Q_L0, Q_LAST_V, Q_LAST_A,
  Q_LAST_S, Q_LAST_K, Q_DRIFT_LINK, Q_DRIFT_LEN, Q_DRIFT_E, Q_DT_MIN_ACC, Q_DT_MAX_ACC,
  Q_ERR_MAX_ACC, Q_REFINE, Q_ERROLD, Q_BETA, Q_REJECTED, Q_NCALL, Q_MAXENERGY, Q_MAXREJ, Q_CONSREJ,
- Q_TBRK, Q_LASTBRK, Q_TSETTLE, Q_ARMED, Q_VRBASE, Q_VRPEAK) = range(43)
-NQ = 43
+ Q_TBRK, Q_LASTBRK, Q_TSETTLE, Q_ARMED, Q_VRBASE, Q_VRPEAK, Q_VFLOOR) = range(44)
+NQ = 44
+
+#: the stop rule judges a snap only once the running peak of v_max is above the start's own speed
+#: and above this fraction of sqrt(g L) (``Q_VFLOOR``): a start that is not at rest (a chain swinging
+#: gently from the start: its v_max only falls) or a release transient (a bent line's residual
+#: force on 58,422 links: v_max 4e-8 at t = 6e-11, then damped) is not a snap
+STOP_FLOOR = 1e-3
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
@@ -386,7 +392,7 @@ def after_attempt_with(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0
             ctl[Q_VRPEAK] = vrel
         fell = ctl[Q_ARMED] != 0.0 and ctl[Q_VRPEAK] > ctl[Q_VRBASE] and vrel < stopfrac * ctl[Q_VRPEAK]
     else:
-        fell = vmax < stopfrac * vbest
+        fell = vbest > ctl[Q_VFLOOR] and vmax < stopfrac * vbest
     code = GO_ON
     if meas[K.M_FINITE] == 0.0:
         code = K.RET_FAIL_NAN
