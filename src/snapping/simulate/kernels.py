@@ -50,12 +50,12 @@ from .accelerations import BLOCK, rhs, rhs_thomas  # noqa: F401
 from .layout import (C_CONSREJ, C_CUR, C_DRIFT_E, C_DRIFT_LEN, C_DRIFT_LINK, C_DRIFT_LINK0, C_DT, C_DTMIN,
                      C_DT_MAX_ACC, C_DT_MIN_ACC, C_E0, C_EPS_MAX_ACC, C_FIXED, C_L0, C_LAST_A, C_LAST_K, C_LAST_S,
                      C_LAST_V, C_MAXENERGY, C_MAXLINK, C_MAXREJ, C_NREC, C_NREJ, C_NRHS, C_NSTEPS, C_STEPS_PER_CALL,
-                     C_STOPFRAC, C_T, C_TEND, C_THIN, C_TOL, C_TRET, C_T_PEAKSTATE, C_VDOWN, C_VUP, M_AEND, M_AMAX,
+                     C_STOPFRAC, C_T, C_TEND, C_VFLOOR, C_THIN, C_TOL, C_TRET, C_T_PEAKSTATE, C_VDOWN, C_VUP, M_AEND, M_AMAX,
                      M_ENERGY, M_FINITE, M_KMAX, M_LENGTH, M_LINKERR, M_LINKERR0, M_PFX, M_PFY, M_SA, M_SIGMAX, M_SK,
                      M_SIGMIN, M_SSIGMIN, M_SV, M_VEND, M_VMAX, NCTL, NMEAS, NPK, NREC, NROWS, PEAK_QUANTITIES, P_NEED, P_Q0, P_QM1, P_QP1,
                      P_QPREV, P_T0, P_TM1, P_TP1, P_TPREV, RAX, RAY, RECORD_NAMES, RET_CALL_LIMIT, RET_END,
                      RET_FAIL_DRIFT, RET_FAIL_DT, RET_FAIL_ENERGY, RET_FAIL_NAN, RET_FAIL_REJECT, RET_RECORD_FULL,
-                     RET_STOP, RET_T_RETURN, RET_V_DOWN, RET_V_UP, RSIG, RVX, RVY, RX, RY, R_AEND, R_AMAX, R_DT,
+                     RET_STOP, RET_T_RETURN, RET_V_DOWN, RET_V_UP, RSIG, RVX, RVY, RX, RY, STOP_FLOOR, R_AEND, R_AMAX, R_DT,
                      R_ENERGY, R_EPS, R_KMAX, R_LINKERR, R_PFX, R_PFY, R_SA, R_SIGMAX, R_SIGMIN, R_SK, R_SSIGMIN, R_SV, R_T, R_VEND, R_VMAX,
                      _PEAK_MEAS)  # noqa: F401
 from .measures import measure  # noqa: F401

@@ -34,8 +34,15 @@ RECORD_NAMES = ("t", "dt", "v_max", "a_max", "sigma_max", "kappa_max", "s_kappa_
  C_DTMIN, C_STEPS_PER_CALL, C_TEND, C_TRET, C_VUP, C_VDOWN, C_STOPFRAC, C_E0, C_L0,
  C_LAST_V, C_LAST_A, C_LAST_S, C_LAST_K, C_DRIFT_LINK, C_DRIFT_LINK0, C_DRIFT_LEN, C_DRIFT_E,
  C_T_PEAKSTATE, C_DT_MIN_ACC, C_DT_MAX_ACC, C_EPS_MAX_ACC,
- C_MAXENERGY, C_MAXREJ, C_CONSREJ) = range(35)
-NCTL = 35
+ C_MAXENERGY, C_MAXREJ, C_CONSREJ, C_VFLOOR) = range(36)
+NCTL = 36
+
+#: the stop rule judges a snap only once the running peak of v_max is above the start's own speed
+#: and above this fraction of sqrt(g L) (``C_VFLOOR`` here, ``rk.Q_VFLOOR`` for DOP853 and RODAS4):
+#: a start that is not at rest (a chain swinging gently from the start: its v_max only falls) or a
+#: release transient (a bent line's residual force on 58,422 links: v_max 4e-8 at t = 6e-11, then
+#: damped) is not a snap
+STOP_FLOOR = 1e-3
 
 # peak tracking: rows v, a, sigma, kappa; columns
 P_TPREV, P_QPREV, P_TM1, P_QM1, P_T0, P_Q0, P_TP1, P_QP1, P_NEED = range(9)

@@ -95,11 +95,7 @@ ERR_EXPONENT = -1.0 / 8.0
  Q_TBRK, Q_LASTBRK, Q_TSETTLE, Q_ARMED, Q_VRBASE, Q_VRPEAK, Q_VFLOOR) = range(44)
 NQ = 44
 
-#: the stop rule judges a snap only once the running peak of v_max is above the start's own speed
-#: and above this fraction of sqrt(g L) (``Q_VFLOOR``): a start that is not at rest (a chain swinging
-#: gently from the start: its v_max only falls) or a release transient (a bent line's residual
-#: force on 58,422 links: v_max 4e-8 at t = 6e-11, then damped) is not a snap
-STOP_FLOOR = 1e-3
+#: ``Q_VFLOOR``: the stop rule's floor, max(v_max at the start, layout.STOP_FLOOR sqrt(g L))
 
 # peak tracking: rows v, a, sigma, kappa
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)

@@ -14,7 +14,7 @@ from .accelerations import rhs
 from .layout import (C_CONSREJ, C_CUR, C_DRIFT_E, C_DRIFT_LEN, C_DRIFT_LINK, C_DRIFT_LINK0, C_DT, C_DTMIN,
                      C_DT_MAX_ACC, C_DT_MIN_ACC, C_E0, C_EPS_MAX_ACC, C_FIXED, C_L0, C_LAST_A, C_LAST_K, C_LAST_S,
                      C_LAST_V, C_MAXENERGY, C_MAXLINK, C_MAXREJ, C_NREC, C_NREJ, C_NRHS, C_NSTEPS, C_STEPS_PER_CALL,
-                     C_STOPFRAC, C_T, C_TEND, C_THIN, C_TOL, C_TRET, C_T_PEAKSTATE, C_VDOWN, C_VUP, M_AEND, M_AMAX,
+                     C_STOPFRAC, C_T, C_TEND, C_VFLOOR, C_THIN, C_TOL, C_TRET, C_T_PEAKSTATE, C_VDOWN, C_VUP, M_AEND, M_AMAX,
                      M_ENERGY, M_FINITE, M_KMAX, M_LENGTH, M_LINKERR, M_LINKERR0, M_PFX, M_PFY, M_SA, M_SIGMAX, M_SIGMIN, M_SK,
                      M_SSIGMIN, M_SV, M_VEND, M_VMAX, NROWS, P_NEED, P_Q0, P_QM1, P_QP1, P_QPREV, P_T0, P_TM1, P_TP1, P_TPREV,
                      RAX, RAY, RET_CALL_LIMIT, RET_END, RET_FAIL_DRIFT, RET_FAIL_DT, RET_FAIL_ENERGY, RET_FAIL_NAN,
@@ -225,7 +225,7 @@ def advance(N, S, H, dx, dy, cp, dp, rinv0, ctl, rec, pk, PS, meas):
             code = RET_FAIL_ENERGY
         elif not fixed and dt < dtmin:
             code = RET_FAIL_DT
-        elif stopfrac > 0.0 and vmax < stopfrac * pk[0, P_Q0]:
+        elif stopfrac > 0.0 and pk[0, P_Q0] > ctl[C_VFLOOR] and vmax < stopfrac * pk[0, P_Q0]:
             code = RET_STOP
         elif last:
             code = RET_END

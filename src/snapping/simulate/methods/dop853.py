@@ -153,7 +153,7 @@ class Engine(CheckpointMixin):
         c[R.Q_TRET] = np.inf
         c[R.Q_VUP] = np.inf
         c[R.Q_STOPFRAC] = stop_fraction
-        c[R.Q_VFLOOR] = max(self.meas[K.M_VMAX], R.STOP_FLOOR * np.sqrt(self.mdl[0][G.P_G] * float(np.sum(self.mdl[1]))))
+        c[R.Q_VFLOOR] = max(self.meas[K.M_VMAX], K.STOP_FLOOR * np.sqrt(self.mdl[0][G.P_G] * float(np.sum(self.mdl[1]))))
         c[R.Q_E0] = self.meas[K.M_ENERGY]
         c[R.Q_L0] = self.meas[K.M_LENGTH]
         c[R.Q_LAST_V] = self.meas[K.M_VMAX]

@@ -114,6 +114,7 @@ class Engine(CheckpointMixin):
         c[K.C_TRET] = np.inf
         c[K.C_VUP] = np.inf
         c[K.C_STOPFRAC] = stop_fraction
+        c[K.C_VFLOOR] = max(self.meas[K.M_VMAX], K.STOP_FLOOR * np.sqrt(float(np.sum(l0))))  # (g = 1 here)
         c[K.C_E0] = self.meas[K.M_ENERGY]
         c[K.C_L0] = float(np.sum(l0))
         c[K.C_LAST_V] = self.meas[K.M_VMAX]
