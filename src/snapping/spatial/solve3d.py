@@ -40,6 +40,7 @@ from numba import njit
 from scipy.optimize import minimize_scalar
 
 from ..simulate import rk as R
+from ..simulate.layout import STOP_FLOOR
 from . import chain3d as C
 from .error3d import STAGE_BLOCK, step_error3d, step_error3d_components
 
@@ -48,8 +49,8 @@ __all__ = ["run3d", "Stepper3D"]
 # ---------------------------------------------------------------- control array
 (Q_T, Q_H, Q_SLOT, Q_NSTEPS, Q_NREJ, Q_NRHS, Q_NREC, Q_TOL, Q_TEND, Q_STOPFRAC, Q_DTMIN, Q_MAXREJ, Q_CONSREJ,
  Q_REJECTED, Q_TBRK, Q_LASTBRK, Q_REFINE, Q_NCALL, Q_CALLMAX, Q_REEVAL, Q_TSETTLE, Q_ARMED, Q_VRBASE,
- Q_VRPEAK, Q_MAXLINK) = range(25)
-NQ = 25
+ Q_VRPEAK, Q_MAXLINK, Q_VFLOOR) = range(26)
+NQ = 26
 # peak rows: v, a, sigma
 (PK_SBEST, PK_TPREV, PK_TBEFORE, PK_NEED, PK_TA, PK_TB, PK_BEST, PK_TBEST) = range(8)
 NPKR = 8
@@ -231,7 +232,7 @@ def advance3d(N, Y0, Y1, KK, TS, HS, DOK, ytmp, T, cp, dp, ctl, rec, pk, meas, s
                 ctl[Q_VRPEAK] = vrel
             fell = ctl[Q_ARMED] != 0.0 and ctl[Q_VRPEAK] > ctl[Q_VRBASE] and vrel < ctl[Q_STOPFRAC] * ctl[Q_VRPEAK]
         else:
-            fell = meas[C.M_VMAX] < ctl[Q_STOPFRAC] * pk[0, PK_BEST]
+            fell = pk[0, PK_BEST] > ctl[Q_VFLOOR] and meas[C.M_VMAX] < ctl[Q_STOPFRAC] * pk[0, PK_BEST]
         nrec = int(ctl[Q_NREC])
         rec[nrec, 0] = t
         rec[nrec, 1] = h
@@ -295,6 +296,9 @@ class Stepper3D:
         self.tol = tol
         c = np.zeros(NQ)
         c[Q_TOL], c[Q_TEND], c[Q_STOPFRAC], c[Q_DTMIN], c[Q_MAXREJ] = tol, t_end, stop_fraction, dt_min, max_rejections
+        # the stop rule's floor (simulate.layout.STOP_FLOOR): above the start's own speed and STOP_FLOOR sqrt(g L)
+        g = float(np.linalg.norm(par[C.P_GX:C.P_GZ + 1]))
+        c[Q_VFLOOR] = max(self.meas[C.M_VMAX], STOP_FLOOR * np.sqrt(g * float(np.sum(h))))
         c[Q_REEVAL] = 1.0 if reeval else 0.0
         c[Q_LASTBRK] = np.nan
         c[Q_CALLMAX] = max(20, 20_000_000 // (R.NS * N))
