@@ -90,19 +90,7 @@ def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J, gW, gD):
             continue
         # the node blocks (jac_given)
         _, fp = EK.law(E[j], ea[j], tabe, tabt)
-        tdx = fp * ux / h[j] + c * (dvx - udv * ux) / (ln * h[j])
-        tdy = fp * uy / h[j] + c * (dvy - udv * uy) / (ln * h[j])
-        tvx = c * ux / h[j]
-        tvy = c * uy / h[j]
-        q = tj / ln
-        a00 = q * (1.0 - ux * ux) + ux * tdx
-        a01 = -q * ux * uy + ux * tdy
-        a10 = -q * uy * ux + uy * tdx
-        a11 = q * (1.0 - uy * uy) + uy * tdy
-        b00 = ux * tvx
-        b01 = ux * tvy
-        b10 = uy * tvx
-        b11 = uy * tvy
+        a00, a01, a10, a11, b00, b01, b10, b11 = EK.link_blocks(tj, fp, c, h[j], ln, ux, uy, dvx, dvy, udv)
         mj = invm[j]
         _add_block(J, j, 1, -1.0 * mj, a00, a01, a10, a11, b00, b01, b10, b11)
         if j + 1 < N:
@@ -111,6 +99,7 @@ def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J, gW, gD):
             _add_block(J, j + 1, 0, 1.0 * mk, a00, a01, a10, a11, b00, b01, b10, b11)
             _add_block(J, j + 1, 1, -1.0 * mk, a00, a01, a10, a11, b00, b01, b10, b11)
         else:  # the W row (wd_gradients)
+            q = tj / ln
             tdx = fp * ux / h[j] + c * px / h[j]
             tdy = fp * uy / h[j] + c * py / h[j]
             uvp = ux * pin[2] + uy * pin[3]

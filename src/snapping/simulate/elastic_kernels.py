@@ -183,6 +183,21 @@ def jac_blocks(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E, ED, FV):
 
 
 @njit(cache=True, error_model="numpy")
+def link_blocks(tj, fp, c, hj, ln, ux, uy, dvx, dvy, udv):
+    """A taut link's force derivative blocks ``(a00, a01, a10, a11, b00, b01, b10, b11)``:
+    ``A = dG/dd = T/l (I - u u^T) + u (dT/dd)^T`` and ``Bv = dG/d(dv) = u (dT/d(dv))^T``, ``G = T u``
+    (``fp`` the law's slope, ``c`` the damping, ``udv = u . dv``)."""
+    # dT/dd and dT/d(dv)
+    tdx = fp * ux / hj + c * (dvx - udv * ux) / (ln * hj)
+    tdy = fp * uy / hj + c * (dvy - udv * uy) / (ln * hj)
+    tvx = c * ux / hj
+    tvy = c * uy / hj
+    q = tj / ln
+    return (q * (1.0 - ux * ux) + ux * tdx, -q * ux * uy + ux * tdy, -q * uy * ux + uy * tdx,
+            q * (1.0 - uy * uy) + uy * tdy, ux * tvx, ux * tvy, uy * tvx, uy * tvy)
+
+
+@njit(cache=True, error_model="numpy")
 def jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E):
     """:func:`jac_blocks` with the tensions ``T`` and strains ``E`` of ``z`` given (by
     :func:`tensions` or :func:`rhs` at the same state: a Rosenbrock method's Jacobian is
@@ -207,21 +222,7 @@ def jac_given(N, z, pin, h, invm, ea, damp, tabe, tabt, B, T, E):
         _, fp = law(E[j], ea[j], tabe, tabt)
         c = damp[j]
         udv = ux * dvx + uy * dvy
-        # dT/dd and dT/d(dv)
-        tdx = fp * ux / h[j] + c * (dvx - udv * ux) / (ln * h[j])
-        tdy = fp * uy / h[j] + c * (dvy - udv * uy) / (ln * h[j])
-        tvx = c * ux / h[j]
-        tvy = c * uy / h[j]
-        # A = dG/dd = T/l (I - u u^T) + u (dT/dd)^T ; Bv = dG/d(dv) = u (dT/d(dv))^T, G = T u
-        q = tj / ln
-        a00 = q * (1.0 - ux * ux) + ux * tdx
-        a01 = -q * ux * uy + ux * tdy
-        a10 = -q * uy * ux + uy * tdx
-        a11 = q * (1.0 - uy * uy) + uy * tdy
-        b00 = ux * tvx
-        b01 = ux * tvy
-        b10 = uy * tvx
-        b11 = uy * tvy
+        a00, a01, a10, a11, b00, b01, b10, b11 = link_blocks(tj, fp, c, h[j], ln, ux, uy, dvx, dvy, udv)
         # node j: acc += G/m_j, G depends on r_{j+1} - r_j and v_{j+1} - v_j
         mj = invm[j]
         for sgn, k in ((-1.0, 1), (1.0, 2)):
