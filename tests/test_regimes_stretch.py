@@ -255,3 +255,18 @@ def test_report_section_gives_the_stretching_verdict(shipped):
     want = "; ".join(stretching_speeds(level_ratios(shipped), ideal_speeds([other, shipped])))
     assert f"**Verdict (computed, stretching against the issue's guess, c ~ v): {want}.**" in text
     assert "(end-mass study" in want  # the resolved ideal speed, not this study's own
+
+
+def test_report_section_stretching_generic_verdict_points_to_the_ratio(shipped):
+    """The stretching study's own limits are not resolved apart: its generic verdict says so,
+    quotes the ideal's limits from the file, and hands the crossovers to the same-links ratio
+    (it used to print "no crossover: the ideal's limit is not resolved" for every chi)."""
+    from snapping.caps_report import report_section
+
+    text = "\n".join(report_section([], [shipped]))
+    line = next(t for t in text.splitlines() if t.startswith("**Verdict (computed, v_peak): "))
+    assert "no crossover" not in line and "same-links ratio's (below)" in line
+    v = float(shipped.v_peak_ideal.sel(chi=0.5))
+    assert f"chi=0.5: {v:.4g} +- " in line
+    bad = int((shipped.sizes["chi"] * shipped.sizes["number"]))
+    assert f"of {bad} cells not converged" in line or "every cell converged" in line

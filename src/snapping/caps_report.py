@@ -143,7 +143,7 @@ def convergence_words(ds, quantity: str = "v_peak") -> str:
 def report_section(answers: list[dict], study_list: list, figure_names=()) -> list[str]:
     """Markdown lines of the section "Beyond the paper: what caps the snap"."""
     from . import caps
-    from .regimes_analysis import LEVEL, analyze, level_ratios, report
+    from .regimes_analysis import LEVEL, analyze, level_ratios, report, with_level_ratios
 
     lines = ["## Beyond the paper: what caps the snap", "",
              "The paper's snap is capped by geometry (the fold's curvature scale); a real line has bending, "
@@ -168,10 +168,16 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
         a = analyze(ds, "v_peak")
         crossed = [f"chi={chi:g}: {row['crossover']['statement']}" for chi, row in a["chi"].items()]
         lines += [f"### Regime study: {ds.attrs['mechanism']} ({ds.attrs.get('source', '')})", "", "```"]
-        lines += report(ds) + ["```", "",
-                               f"**Verdict (computed, v_peak): {'; '.join(crossed)}; {a['crossover_law']['statement']}"
-                               + (f"; {convergence_words(ds)}" if "converged" in ds else "") + ".**",
-                               ""]
+        if ds.attrs["mechanism"] == "stretching":  # limits not resolved apart: the same-links ratio judges
+            ideal = ", ".join(f"chi={chi:g}: {row['ideal']:.4g} +- {row['ideal_error']:.2g}"
+                              for chi, row in a["chi"].items())
+            verdict = ("each cell's own continuum limit is not resolved at this study's levels (the ideal's: "
+                       f"{ideal}), so its crossovers are the same-links ratio's (below); "
+                       f"{convergence_words(with_level_ratios(ds))}")
+        else:
+            verdict = ("; ".join(crossed) + f"; {a['crossover_law']['statement']}"
+                       + (f"; {convergence_words(ds)}" if "converged" in ds else ""))
+        lines += report(ds) + ["```", "", f"**Verdict (computed, v_peak): {verdict}.**", ""]
         if ds.attrs["mechanism"] == "stretching":
             lr = level_ratios(ds, "v_peak")
             lines += ["The stretching study's levels are too coarse for each limit apart (above); the ratio to "
