@@ -28,13 +28,21 @@ links, its tension within 0.11% of the converged value, estimate 0.55%).
 bending or drag; it is run when EA is given and matters: when the ideal run's peak speed
 reaches ``STRETCH_MATTERS`` = 5% of the longitudinal wave speed c = sqrt(EA/lambda) (the
 elastic guide's measurements put the peaks' change at 0.1-0.3% for v/c of 1-3% and 4-11% for
-v/c of about 20%). Then it runs the elastic line and the rigid chain on the same
-``STRETCH_N`` = 30 uniform links (grid damping 1, DOP853: seconds) and takes their ratio as the
-stretching factor of each peak (at more links the elastic model's tension peak is not
-reliable: the elastic guide's +45% at N = 100, c = 300, unexplained). The stretching-alone
-answer is the ideal's times that factor; the **real answer** is the full run's times it (the
-two models cannot run together: the factors are taken as independent, and the answer says so).
-Below the threshold the answer says stretching was left out, and why.
+v/c of about 20%). Then it runs the elastic line (from the rigid chain's release, ``"matched"``:
+no release wave; grid damping 1; RODAS4) and the rigid chain on the same uniform links, on two
+levels, ``STRETCH_LEVELS`` = 30 and 60 links, and takes their ratio as the stretching factor of
+each peak **only where the two levels agree within** :data:`RESOLVED` = 1%
+(:func:`snapping.caps_runs.accept_factors`: the finer level's factor); a peak whose two levels
+disagree keeps the full run's value (factor 1), and the answer says so (``stretching["resolved"]``
+per peak, ``stretching["why"]``, the printed answer). The ratio is not a converged quantity: the
+ideal chain's snap, and with it v/c, grows with the links; the elastic line's tension peak is often
+not the snap's but the snap's tension wave reaching the held end (L/c later, at the held end's
+link) or, on a coarse chain at small chi, a slack link jerked taut after the snap where the rigid
+chain carries compression (the nylon line at chi 0.1 on 30 links: x11.4 in the tension, 1.06 on 60;
+the elastic guide, "The tension peak of the elastic chain"). The stretching-alone answer is the
+ideal's times the applied factor; the **real answer** is the full run's times it (the two models
+cannot run together: the factors are taken as independent, and the answer says so). Below the
+threshold the answer says stretching was left out, and why.
 
 **The capping mechanism** (rule): if the real peak (of ``quantity``, default the tension) is
 within 10% of the ideal's (ratio >= :data:`snapping.regimes_analysis.LEVEL` = 0.9, the
