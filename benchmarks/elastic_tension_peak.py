@@ -49,9 +49,11 @@ def one(sp, chi: float, N: int, zeta: float, start: str, method: str, tol: float
     ts = float(ra["t_snap_sigma"])
     r = {q: float(ea[q]) / float(ra[q]) for q in caps.QUANTITIES}
     return (f"| {chi:g} | {N} | {zeta:g} | {start} | {tol:g} | {r['v_peak']:.4f} | {r['a_peak']:.4f} | "
-            f"{r['sigma_peak']:.4f} | {ts:.5f} | {sm[i]:.4g} (before: {sm[i - 1]:.4g}) | {float(ds['s_sigma_max'][i]):.3f} | "
+            f"{r['sigma_peak']:.4f} | {ts:.5f} | {sm[i]:.4g} (before: {sm[i - 1]:.4g}) | "
+            f"{float(ds['s_sigma_max'][i]):.3f} | "
             f"{t[i] - ts:+.4f} | {int(ds['n_slack'][i])} | {sm[iw] / float(ra['sigma_peak']):.4f} | "
-            f"{am[jw] / float(ra['a_peak']):.4f} | {smin[k]:.3g} (t {float(dr['t'][k]):.4f}, s {float(dr['s_sigma_min'][k]):.3f}) | "
+            f"{am[jw] / float(ra['a_peak']):.4f} | {smin[k]:.3g} (t {float(dr['t'][k]):.4f}, "
+            f"s {float(dr['s_sigma_min'][k]):.3f}) | "
             f"{float(ra['t_final']):.4f} / {float(ea['t_final']):.4f} | {int(ra['n_rhs'])} / {int(ea['n_rhs'])} | "
             f"{c1 - c0:.2f} / {c2 - c1:.2f} |")
 

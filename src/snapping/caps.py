@@ -77,8 +77,8 @@ from dataclasses import dataclass, replace
 
 from . import _validate as V
 from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO,  # noqa: F401
-                        STIFF_TOL, STRETCH_LEVELS, STRETCH_METHOD, STRETCH_N, STRETCH_START, Runs, accept_factors, bending_length,
-                        grading_rule, method_for, problem, richardson, stretch_factor)
+                        STIFF_TOL, STRETCH_LEVELS, STRETCH_METHOD, STRETCH_N, STRETCH_START, Runs, accept_factors,
+                        bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
 from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
@@ -322,8 +322,8 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         if ratio >= STRETCH_MATTERS:
             sl = [stretch_factor(sp, chi, runs.tol, n) for n in STRETCH_LEVELS]
             for f in sl:
-                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {STRETCH_METHOD}", "tol": runs.tol,
-                                 "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
+                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {STRETCH_METHOD}",
+                                 "tol": runs.tol, "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
             factor_s, ok = accept_factors(*({q: f[q] for q in QUANTITIES} for f in sl), RESOLVED)
             stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"],
                                "levels": [{"N": f["N"], **{q: f[q] for q in QUANTITIES}, "s_sigma": f["s_sigma"],
@@ -469,7 +469,8 @@ def format_answer(r: dict) -> list[str]:
     if r["alone"]:
         left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
-            f"{m} {v[r['quantity']]:.5g}" + (" (factor not resolved: the ideal's)" if m == "stretching" and left else "")
+            f"{m} {v[r['quantity']]:.5g}"
+            + (" (factor not resolved: the ideal's)" if m == "stretching" and left else "")
             for m, v in r["alone"].items()))
     out.append(f"  stretching: {r['stretching']['why']}")
     if r.get("auto_N") and r.get("graded", {}).get("used"):
@@ -519,8 +520,8 @@ def format_design(d: dict) -> list[str]:
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:
-        out.append(f"  stretching factor NOT applied (not resolved from {STRETCH_LEVELS[0]} to {STRETCH_LEVELS[1]} links) "
-                   f"at chi: {'; '.join(st)}")
+        out.append(f"  stretching factor NOT applied (not resolved from {STRETCH_LEVELS[0]} to {STRETCH_LEVELS[1]} "
+                   f"links) at chi: {'; '.join(st)}")
     ok = d["admissible_chi"]
     out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")
     out.append(f"  capped by: the mechanism whose run alone comes nearest the real {q} (none: real/ideal >= 0.9, "
