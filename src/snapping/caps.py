@@ -28,13 +28,21 @@ links, its tension within 0.11% of the converged value, estimate 0.55%).
 bending or drag; it is run when EA is given and matters: when the ideal run's peak speed
 reaches ``STRETCH_MATTERS`` = 5% of the longitudinal wave speed c = sqrt(EA/lambda) (the
 elastic guide's measurements put the peaks' change at 0.1-0.3% for v/c of 1-3% and 4-11% for
-v/c of about 20%). Then it runs the elastic line and the rigid chain on the same
-``STRETCH_N`` = 30 uniform links (grid damping 1, DOP853: seconds) and takes their ratio as the
-stretching factor of each peak (at more links the elastic model's tension peak is not
-reliable: the elastic guide's +45% at N = 100, c = 300, unexplained). The stretching-alone
-answer is the ideal's times that factor; the **real answer** is the full run's times it (the
-two models cannot run together: the factors are taken as independent, and the answer says so).
-Below the threshold the answer says stretching was left out, and why.
+v/c of about 20%). Then it runs the elastic line (from the rigid chain's release, ``"matched"``:
+no release wave; grid damping 1; RODAS4) and the rigid chain on the same uniform links, on two
+levels, ``STRETCH_LEVELS`` = 30 and 60 links, and takes their ratio as the stretching factor of
+each peak **only where the two levels agree within** :data:`RESOLVED` = 1%
+(:func:`snapping.caps_runs.accept_factors`: the finer level's factor); a peak whose two levels
+disagree keeps the full run's value (factor 1), and the answer says so (``stretching["resolved"]``
+per peak, ``stretching["why"]``, the printed answer). The ratio is not a converged quantity: the
+ideal chain's snap, and with it v/c, grows with the links; the elastic line's tension peak is often
+not the snap's but the snap's tension wave reaching the held end (L/c later, at the held end's
+link) or, on a coarse chain at small chi, a slack link jerked taut after the snap where the rigid
+chain carries compression (the nylon line at chi 0.1 on 30 links: x11.4 in the tension, 1.06 on 60;
+the elastic guide, "The tension peak of the elastic chain"). The stretching-alone answer is the
+ideal's times the applied factor; the **real answer** is the full run's times it (the two models
+cannot run together: the factors are taken as independent, and the answer says so). Below the
+threshold the answer says stretching was left out, and why.
 
 **The capping mechanism** (rule): if the real peak (of ``quantity``, default the tension) is
 within 10% of the ideal's (ratio >= :data:`snapping.regimes_analysis.LEVEL` = 0.9, the
@@ -69,7 +77,8 @@ from dataclasses import dataclass, replace
 
 from . import _validate as V
 from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO,  # noqa: F401
-                        STIFF_TOL, STRETCH_N, Runs, bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
+                        STIFF_TOL, STRETCH_LEVELS, STRETCH_METHOD, STRETCH_N, STRETCH_START, Runs, accept_factors,
+                        bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
 from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
@@ -248,7 +257,10 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         ``line``, ``chi``, ``N``, ``numbers`` (nondimensional), ``ideal``, ``real``, ``full``
         (the inextensible run with every mechanism), ``alone`` ({mechanism: peaks}), each
         peaks in SI; ``factor`` (real / ideal per peak), ``cap`` (the capping mechanism or
-        ``"none"``), ``rule``, ``stretching`` (what was done and why), ``resolution``
+        ``"none"``), ``rule``, ``stretching`` (what was done and why: ``run``, ``why``, and when run
+        ``factor`` (the factor applied per peak, 1.0 where left out), ``resolved`` (per peak: whether
+        the two levels agreed within :data:`RESOLVED`, i.e. whether the factor was applied) and
+        ``levels`` (each level's links and factors, where and when its tension peaked)), ``resolution``
         (relative change N/2 -> N per peak; graded: coarse -> fine level), ``graded`` (``used``,
         ``why``, and when used ``levels`` (links), ``bending_length``, ``error`` (SI) and
         ``relative_error`` per peak, ``within`` (every peak's error <= 1%)), ``runs`` (each run:
@@ -308,13 +320,17 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         ratio = ideal_nd["v_peak"] / c
         stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio})
         if ratio >= STRETCH_MATTERS:
-            f = stretch_factor(sp, chi, runs.tol)
-            runs.log.append({"run": "stretching", "N": f["N"], "method": "dop853", "tol": runs.tol,
-                             "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
-            factor_s = {q: f[q] for q in QUANTITIES}
-            stretching.update({"run": True, "factor": factor_s, "N": f["N"], "strain_peak": f["strain_peak"],
-                               "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g}: run (elastic over rigid, "
-                                      f"{f['N']} links); the real answer is the full run times this factor"})
+            sl = [stretch_factor(sp, chi, runs.tol, n) for n in STRETCH_LEVELS]
+            for f in sl:
+                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {STRETCH_METHOD}",
+                                 "tol": runs.tol, "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
+            factor_s, ok = accept_factors(*({q: f[q] for q in QUANTITIES} for f in sl), RESOLVED)
+            stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"],
+                               "levels": [{"N": f["N"], **{q: f[q] for q in QUANTITIES}, "s_sigma": f["s_sigma"],
+                                           "t_sigma": f["t_sigma"], "t_snap": f["t_snap"]} for f in sl],
+                               "strain_peak": sl[1]["strain_peak"],
+                               "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g}: run (elastic over rigid on "
+                                      f"{sl[0]['N']} and {sl[1]['N']} links); " + stretch_words(sl, ok)})
             if alone:
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -330,8 +346,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         half = runs.get(tuple(present), N // 2)
         resolution = {q: (full_nd[q] - half[q]) / full_nd[q] for q in QUANTITIES}
     factor = {q: real_nd[q] / ideal_nd[q] for q in QUANTITIES}
-    capped = decide(factor[quantity], real_nd[quantity], {m: v[quantity] for m, v in alone_nd.items()},
-                    bool(present or stretching["run"]), alone)
+    judged = {m: v[quantity] for m, v in alone_nd.items() if m != "stretching" or stretching["resolved"][quantity]}
+    capped = decide(factor[quantity], real_nd[quantity], judged,
+                    bool(present or (stretching["run"] and stretching["resolved"][quantity])), alone)
     from .regimes_analysis import LEVEL
 
     rule = (f"{quantity}: real/ideal >= {LEVEL:g} -> none (the ideal chain's own cap: geometry and links); else the "
@@ -342,6 +359,25 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
             "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
             "stretching": stretching, "resolution": resolution, "damping": runs.damping, "graded": grade,
             "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}}
+
+
+def stretch_words(levels: list, resolved: dict) -> str:
+    """What the stretching factor did, peak by peak (``levels``: :func:`stretch_factor`'s two,
+    ``resolved``: :func:`accept_factors`'): applied where the two levels agree within
+    :data:`RESOLVED`, left out (and said so) where they do not."""
+    a, b = levels
+    arrow = {q: f"{a[q]:.4g} -> {b[q]:.4g}" for q in QUANTITIES}
+    on = [f"{q} x{b[q]:.4f} ({arrow[q]})" for q in QUANTITIES if resolved[q]]
+    off = [f"{q} ({arrow[q]})" for q in QUANTITIES if not resolved[q]]
+    words = []
+    if on:
+        words.append(f"applied where the two agree within {RESOLVED:.0%}: " + ", ".join(on)
+                     + " (the real answer is the full run times it: the factors taken as independent)")
+    if off:
+        words.append(f"NOT applied, not resolved in the links (they differ by more than {RESOLVED:.0%}): "
+                     + ", ".join(off) + ": the real answer leaves stretching out of "
+                     + ("it" if len(off) == 1 else "them"))
+    return "; ".join(words)
 
 
 def decide(factor: float, real: float, alone: dict, acts: bool = True, tried: bool = True) -> str:
@@ -415,6 +451,7 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
         n_rhs += r["n_rhs"]
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],
+                     "stretching": r["stretching"],
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
     ok = [r["chi"] for r in rows if r["admissible"]]
@@ -430,8 +467,11 @@ def format_answer(r: dict) -> list[str]:
     for q, u in QUANTITIES.items():
         out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
     if r["alone"]:
+        left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
-            f"{m} {v[r['quantity']]:.5g}" for m, v in r["alone"].items()))
+            f"{m} {v[r['quantity']]:.5g}"
+            + (" (factor not resolved: the ideal's)" if m == "stretching" and left else "")
+            for m, v in r["alone"].items()))
     out.append(f"  stretching: {r['stretching']['why']}")
     if r.get("auto_N") and r.get("graded", {}).get("used"):
         out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each "
@@ -477,6 +517,11 @@ def format_design(d: dict) -> list[str]:
           if r.get("graded", {}).get("used")]
     if gr:
         out.append(f"  real peaks from graded links, two levels extrapolated, at chi: {', '.join(gr)}")
+    st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
+          for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
+    if st:
+        out.append(f"  stretching factor NOT applied (not resolved from {STRETCH_LEVELS[0]} to {STRETCH_LEVELS[1]} "
+                   f"links) at chi: {'; '.join(st)}")
     ok = d["admissible_chi"]
     out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")
     out.append(f"  capped by: the mechanism whose run alone comes nearest the real {q} (none: real/ideal >= 0.9, "

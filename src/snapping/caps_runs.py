@@ -23,12 +23,21 @@ import time
 import numpy as np
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
-           "STRETCH_N", "QUANTITIES", "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
+           "STRETCH_N", "STRETCH_LEVELS", "STRETCH_START", "STRETCH_METHOD", "accept_factors", "QUANTITIES",
+           "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
            "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
            "grading_for"]
 
-#: links of the elastic and rigid runs that give the stretching factor
+#: links of the coarser level of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
+#: the stretching factor's two levels (:func:`accept_factors`: a peak's factor is applied only where they agree)
+STRETCH_LEVELS = (STRETCH_N, 2 * STRETCH_N)
+#: the elastic line's start in the stretching runs: the rigid chain's release (no release wave;
+#: :func:`snapping.simulate.elastic_statics.matched`), the release the full run makes
+STRETCH_START = "matched"
+#: the elastic line's method in the stretching runs: the compiled RODAS4 (exact banded Jacobian); at tol 1e-6
+#: its peaks are within 1e-5 of DOP853's on the nylon line's 30 and 60 links, at 0.13-0.56 s of CPU against 0.66-1.12
+STRETCH_METHOD = "rodas4"
 #: RODAS4's tolerance in the runs it takes (:func:`method_for`)
 STIFF_TOL = 1e-4
 #: a run is stiff when DOP853's stability limit needs more than this many times its accuracy-limited steps
@@ -251,22 +260,42 @@ def _run(problem_, method: str, tol: float) -> dict:
             "method": str(a["method"]), "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
 
 
-def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N) -> dict:
+def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start: str = STRETCH_START) -> dict:
     """The elastic line over the rigid chain on the same ``N`` uniform links (shared lumping),
-    peak by peak: the stretching factor of :func:`snapping.caps.cap`."""
+    peak by peak: one level of the stretching factor of :func:`snapping.caps.cap` (which takes two,
+    :data:`STRETCH_LEVELS`, and applies a peak's factor only where they agree: :func:`accept_factors`).
+    The elastic line starts ``start`` (:data:`STRETCH_START`), grid damping 1, by
+    :data:`STRETCH_METHOD` at ``tol``; the rigid chain by the fast method at ``tol``.
+    Besides the ratios: ``s_sigma`` and ``t_sigma``, where (arclength from the held end) and when the
+    elastic line's tension peaks, ``t_snap`` the rigid chain's (its tension peak's) time."""
     from .simulate import Links, Problem, run
     from .simulate.elastic import Elastic, solve
 
     t0, c0 = time.perf_counter(), time.process_time()
     p = Problem.catenary(chi, links=Links.uniform(N, lumping="shared"))
     rigid = run(p, method="fast", tol=tol, progress=False).dataset.attrs
-    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method="dop853").dataset.attrs
+    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method=STRETCH_METHOD,
+               start=start).dataset.attrs
     if el.get("status") != "completed":
         raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')})")
     return {**{q: float(el[q]) / float(rigid[q]) for q in QUANTITIES}, "N": N,
             "n_rhs": int(el["n_rhs"]) + int(rigid["n_rhs"]), "wall": time.perf_counter() - t0,
-            "cpu": time.process_time() - c0,
-            "strain_peak": float(el["strain_peak"])}
+            "cpu": time.process_time() - c0, "strain_peak": float(el["strain_peak"]),
+            "s_sigma": float(el["s_sigma_peak"]), "t_sigma": float(el["t_snap_sigma"]),
+            "t_snap": float(rigid["t_snap_sigma"])}
+
+
+def accept_factors(coarse: dict, fine: dict, tol: float) -> tuple[dict, dict]:
+    """``(applied, resolved)`` per peak of two levels of the stretching factor (``coarse`` on
+    :data:`STRETCH_N` links, ``fine`` on twice as many; {peak: factor}): a peak's factor is resolved
+    when the two agree to ``tol`` relative, ``|fine - coarse| <= tol |fine|``, and then the fine
+    level's is applied; otherwise it is left out (1.0), never applied unverified.
+
+    >>> accept_factors({"v_peak": 0.995, "sigma_peak": 0.996}, {"v_peak": 0.989, "sigma_peak": 1.483}, 0.01)
+    ({'v_peak': 0.989, 'sigma_peak': 1.0}, {'v_peak': True, 'sigma_peak': False})
+    """
+    resolved = {q: bool(abs(fine[q] - coarse[q]) <= tol * abs(fine[q])) for q in fine}
+    return {q: (fine[q] if resolved[q] else 1.0) for q in fine}, resolved
 
 
 class Runs:
