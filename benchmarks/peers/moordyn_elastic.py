@@ -25,7 +25,8 @@ or ``rk4``, ...), one ``Step`` call per step (the step ``dtM`` in the input file
 sampling the free point's speed and the line's largest tension (``GetLineMaxTen``) after
 every step; peaks: the vertex of the parabola through the three samples around the largest,
 up to the reference's end (this project's stop at the snap). The per-step
-sampling costs Python calls (about a third of MoorDyn's own time at N = 100).
+sampling costs Python calls (27% of the sampled run at N = 100, RK4): :func:`stepping_cpu`
+times MoorDyn's stepping alone, what ``elastic_table.py`` compares.
 
 Usage::
 
@@ -202,6 +203,19 @@ def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_
     return E.Result("MoorDyn", N, c, f"{scheme} dt={dt:.3g}", n, w, vp, tp, sp_, ts, start=start)
 
 
+def advance(s, dt: float, n_steps: int, chunk: int) -> None:
+    """``n_steps`` steps of ``dt`` of the MoorDyn system ``s`` from t = 0, ``chunk`` steps a
+    ``Step`` call (MoorDyn divides a call's interval into its steps of ``dtM = dt``)."""
+    import moordyn
+
+    n, t = 0, 0.0
+    while n < n_steps:
+        m = min(chunk, n_steps - n)
+        moordyn.Step(s, [], [], t, m * dt)
+        n += m
+        t = n * dt
+
+
 def stepping_cpu(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: int, start: str = "stretched",
                  repeats: int = 1) -> list:
     """CPU seconds of MoorDyn's own work for ``n_steps`` steps of ``dt`` (``repeats`` runs): the
@@ -209,7 +223,7 @@ def stepping_cpu(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: 
     ``Step`` called for ``CHUNK`` steps at a time (MoorDyn divides a call's interval into its
     ``dtM`` steps: the same states as one call a step, to round-off), with nothing sampled
     between the calls. :func:`run_moordyn`'s time also holds the Python calls that sample the
-    peaks after every step (about a third of it at N = 100): this is MoorDyn's cost without them."""
+    peaks after every step (27% of it at N = 100, RK4 at h/c): this is MoorDyn's cost without them."""
     import moordyn
 
     E.start_state(chi, N, c, start)  # the given data (cached): not timed
@@ -218,12 +232,7 @@ def stepping_cpu(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: 
         with tempfile.TemporaryDirectory() as d, quiet_stdout():
             w = time.process_time()
             s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
-            n, t = 0, 0.0
-            while n < n_steps:
-                k = min(CHUNK, n_steps - n)
-                moordyn.Step(s, [], [], t, k * dt)
-                n += k
-                t = n * dt
+            advance(s, dt, n_steps, CHUNK)
             out.append(time.process_time() - w)
             moordyn.Close(s)
     return out
@@ -239,12 +248,7 @@ def chunk_check(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: i
     for k in (1, CHUNK):
         with tempfile.TemporaryDirectory() as d, quiet_stdout():
             s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
-            n, t = 0, 0.0
-            while n < n_steps:
-                m = min(k, n_steps - n)
-                moordyn.Step(s, [], [], t, m * dt)
-                n += m
-                t = n * dt
+            advance(s, dt, n_steps, k)
             out.append(np.array(list(moordyn.GetPointPos(pt)) + list(moordyn.GetPointVel(pt))))
             moordyn.Close(s)
     return float(np.abs(out[0] - out[1]).max())
