@@ -395,6 +395,34 @@ def test_moordyn_line_is_the_same_line():
 
 
 @needs_moordyn
+def test_moordyn_stepping_in_chunks_is_one_call_a_step(tmp_path):
+    """The clock of the side-by-side table (``moordyn_elastic.advance``, many steps a ``Step``
+    call, what ``stepping_cpu`` times) takes the same steps as one ``Step`` call a step written
+    out here: the same free-end state after 450 steps (t = 0.75, before the snap; 100 steps a call,
+    the last call 50), to round-off, and the end has moved. (Past the snap the undamped line's
+    slack-taut switches amplify round-off: 2.5e-3 apart after 1,500 steps.)"""
+    import moordyn
+
+    M = _load(MD_SCRIPT)
+    N, c = 20, 30.0
+    dt = M.axial_dt(N, c, "rk4")
+    states = []
+    for chunked in (False, True):
+        s, pt, _ = M.build_moordyn(0.25, N, c, dt, "rk4", str(tmp_path), "matched")
+        with M.quiet_stdout():
+            if chunked:
+                M.advance(s, dt, 450, 100)
+            else:
+                for n in range(450):
+                    moordyn.Step(s, [], [], n * dt, dt)
+        states.append(np.array(list(moordyn.GetPointPos(pt)) + list(moordyn.GetPointVel(pt))))
+        moordyn.Close(s)
+    x0, y0, _, _ = _load(ROOT / "benchmarks" / "peers" / "elastic_common.py").start_state(0.25, N, c, "matched")
+    assert np.abs(states[1] - states[0]).max() < 1e-12
+    assert np.hypot(states[0][0] - x0[0], -states[0][2] - y0[0]) > 0.1
+
+
+@needs_moordyn
 def test_moordyn_quick_run(tmp_path):
     """--quick (N = 20, c = 30; seconds, no timing asserted): MoorDyn's RK2 peak speed agrees with
     this project's reference (tol 1e-9) within 5e-3 (measured 7.5e-4 at dt = h/(8 c); the undamped line's grid-scale ringing makes the peak itself uncertain to about 1e-3

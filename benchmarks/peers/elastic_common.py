@@ -170,13 +170,15 @@ class Result:
     start: str = "stretched"
     agree_v: float = float("nan")  # (a reference) |v at REF_TOL / v at REF_LOOSE * REF_TOL - 1|
     agree_sigma: float = float("nan")
+    cpu_runs: tuple = ()  # every timing of the run (``cpu`` is their least: repeats, elastic_table.py)
 
 
 def run_project(chi: float, N: int, c: float, tol: float, method: str = "radau", start: str = "stretched") -> Result:
     from snapping.simulate.elastic import solve
 
+    p, el, ini = problem(chi, N), elastic(c), start_state(chi, N, c, start)  # the given data: not timed
     w = time.process_time()
-    r = solve(problem(chi, N), elastic(c), tol=tol, method=method, initial=start_state(chi, N, c, start))
+    r = solve(p, el, tol=tol, method=method, initial=ini)
     w = time.process_time() - w
     a = r.dataset.attrs
     pk = r.peaks

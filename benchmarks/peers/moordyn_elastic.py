@@ -25,7 +25,8 @@ or ``rk4``, ...), one ``Step`` call per step (the step ``dtM`` in the input file
 sampling the free point's speed and the line's largest tension (``GetLineMaxTen``) after
 every step; peaks: the vertex of the parabola through the three samples around the largest,
 up to the reference's end (this project's stop at the snap). The per-step
-sampling costs Python calls (about a third of MoorDyn's own time at N = 100).
+sampling costs Python calls (27% of the sampled run at N = 100, RK4): :func:`stepping_cpu`
+times MoorDyn's stepping alone, what ``elastic_table.py`` compares.
 
 Usage::
 
@@ -43,7 +44,6 @@ import argparse
 import contextlib
 import math
 import os
-import struct
 import sys
 import tempfile
 import time
@@ -174,6 +174,7 @@ def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_
     n_max = int(math.ceil((3.0 if t_end is None else t_end) / dt - 1e-9))
     v = np.empty(n_max)
     T = np.empty(n_max)
+    E.start_state(chi, N, c, start)  # the given data (cached): not timed
     with tempfile.TemporaryDirectory() as d, quiet_stdout():
         w = time.process_time()
         s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
@@ -202,9 +203,70 @@ def run_moordyn(chi: float, N: int, c: float, dt: float, scheme: str = "rk2", t_
     return E.Result("MoorDyn", N, c, f"{scheme} dt={dt:.3g}", n, w, vp, tp, sp_, ts, start=start)
 
 
+def advance(s, dt: float, n_steps: int, chunk: int) -> None:
+    """``n_steps`` steps of ``dt`` of the MoorDyn system ``s`` from t = 0, ``chunk`` steps a
+    ``Step`` call (MoorDyn divides a call's interval into its steps of ``dtM = dt``)."""
+    import moordyn
+
+    n, t = 0, 0.0
+    while n < n_steps:
+        m = min(chunk, n_steps - n)
+        moordyn.Step(s, [], [], t, m * dt)
+        n += m
+        t = n * dt
+
+
+def stepping_cpu(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: int, start: str = "stretched",
+                 repeats: int = 1) -> list:
+    """CPU seconds of MoorDyn's own work for ``n_steps`` steps of ``dt`` (``repeats`` runs): the
+    same build as :func:`run_moordyn` (input file, ``Init_NoIC``, the start loaded), then
+    ``Step`` called for ``CHUNK`` steps at a time (MoorDyn divides a call's interval into its
+    ``dtM`` steps: the same states as one call a step, to round-off), with nothing sampled
+    between the calls. :func:`run_moordyn`'s time also holds the Python calls that sample the
+    peaks after every step (27% of it at N = 100, RK4 at h/c): this is MoorDyn's cost without them."""
+    import moordyn
+
+    E.start_state(chi, N, c, start)  # the given data (cached): not timed
+    out = []
+    for _ in range(repeats):
+        with tempfile.TemporaryDirectory() as d, quiet_stdout():
+            w = time.process_time()
+            s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
+            advance(s, dt, n_steps, CHUNK)
+            out.append(time.process_time() - w)
+            moordyn.Close(s)
+    return out
+
+
+def chunk_check(chi: float, N: int, c: float, dt: float, scheme: str, n_steps: int, start: str = "stretched") -> float:
+    """Largest difference of the free point's position and velocity after ``n_steps`` steps taken
+    one ``Step`` call a step and ``CHUNK`` steps a call (:func:`stepping_cpu`): round-off when
+    MoorDyn divides a call's interval into the same steps."""
+    import moordyn
+
+    out = []
+    for k in (1, CHUNK):
+        with tempfile.TemporaryDirectory() as d, quiet_stdout():
+            s, pt, ln = build_moordyn(chi, N, c, dt, scheme, d, start)
+            advance(s, dt, n_steps, k)
+            out.append(np.array(list(moordyn.GetPointPos(pt)) + list(moordyn.GetPointVel(pt))))
+            moordyn.Close(s)
+    return float(np.abs(out[0] - out[1]).max())
+
+
+#: steps a ``Step`` call of :func:`stepping_cpu` (MoorDyn subdivides the call's interval into them)
+CHUNK = 1000
+
+
 def axial_dt(N: int, c: float, scheme: str = "rk2") -> float:
-    """The first step of the ladder: AXIAL_SAFETY h/c (RK2), twice that for RK4 (stable to 1.39 h/c)."""
-    return AXIAL_SAFETY * (2.0 if scheme.lower() == "rk4" else 1.0) / (N * c)
+    """The first step of the ladder: AXIAL_SAFETY h/c for RK2, RK4_FIRST h/c for RK4 (its stability
+    limit on the line's fastest mode, omega = 2 c/h, is 2.83/omega = 1.41 h/c)."""
+    return (RK4_FIRST if scheme.lower() == "rk4" else AXIAL_SAFETY) / (N * c)
+
+
+#: RK4's first step in units of h/c (0.5 before branch peers3: RK4 was already within 1e-6 of the
+#: matched start's peak there, so its ladder started finer than the accuracy needed)
+RK4_FIRST = 1.0
 
 
 def compare(chi, N, c, dts, scheme, method, budget, tols=E.PROJECT_TOLS, project_budget=300.0, with_ref=True,
