@@ -13,14 +13,16 @@ the ideal chain and variants that switch one ingredient at a time:
 * ``damp-only``: the grid damping alone (bending 0);
 * ``bent-z0.5`` / ``bent-z2``: the grid damping ratio halved / doubled;
 * ``ideal-late`` / ``bent-late``: as ``ideal`` / ``bent``, run on after the snap until v_max falls to
-  ``LATE_STOP`` of its peak or to t = ``LATE_END`` (is the peak the stop rule's?).
+  ``LATE_STOP`` of its peak or to t = ``LATE_END`` (is the peak the stop rule's?);
+* ``tipX`` / ``outX``: bending (and its grid damping) only on the nodes within arclength X of the
+  free end / only beyond it, released from the catenary (where along the line does bending act?).
 
 Each run's diagnostics (``row``): its peaks, cost (evaluations, CPU by ``time.process_time``), the
 energy balance (max over the run of |E + dissipated - E0|, E = kinetic + gravity + bending, and the
 recorded energy at the peak against kinetic + gravity recomputed here from the peak profile), where
 the kinetic energy sits at the peak (fractions within arclength r of the free end, the length
 holding half of it), the bending energy (its maximum, when, its value at the peak), the fold (the
-curvature maximum's growth exponent ``kappa_max ~ (t* - t)^-p`` over t* - t in [1e-4, 1e-2], and the
+curvature maximum's growth exponent ``kappa_max ~ (t* - t)^-p`` over t* - t in [1e-3, 1e-2] and [1e-4, 1e-3], the
 paper's regularisation length: the first time the fold's distance from the free end falls to its
 quarter circle pi / (2 kappa_max), delta_kappa, with the estimate v_delta = sqrt(6 P / delta), P the
 energy released), and the bending length l_B = sqrt(beta / sigma_max) there against the fold radius.
@@ -49,15 +51,18 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "results", "bending_rise.json")
-VARIANTS = ("ideal", "bent", "bent-cat", "ideal-rest", "damp-only", "bent-z0.5", "bent-z2", "ideal-late", "bent-late")
+VARIANTS = ("ideal", "bent", "bent-cat", "ideal-rest", "damp-only", "bent-z0.5", "bent-z2", "ideal-late", "bent-late",
+            "tip0.01", "out0.01", "tip0.001", "out0.001")
 #: the '-late' variants: run on until v_max falls to LATE_STOP of its peak (the study's 0.5) or to t = LATE_END
 LATE_STOP, LATE_END = 0.1, 1.3
 #: the bent runs' RODAS4 tolerance (the study's 1e-7 moves the peaks by < 1e-5 relative at these levels,
 #: bench_bendconv's measurement) and the ideal's DOP853 tolerance (the study's)
 TOL_BENT, TOL_IDEAL = 1e-6, 1e-7
 RADII = (1e-5, 3e-5, 1e-4, 3e-4, 1e-3, 1e-2)
-#: the window of the curvature exponent fit, t* - t
-FIT = (1e-4, 1e-2)
+#: the tip diagnostics' window (t* - t) and the reach of the tip's turning (arclength from the free end)
+TIP_WINDOW, TIP_R = 1e-3, 1e-3
+#: the windows of the curvature exponent fits, t* - t
+FITS = ((1e-3, 1e-2), (1e-4, 1e-3))
 
 
 def level(k: int) -> dict:
@@ -88,29 +93,91 @@ def problems(chi: float, beta: float, k: int, variant: str):
         return Problem.catenary(chi, links=links, chords="exact", body=body, start="catenary"), "rodas4", TOL_BENT
     if variant == "damp-only":
         return Problem.catenary(chi, links=links, chords="exact", body=Body(damping=eta)), "rodas4", TOL_BENT
+    if variant[:3] in ("tip", "out") and variant[3:].replace(".", "", 1).replace("e-", "", 1).isdigit():
+        r = np.concatenate([[0.0], np.cumsum(h)])  # each node's distance from the free end (index 0)
+        on = (r <= float(variant[3:])) if variant.startswith("tip") else (r > float(variant[3:]))
+        body = Body(bending=np.where(on, beta, 0.0), damping=np.where(on, eta, 0.0))
+        return Problem.catenary(chi, links=links, chords="exact", body=body, start="catenary"), "rodas4", TOL_BENT
+    if variant.startswith("band"):
+        lo, hi = (float(x) for x in variant[4:].split("-", 1))
+        r = np.concatenate([[0.0], np.cumsum(h)])
+        on = (r > lo) & (r <= hi)
+        body = Body(bending=np.where(on, beta, 0.0), damping=np.where(on, eta, 0.0))
+        return Problem.catenary(chi, links=links, chords="exact", body=body, start="catenary"), "rodas4", TOL_BENT
     if variant in ("bent-z0.5", "bent-z2"):
         return cell_problem(chi, "bending", beta, level(k), damping=zeta), "rodas4", TOL_BENT
-    raise SystemExit(f"unknown variant {variant!r}: one of {VARIANTS}")
+    raise SystemExit(f"unknown variant {variant!r}: one of {', '.join(VARIANTS)}, tipX, outX, bandA-B, ib@T, bi@T")
+
+
+def switched(chi: float, beta: float, k: int, variant: str):
+    """``ib@T``: the ideal chain from the catenary to t = T, then the bent line (bending and its grid
+    damping switched on) from that state; ``bi@T``: the bent line from the catenary (``bent-cat``) to T,
+    then the ideal chain. Returns the second run's problem, method, tolerance, the first run's end time
+    and its evaluations and CPU seconds."""
+    from snapping.simulate import Problem, run
+
+    first, T = ("ideal" if variant.startswith("ib") else "bent-cat"), float(variant.split("@")[1])
+    p1, m1, tol1 = problems(chi, beta, k, first)
+    cpu = time.process_time()
+    d1 = run(p1, method=m1, tol=tol1, t_end=T, progress=False).dataset
+    cpu = time.process_time() - cpu
+    kinds = [str(x) for x in d1.snapshot_kind.values]
+    s = d1.isel(snapshot=kinds.index("final"))
+    pb, mb, tolb = problems(chi, beta, k, "bent-cat")
+    body = pb.body if variant.startswith("ib") else None
+    p2 = Problem.nodes(s.x.values, s.y.values, links=pb.links, vx=s.vx.values, vy=s.vy.values,
+                       name=f"{first} at t = {float(s.t_snapshot):.6g}", body=body)
+    if body is None:
+        m2, tol2 = "fast", TOL_IDEAL
+    else:
+        m2, tol2 = mb, tolb
+    return p2, m2, tol2, float(s.t_snapshot), int(d1.attrs["n_rhs"]), cpu, float(d1.attrs["energy_initial"])
+
+
+def energy_check(ds, beta) -> float:
+    """The recorded energy against kinetic + gravity + bending recomputed here from every snapshot taken
+    at a step's time (the peak's may lie between steps): the largest difference. Gravity is zero for the
+    line hanging straight down at rest; bending ``sum beta phi_j^2 / (2 (h_j + h_j+1)/2)`` over the
+    joints (phi the turning angle), the schema's formula, written out again here."""
+    m, h = ds.node_mass.values, ds.link_length.values
+    r = np.concatenate([[0.0], np.cumsum(h)])  # distance of each node from the free end (index 0)
+    worst = 0.0
+    for j in range(ds.sizes["snapshot"]):
+        s = ds.isel(snapshot=j)
+        i = int(np.argmin(np.abs(ds.t.values - float(s.t_snapshot))))
+        if ds.t.values[i] != float(s.t_snapshot):
+            continue
+        x, y = s.x.values, s.y.values
+        K = 0.5 * float(np.sum(m * (s.vx.values ** 2 + s.vy.values ** 2)))
+        U = -float(np.sum(m * y)) + float(np.sum(m * (r[-1] - r)))  # y downward; hanging: depth L - r
+        phi = np.diff(np.unwrap(np.arctan2(np.diff(y), np.diff(x))))
+        Eb = float(np.sum(beta * phi ** 2 / (h[:-1] + h[1:])))
+        worst = max(worst, abs(K + U + Eb - float(ds.energy.values[i])))
+    return worst
 
 
 def peak_profile(ds) -> dict:
-    """Where the kinetic energy sits at the peak (the snapshot of kind 'peak'), and the energy there
-    recomputed from the profile: kinetic + gravity (zero for the line hanging straight down at rest)."""
+    """The speed budget at the peak (the snapshot of kind 'peak'): the fast tip piece, out to
+    ``r_half`` from the free end where the speed first falls to half the peak, holds the kinetic energy
+    K_half in the mass m_half, and v_peak^2 = (2 K_half / m_half) / shape exactly, shape = the piece's
+    mass-weighted mean of (v / v_peak)^2. So bent / ideal, v_peak^2 ratio = energy ratio x (1 / mass
+    ratio) x (1 / shape ratio). Also the kinetic energy within fixed distances of the free end."""
     m, h = ds.node_mass.values, ds.link_length.values
-    r = np.concatenate([[0.0], np.cumsum(h)])  # distance of each node from the free end (index 0)
+    r = np.concatenate([[0.0], np.cumsum(h)])
     kinds = [str(x) for x in ds.snapshot_kind.values]
     s = ds.isel(snapshot=kinds.index("peak"))
-    ke = 0.5 * m * (s.vx.values ** 2 + s.vy.values ** 2)
+    v = np.hypot(s.vx.values, s.vy.values)
+    ke = 0.5 * m * v ** 2
     K = float(ke.sum())
-    ck = np.cumsum(ke)
-    # gravity: y downward; hanging straight down from the pin, node j sits at depth L - r_j
-    U = -float(np.sum(m * s.y.values)) + float(np.sum(m * (r[-1] - r)))
-    t = float(s.t_snapshot)
-    i = int(np.argmin(np.abs(ds.t.values - t)))
-    rec = float(ds.energy.values[i]) - (float(ds.bending_energy.values[i]) if "bending_energy" in ds else 0.0)
+    vp = float(v.max())
+    n = int(np.argmax(v < 0.5 * vp))  # the first node (from the free end) below half the peak speed
+    kh, mh = float(ke[:n].sum()), float(m[:n].sum())
+    kap = np.abs(s.curvature.values)
+    j = int(np.nanargmax(kap))
     return {"K": K, "K_within": {f"{x:g}": float(ke[r <= x].sum()) for x in RADII},
-            "l50": float(r[np.searchsorted(ck, 0.5 * K)]), "l90": float(r[np.searchsorted(ck, 0.9 * K)]),
-            "energy_check": abs(K + U - rec), "t_peak_snapshot": t}
+            "l50": float(r[np.searchsorted(np.cumsum(ke), 0.5 * K)]), "v_tip": float(v[0]), "v_max": vp,
+            "r_half": float(r[n]), "n_half": n, "K_half": kh, "m_half": mh, "shape": 2.0 * kh / mh / vp ** 2,
+            "kappa": float(kap[j]), "r_kappa": float(r[j]), "t": float(s.t_snapshot)}
 
 
 def fold(ds, beta: float) -> dict:
@@ -122,8 +189,10 @@ def fold(ds, beta: float) -> dict:
     dist = 1.0 - ds.s_kappa_max.values
     ts = float(ds.attrs["t_snap_v"])
     P = float(ds.attrs["energy_initial"])
-    w = (ts - t >= FIT[0]) & (ts - t <= FIT[1])
-    p = -float(np.polyfit(np.log(ts - t[w]), np.log(km[w]), 1)[0])
+    p = []
+    for lo, hi in FITS:
+        w = (ts - t >= lo) & (ts - t <= hi)
+        p.append(-float(np.polyfit(np.log(ts - t[w]), np.log(km[w]), 1)[0]) if w.sum() > 3 else float("nan"))
     hit = np.flatnonzero(dist <= 0.5 * math.pi / km)
     before = t <= ts
     h0 = float(ds.link_length.values[0])
@@ -140,17 +209,50 @@ def fold(ds, beta: float) -> dict:
     return out
 
 
-def history(ds, n: int = 160) -> dict:
-    """The step record thinned to ~n steps log-spaced in t* - t (for the figure)."""
+def history(ds, n: int = 120) -> dict:
+    """The step record thinned to ~n steps log-spaced in t* - t (for the figure), 4 digits."""
     t = ds.t.values
     ts = float(ds.attrs["t_snap_v"])
     want = ts - np.logspace(-0.5, -7.0, n)
     i = np.unique(np.clip(np.searchsorted(t, want), 0, t.size - 1))
-    return {"tstar_minus_t": (ts - t[i]).tolist(), "kappa_max": ds.kappa_max.values[i].tolist(),
-            "v_max": ds.v_max.values[i].tolist(), "dist": (1.0 - ds.s_kappa_max.values[i]).tolist()}
+    i = i[t[i] <= ts]
+
+    def r4(a):
+        return [float(f"{x:.4g}") for x in a]
+    return {"tstar_minus_t": r4(ts - t[i]), "kappa_max": r4(ds.kappa_max.values[i]), "v_max": r4(ds.v_max.values[i]),
+            "v_end": r4(ds.v_end.values[i]), "dist": r4(1.0 - ds.s_kappa_max.values[i])}
 
 
-def diagnose(ds, beta: float) -> dict:
+def tip(ds) -> dict:
+    """Is there a loop at the free end before the peak? From the step record over the final approach
+    (t* - t <= TIP_WINDOW, to the peak): the free end's speed against the line's maximum (1: the free
+    end is the fastest point throughout), the largest fall of the free end's speed below its running
+    maximum (over v_peak), and the time fraction with the fastest point not at the free end. From the
+    snapshots before the peak: the largest total turning sum |phi| of the line within TIP_R of the free
+    end (pi: a fold; more than 2 pi: a loop)."""
+    t, ve, vm = ds.t.values, ds.v_end.values, ds.v_max.values
+    i = int(np.argmax(vm))
+    ts = t[i]
+    w = np.flatnonzero((ts - t <= TIP_WINDOW) & (t <= ts))
+    run_max = np.maximum.accumulate(ve[w])
+    dt = np.diff(t[w], append=t[w][-1])
+    inside = ds.s_v_max.values[w] < 1.0 - 1e-9
+    h = ds.link_length.values
+    r = np.concatenate([[0.0], np.cumsum(h)])
+    turn = 0.0
+    for j in range(ds.sizes["snapshot"]):
+        s = ds.isel(snapshot=j)
+        if float(s.t_snapshot) > ts:
+            continue
+        phi = np.diff(np.unwrap(np.arctan2(np.diff(s.y.values), np.diff(s.x.values))))
+        turn = max(turn, float(np.abs(phi[r[1:-1] <= TIP_R]).sum()))
+    return {"v_end_over_v_max_min": float((ve[w] / vm[w]).min()), "v_end_dip": float((run_max - ve[w]).max() / vm[i]),
+            "inside_fraction": float(dt[inside].sum() / max(dt.sum(), 1e-300)), "tip_turning_max": turn}
+
+
+def diagnose(ds, beta) -> dict:
+    """All diagnostics of one run; ``beta``: the bending stiffness per node (N + 1, free end first) or 0."""
+    beta = np.broadcast_to(np.asarray(beta, dtype=float), ds.node_mass.shape)
     a = ds.attrs
     E, E0 = ds.energy.values, float(a["energy_initial"])
     D = ds.dissipated.values if "dissipated" in ds else np.zeros_like(E)
@@ -167,8 +269,10 @@ def diagnose(ds, beta: float) -> dict:
         row.update({"Eb_start": float(Eb[0]), "Eb_max": float(Eb[j]), "t_Eb_max": float(ds.t.values[j]),
                     "Eb_at_peak": float(Eb[i])})
     row["peak"] = peak_profile(ds)
-    row["fold"] = fold(ds, beta)
+    row["energy_check"] = energy_check(ds, beta[1:-1])  # the joints: the interior nodes
+    row["fold"] = fold(ds, float(beta.max()))
     row["history"] = history(ds)
+    row["tip"] = tip(ds)
     return row
 
 
@@ -187,7 +291,11 @@ def run_one(chi, beta, k, variant, path):
     kk = key(chi, beta, k, variant)
     if kk in db:
         return db[kk]
-    prob, method, tol = problems(chi, beta, k, variant)
+    off, rhs0, cpu0, e0 = 0.0, 0, 0.0, None
+    if "@" in variant:
+        prob, method, tol, off, rhs0, cpu0, e0 = switched(chi, beta, k, variant)
+    else:
+        prob, method, tol = problems(chi, beta, k, variant)
     cpu = time.process_time()
     late = variant.endswith("-late")
     ds = run(prob, method=method, tol=tol, stop_fraction=LATE_STOP if late else 0.5,
@@ -195,8 +303,11 @@ def run_one(chi, beta, k, variant, path):
     cpu = time.process_time() - cpu
     if ds.attrs.get("status") != "completed" or not (late or int(ds.attrs.get("snap_reached", 0))):
         raise RuntimeError(f"{kk}: {ds.attrs.get('status')} {ds.attrs.get('stop_reason')}")
-    row = diagnose(ds, beta if variant.startswith("bent") else 0.0)
-    row["cpu"] = cpu
+    row = diagnose(ds, prob.body.node_values("bending", prob.links.h) if prob.body is not None else 0.0)
+    row["cpu"] = cpu + cpu0
+    if "@" in variant:  # the second run's clock starts at the switch
+        row.update({"t_switch": off, "t_snap_v": row["t_snap_v"] + off, "t_final": row["t_final"] + off,
+                    "n_rhs": row["n_rhs"] + rhs0, "energy_at_switch": row["energy_initial"], "energy_initial": e0})
     row["load"] = os.getloadavg()[0]
     db = load(path)
     db[kk] = row
@@ -208,93 +319,170 @@ def run_one(chi, beta, k, variant, path):
     return row
 
 
+def _nan(d, k):
+    return d.get(k, float("nan"))
+
+
 def table(path):
     db = load(path)
     print(f"machine: {platform.node()} {platform.machine()} {os.cpu_count()} cpus; CPU seconds by time.process_time "
-          f"(includes the first run's compilation)")
+          f"(the machine shared; the first run's includes loading the compiled kernels)")
     cells = sorted({tuple(x.split()[:3]) for x in db}, key=lambda c: (float(c[0]), float(c[1]), int(c[2])))
     for c in cells:
         chi, beta, k = float(c[0]), float(c[1]), int(c[2])
-        rows = {v: db[key(chi, beta, k, v)] for v in VARIANTS if key(chi, beta, k, v) in db}
+        got = [x.split()[3] for x in db if tuple(x.split()[:3]) == c]
+        order = [v for v in VARIANTS if v in got] + sorted(v for v in got if v not in VARIANTS)
+        rows = {v: db[key(chi, beta, k, v)] for v in order}
         ide = rows.get("ideal")
         n = next(iter(rows.values()))["N"]
-        print(f"\nchi={chi:g} beta={beta:g} level k={k} (frac {level(k)['frac']:g}), N={n} links, all variants "
-              f"on these links")
-        print(f"  {'variant':10} {'v_peak':>8} {'ratio':>6} {'t*':>10} {'closure':>8} {'E chk':>7} {'diss@pk':>8} "
-              f"{'Eb max':>8} {'K<1e-4':>6} {'K<1e-3':>6} {'l50':>8} {'p_kappa':>7} {'k(1e-3)':>7} {'k(1e-4)':>7} "
-              f"{'delta':>8} {'v_delta':>7} {'R/l_B':>6} {'d_min/h':>7} {'t_final':>9} {'rhs':>7} {'cpu s':>6}")
+        print(f"\nchi={chi:g} beta={beta:g} level k={k} (frac {level(k)['frac']:g}), N={n} links (every variant on "
+              f"these links); ratio: v_peak over the ideal's")
+        print(f"  {'variant':10} {'v_peak':>7} {'ratio':>6} {'t*':>10} {'closure':>7} {'E chk':>7} {'diss@pk':>7} "
+              f"{'Eb max':>7} {'Eb@pk':>7} {'p(-2,-3)':>8} {'p(-3,-4)':>8} {'k(1e-3)':>7} {'k(1e-4)':>7} {'delta':>8} "
+              f"{'v_delta':>7} {'R/l_B':>5} {'t_final':>9} {'rhs':>6} {'cpu s':>5}")
         for v, r in rows.items():
-            pk, fo = r["peak"], r["fold"]
+            fo = r["fold"]
             ratio = r["v_peak"] / ide["v_peak"] if ide else float("nan")
             rlb = fo["fold_radius"] / fo["l_B_at_delta"] if "l_B_at_delta" in fo else float("nan")
-            print(f"  {v:10} {r['v_peak']:8.4g} {ratio:6.3f} {r['t_snap_v']:10.7f} {r['closure']:8.1e} "
-                  f"{pk['energy_check']:7.0e} {r['dissipated_at_peak']:8.1e} {r.get('Eb_max', 0.0):8.1e} "
-                  f"{pk['K_within']['0.0001'] / pk['K']:6.3f} {pk['K_within']['0.001'] / pk['K']:6.3f} "
-                  f"{pk['l50']:8.2e} {fo['kappa_exponent']:7.3f} {fo['kappa_at']['0.001']:7.0f} "
-                  f"{fo['kappa_at']['0.0001']:7.0f} {fo.get('delta', float('nan')):8.2e} "
-                  f"{fo.get('v_delta', float('nan')):7.4g} {rlb:6.1f} {fo['dist_min_links']:7.1f} {r['t_final']:9.6f} "
-                  f"{r['n_rhs']:7d} {r['cpu']:6.1f}")
+            print(f"  {v:10} {r['v_peak']:7.4g} {ratio:6.3f} {r['t_snap_v']:10.7f} {r['closure']:7.0e} "
+                  f"{r['energy_check']:7.0e} {r['dissipated_at_peak']:7.1e} {r.get('Eb_max', 0.0):7.1e} "
+                  f"{r.get('Eb_at_peak', 0.0):7.1e} {fo['kappa_exponent'][0]:8.3f} {fo['kappa_exponent'][1]:8.3f} "
+                  f"{fo['kappa_at']['0.001']:7.0f} {fo['kappa_at']['0.0001']:7.0f} {_nan(fo, 'delta'):8.2e} "
+                  f"{_nan(fo, 'v_delta'):7.4g} {rlb:5.1f} {r['t_final']:9.6f} {r['n_rhs']:6d} {r['cpu']:5.1f}")
+        if not ide:
+            continue
+        pi = ide["peak"]
+        print("  speed budget at the peak, v_peak^2 = (2 K_half / m_half) / shape over the piece out to r_half (speed "
+              "> v_peak / 2); factors of v_peak over the ideal's: energy sqrt(K_half / K_half_ideal), length "
+              "sqrt(m_half_ideal / m_half), shape sqrt(shape_ideal / shape); kinetic energy within r of the free end "
+              f"(fraction of all); the tip over t* - t <= {TIP_WINDOW:g}: ve/vm min of v_end / v_max, dip the largest "
+              f"fall of v_end below its running maximum (/ v_peak), inside the time fraction with the fastest point "
+              f"not at the free end, turn the largest total turning within {TIP_R:g} of the free end (> 2 pi: a loop)")
+        print(f"  {'variant':10} {'r_half':>8} {'links':>5} {'K_half':>7} {'shape':>6} {'energy':>6} {'length':>6} "
+              f"{'shape':>6} {'product':>7} " + " ".join(f"{'K<' + format(x, 'g'):>7}" for x in RADII)
+              + f" {'kappa@pk':>8} {'at r':>8} {'ve/vm':>6} {'dip':>6} {'inside':>6} {'turn':>6}")
+        for v, r in rows.items():
+            pk = r["peak"]
+            fe, fl = math.sqrt(pk["K_half"] / pi["K_half"]), math.sqrt(pi["m_half"] / pk["m_half"])
+            fs = math.sqrt(pi["shape"] / pk["shape"])
+            print(f"  {v:10} {pk['r_half']:8.2e} {pk['n_half']:5d} {pk['K_half']:7.4f} {pk['shape']:6.3f} {fe:6.3f} "
+                  f"{fl:6.3f} {fs:6.3f} {fe * fl * fs:7.3f} "
+                  + " ".join(f"{pk['K_within'][format(x, 'g')] / pk['K']:7.3f}" for x in RADII)
+                  + f" {pk['kappa']:8.0f} {pk['r_kappa']:8.1e} {r['tip']['v_end_over_v_max_min']:6.3f} "
+                  f"{r['tip']['v_end_dip']:6.3f} {r['tip']['inside_fraction']:6.3f} {r['tip']['tip_turning_max']:6.2f}")
         b = rows.get("bent")
-        if ide and b:
-            pb, pi = b["peak"], ide["peak"]
-            vr = b["v_peak"] / ide["v_peak"]
-            dr = b["fold"].get("v_delta", float("nan")) / ide["fold"].get("v_delta", float("nan"))
-            print(f"  bent / ideal: v_peak x{vr:.3f}; the fold's estimate sqrt(delta_ideal/delta_bent) x{dr:.3f}; "
-                  f"delta {b['fold'].get('delta', float('nan')):.2e} against {ide['fold'].get('delta', float('nan')):.2e}"
-                  f" (t* - t there {b['fold'].get('tstar_minus_t_delta', float('nan')):.1e} against "
-                  f"{ide['fold'].get('tstar_minus_t_delta', float('nan')):.1e}); t* earlier by "
-                  f"{ide['t_snap_v'] - b['t_snap_v']:.2e}")
-            for x in ("0.0001", "0.0003", "0.001"):
-                ex = pb["K_within"][x] - pi["K_within"][x]
-                print(f"  kinetic energy within {float(x):g} of the free end at the peak: bent {pb['K_within'][x]:.4f}, "
-                      f"ideal {pi['K_within'][x]:.4f} (excess {ex:+.4f} = {ex / b['Eb_max']:+.1f} x the bent "
-                      f"line's largest bending energy {b['Eb_max']:.2e})")
-            print(f"  kinetic energy at the peak: bent {pb['K']:.4f}, ideal {pi['K']:.4f}; released P: bent "
-                  f"{b['energy_initial']:.5f}, ideal {ide['energy_initial']:.5f}; dissipated by the grid damping to "
-                  f"the peak {b['dissipated_at_peak']:.2e}")
+        if b:
+            pb = b["peak"]
+            print(f"  bent / ideal: v_peak x{b['v_peak'] / ide['v_peak']:.3f}; the paper's estimate from the fold, "
+                  f"sqrt(delta_ideal / delta_bent), x{_nan(b['fold'], 'v_delta') / _nan(ide['fold'], 'v_delta'):.3f} "
+                  f"(delta {_nan(b['fold'], 'delta'):.2e} against {_nan(ide['fold'], 'delta'):.2e}); t* earlier by "
+                  f"{ide['t_snap_v'] - b['t_snap_v']:.2e}; the fast piece's kinetic energy {pb['K_half']:.4f} against "
+                  f"the ideal's {pi['K_half']:.4f}: excess {pb['K_half'] - pi['K_half']:+.4f}, the bent line's "
+                  f"largest bending energy {b['Eb_max']:.2e}; kinetic energy at the peak {pb['K']:.4f} against "
+                  f"{pi['K']:.4f} (released P {b['energy_initial']:.5f}, {ide['energy_initial']:.5f}; dissipated "
+                  f"by the grid damping by the peak {b['dissipated_at_peak']:.1e})")
 
 
-def figure(path, out, cells):
+SHAPES = os.path.join(HERE, "results", "bending_rise_shapes.json")
+#: t* - t of the tip shapes drawn (besides the peak)
+SHAPE_TIMES = (1e-3, 2.5e-4, 1.2e-4, 6e-5, 3e-5, 1.5e-5, 5e-6)
+
+
+def tip_shapes(chi, beta, k, path, out=SHAPES, reach=1e-3):
+    """The line within ``reach`` of the free end at t* - SHAPE_TIMES and at the peak, ideal and bent (each run
+    again with these snapshots, its t* from ``path``), for the figure; kept in ``out``."""
+    from snapping.simulate import run
+
+    db, shp = load(path), load(out)
+    for v in ("ideal", "bent"):
+        kk = key(chi, beta, k, v)
+        if kk in shp or kk not in db:
+            continue
+        prob, method, tol = problems(chi, beta, k, v)
+        ts = db[kk]["t_snap_v"]
+        ds = run(prob, method=method, tol=tol, snapshot_times=[ts - x for x in SHAPE_TIMES], progress=False).dataset
+        if abs(float(ds.attrs["t_snap_v"]) - ts) > 1e-12:
+            raise RuntimeError(f"{kk}: the rerun's t* {ds.attrs['t_snap_v']!r} is not the stored {ts!r}")
+        r = np.concatenate([[0.0], np.cumsum(ds.link_length.values)])
+        sel = r <= reach
+        kinds = [str(x) for x in ds.snapshot_kind.values]
+        rows = []
+        for j, kind in enumerate(kinds):
+            if kind not in ("requested", "peak"):
+                continue
+            sn = ds.isel(snapshot=j)
+            x, y = sn.x.values[sel] - float(sn.x.values[0]), sn.y.values[sel] - float(sn.y.values[0])
+            rows.append({"tstar_minus_t": ts - float(sn.t_snapshot), "kind": kind,
+                         "v_end": float(np.hypot(sn.vx.values[0], sn.vy.values[0])),
+                         "x": [float(f"{q:.4g}") for q in x], "y": [float(f"{q:.4g}") for q in y]})
+        shp = load(out)
+        shp[kk] = rows
+        json.dump(shp, open(out, "w"))
+        print(f"tip shapes: {kk}", flush=True)
+    return load(out)
+
+
+def figure(path, out, cells, shape_cell):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     db = load(path)
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    styles = {"ideal": "-", "bent": "--"}
+    shp = tip_shapes(*shape_cell, path)
+    fig = plt.figure(figsize=(13, 8))
+    gs = fig.add_gridspec(2, 8, height_ratios=[1.25, 1])
+    ax = [fig.add_subplot(gs[0, 0:4]), fig.add_subplot(gs[0, 4:8])]
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ci, (chi, beta, k) in enumerate(cells):
-        for v, ls in styles.items():
+        for v, ls in (("ideal", "-"), ("bent", "--")):
             r = db.get(key(chi, beta, k, v))
             if r is None:
                 continue
             h = r["history"]
-            lab = f"chi={chi:g} k={k} " + ("ideal" if v == "ideal" else f"beta={beta:g}")
-            ax[0].loglog(h["tstar_minus_t"], h["kappa_max"], ls, color=colors[ci % len(colors)], label=lab)
-            ax[1].loglog(h["tstar_minus_t"], h["v_max"], ls, color=colors[ci % len(colors)], label=lab)
-            fo = r["fold"]
-            if "delta" in fo:
-                ax[0].plot(fo["tstar_minus_t_delta"], 0.5 * math.pi / fo["delta"], "o", color=colors[ci % len(colors)],
-                           mfc="none" if v == "ideal" else colors[ci % len(colors)])
-    ax[0].set_xlabel("t* - t")
-    ax[0].set_ylabel("kappa_max (o: fold meets its quarter circle, delta)")
-    ax[1].set_xlabel("t* - t")
-    ax[1].set_ylabel("v_max")
+            c = colors[ci % len(colors)]
+            lab = f"chi={chi:g}, {r['N']} links, " + ("ideal" if v == "ideal" else f"beta={beta:g}")
+            ax[0].loglog(h["tstar_minus_t"], h["kappa_max"], ls, color=c, label=lab)
+            ax[1].loglog(h["tstar_minus_t"], h["v_end"], ls, color=c, label=lab)
+    ax[0].set_ylabel("kappa_max (the fold's curvature)")
+    ax[1].set_ylabel("v_end (the free end's speed)")
     for a in ax:
-        a.invert_xaxis()
+        a.set_xlabel("t* - t (each run's own t*)")
+        a.set_xlim(0.3, 1e-6)
         a.grid(True, which="both", alpha=0.3)
     ax[0].legend(fontsize=7)
-    ax[0].set_title("the fold's curvature: bent (dashed) vs ideal (solid)", fontsize=9)
-    ax[1].set_title("maximum speed, same links", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    ax[0].set_title("bent (dashed) against ideal (solid), same links", fontsize=9)
+    ax[1].set_title("the bent line's free end slows, then cracks", fontsize=9)
+    ki, kb = key(*shape_cell, "ideal"), key(*shape_cell, "bent")
+    if ki in shp and kb in shp:
+        n = min(len(shp[ki]), len(shp[kb]), 8)
+        w = 4e-4
+        for j in range(n):
+            a = fig.add_subplot(gs[1, j])
+            for v, kk, lw, c in (("ideal", ki, 1.0, "0.5"), ("bent", kb, 1.6, colors[3])):
+                sn = shp[kk][j]
+                a.plot(sn["x"], sn["y"], "-", lw=lw, color=c)
+            a.plot(0, 0, "ko", ms=3)
+            a.set_xlim(-w, w)
+            a.set_ylim(w, -w)
+            a.set_aspect("equal")
+            a.tick_params(labelsize=5)
+            a.set_title(("peak" if shp[kb][j]["kind"] == "peak" else f"t*-t={shp[kb][j]['tstar_minus_t']:.2g}")
+                        + f"\nv_end {shp[ki][j]['v_end']:.3g} / {shp[kb][j]['v_end']:.3g}", fontsize=7)
+        fig.text(0.5, 0.005, f"the last {w:g} of the line about its free end (black dot), chi={shape_cell[0]:g}, "
+                 f"beta={shape_cell[1]:g}, level {shape_cell[2]}: grey ideal, red bent (v_end ideal / bent)", ha="center",
+                 fontsize=8)
+    fig.tight_layout(rect=(0, 0.02, 1, 1))
+    fig.savefig(out, dpi=100)
     print(f"figure: {out}")
 
 
 #: the default set: the rise's cell at two levels (the second resolves the bending length at the fold),
-#: every variant on the coarser; the other betas and the controls chi = 0.3 and 0.5
-DEFAULT = ([(0.1, 7.2e-8, 0, VARIANTS), (0.1, 7.2e-8, 2, ("ideal", "bent", "bent-cat")),
+#: every variant on the coarser, bending confined in space (tipX, outX) and in time (ib@T, bi@T); the
+#: other betas and the controls chi = 0.3 and 0.5
+LOCAL = ("tip0.01", "tip0.1", "out0.01", "out0.1", "out0.3", "bi@0.5", "ib@0.5", "bi@1.1", "ib@1.1")
+DEFAULT = ([(0.1, 7.2e-8, 0, VARIANTS + LOCAL),
+            (0.1, 7.2e-8, 2, ("ideal", "bent", "bent-cat", "damp-only", "tip0.1", "out0.3", "bi@0.5")),
             (0.1, 1e-8, 0, ("ideal", "bent")), (0.1, 5.18e-7, 0, ("ideal", "bent")),
             (0.1, 3.73e-6, 0, ("ideal", "bent")),
             (0.3, 5.18e-7, 0, ("ideal", "bent")), (0.5, 5.18e-7, 0, ("ideal", "bent"))])
@@ -305,7 +493,8 @@ def main(argv=None):
     ap.add_argument("--chi", type=float, nargs="*", default=[])
     ap.add_argument("--beta", type=float, nargs="*", default=[])
     ap.add_argument("--k", type=int, nargs="*", default=[], help="fold levels: frac = 0.04 * 2**-k (the study's)")
-    ap.add_argument("--variants", nargs="*", default=["ideal", "bent"], choices=VARIANTS)
+    ap.add_argument("--variants", nargs="*", default=["ideal", "bent"],
+                    help=f"of {', '.join(VARIANTS)}; tipX / outX for any X")
     ap.add_argument("--out", default=OUT)
     ap.add_argument("--table", action="store_true", help="only print what is done")
     ap.add_argument("--figure", default=None, help="draw the fold's curvature and v_max against t* - t")
@@ -318,7 +507,7 @@ def main(argv=None):
             run_one(chi, beta, k, v, a.out)
     table(a.out)
     if a.figure:
-        figure(a.out, a.figure, [(0.1, 7.2e-8, 0), (0.1, 7.2e-8, 2), (0.3, 5.18e-7, 0)])
+        figure(a.out, a.figure, [(0.1, 7.2e-8, 0), (0.1, 7.2e-8, 2), (0.3, 5.18e-7, 0)], (0.1, 7.2e-8, 2))
 
 
 if __name__ == "__main__":
