@@ -229,7 +229,7 @@ def tip(ds) -> dict:
     end is the fastest point throughout), the largest fall of the free end's speed below its running
     maximum (over v_peak), and the time fraction with the fastest point not at the free end. From the
     snapshots before the peak: the largest total turning sum |phi| of the line within TIP_R of the free
-    end (pi: a fold; more than 2 pi: a loop)."""
+    end (about pi: a fold; more: the line curls)."""
     t, ve, vm = ds.t.values, ds.v_end.values, ds.v_max.values
     i = int(np.argmax(vm))
     ts = t[i]
@@ -357,7 +357,7 @@ def table(path):
               "sqrt(m_half_ideal / m_half), shape sqrt(shape_ideal / shape); kinetic energy within r of the free end "
               f"(fraction of all); the tip over t* - t <= {TIP_WINDOW:g}: ve/vm min of v_end / v_max, dip the largest "
               f"fall of v_end below its running maximum (/ v_peak), inside the time fraction with the fastest point "
-              f"not at the free end, turn the largest total turning within {TIP_R:g} of the free end (> 2 pi: a loop)")
+              f"not at the free end, turn the largest total turning (rad) within {TIP_R:g} of the free end")
         print(f"  {'variant':10} {'r_half':>8} {'links':>5} {'K_half':>7} {'shape':>6} {'energy':>6} {'length':>6} "
               f"{'shape':>6} {'product':>7} " + " ".join(f"{'K<' + format(x, 'g'):>7}" for x in RADII)
               + f" {'kappa@pk':>8} {'at r':>8} {'ve/vm':>6} {'dip':>6} {'inside':>6} {'turn':>6}")
@@ -430,8 +430,8 @@ def figure(path, out, cells, shape_cell):
 
     db = load(path)
     shp = tip_shapes(*shape_cell, path)
-    fig = plt.figure(figsize=(13, 8))
-    gs = fig.add_gridspec(2, 8, height_ratios=[1.25, 1])
+    fig = plt.figure(figsize=(13, 7))
+    gs = fig.add_gridspec(2, 8, height_ratios=[1.6, 1])
     ax = [fig.add_subplot(gs[0, 0:4]), fig.add_subplot(gs[0, 4:8])]
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ci, (chi, beta, k) in enumerate(cells):
@@ -466,10 +466,11 @@ def figure(path, out, cells, shape_cell):
             a.set_xlim(-w, w)
             a.set_ylim(w, -w)
             a.set_aspect("equal")
-            a.tick_params(labelsize=5)
+            a.set_xticks([])
+            a.set_yticks([])
             a.set_title(("peak" if shp[kb][j]["kind"] == "peak" else f"t*-t={shp[kb][j]['tstar_minus_t']:.2g}")
                         + f"\nv_end {shp[ki][j]['v_end']:.3g} / {shp[kb][j]['v_end']:.3g}", fontsize=7)
-        fig.text(0.5, 0.005, f"the last {w:g} of the line about its free end (black dot), chi={shape_cell[0]:g}, "
+        fig.text(0.5, 0.005, f"the line near its free end (black dot; boxes {2 * w:g} wide), chi={shape_cell[0]:g}, "
                  f"beta={shape_cell[1]:g}, level {shape_cell[2]}: grey ideal, red bent (v_end ideal / bent)", ha="center",
                  fontsize=8)
     fig.tight_layout(rect=(0, 0.02, 1, 1))
