@@ -42,6 +42,7 @@ Usage::
     python benchmarks/bending_rise.py --table                          # what is done so far
     python benchmarks/bending_rise.py --chi 0.1 --beta 7.2e-8 --k 0 --variants ideal bent bent-cat
     python benchmarks/bending_rise.py --table --figure docs/guide/bending_rise.png
+    python benchmarks/bending_rise.py --fold-profile                   # the fold through the fall
 """
 
 from __future__ import annotations
@@ -484,6 +485,62 @@ def figure(path, out, cells, shape_cell):
     print(f"figure: {out}")
 
 
+FOLDS = os.path.join(HERE, "results", "bending_rise_folds.json")
+
+
+def fold_profiles(chi, beta, k, path, out=FOLDS, variants=("ideal", "bent-cat", "bent"), n=12):
+    """The fold through the fall, from snapshots at t = 0 and t_ideal* - t log-spaced from t* to 1e-4 (each variant
+    run again with them): the curvature maximum and where, the fold's turning Theta (the line's turning
+    from the free end out to three times the fold's distance), its width W (the arclength over which the
+    turning goes from 10% to 90% of Theta), the tension there, the bending length sqrt(beta / T) and
+    l_B kappa_max. Kept in ``out``; printed."""
+    from snapping.simulate import run
+
+    db, res = load(path), load(out)
+    ts = db[key(chi, beta, k, "ideal")]["t_snap_v"] if key(chi, beta, k, "ideal") in db else 1.1935
+    times = ts - np.logspace(math.log10(ts), -4, n + 1)[1:]
+    for v in variants:
+        kk = key(chi, beta, k, v)
+        if kk in res:
+            continue
+        prob, method, tol = problems(chi, beta, k, v)
+        cpu = time.process_time()
+        ds = run(prob, method=method, tol=tol, snapshot_times=times, progress=False).dataset
+        cpu = time.process_time() - cpu
+        h = ds.link_length.values
+        r = np.concatenate([[0.0], np.cumsum(h)])
+        rl = 0.5 * (r[:-1] + r[1:])  # link midpoints' distance from the free end
+        rows = []
+        for j, kind in enumerate(str(x) for x in ds.snapshot_kind.values):
+            if kind not in ("initial", "requested"):
+                continue
+            sn = ds.isel(snapshot=j)
+            th = np.unwrap(np.arctan2(np.diff(sn.y.values), np.diff(sn.x.values)))
+            kap = np.abs(sn.curvature.values)
+            i = int(np.nanargmax(kap))
+            turn = np.abs(th - th[0])
+            theta = float(turn[min(int(np.searchsorted(rl, min(3 * r[i], 0.9))), turn.size - 1)])
+            w = float(rl[np.argmax(turn >= 0.9 * theta)] - rl[np.argmax(turn >= 0.1 * theta)])
+            T = float(sn.tension.values[min(i, h.size - 1)])
+            lb = math.sqrt(beta / T) if T > 0 else float("nan")
+            rows.append({"t": float(sn.t_snapshot), "kappa": float(kap[i]), "r_kappa": float(r[i]), "theta": theta,
+                         "width": w, "T": T, "l_B": lb})
+        res = load(out)
+        res[kk] = {"rows": rows, "cpu": cpu, "n_rhs": int(ds.attrs["n_rhs"]), "N": int(ds.attrs["N"])}
+        json.dump(res, open(out, "w"), indent=1)
+    print(f"\nthe fold through the fall, chi={chi:g} beta={beta:g} level k={k}: kappa_max, its distance r from the free "
+          f"end, the fold's turning Theta and width W (10-90% of Theta), the tension T there, l_B = sqrt(beta/T)")
+    for v in variants:
+        e = res.get(key(chi, beta, k, v))
+        if e is None:
+            continue
+        print(f"  {v} ({e['N']} links, {e['n_rhs']} evaluations, {e['cpu']:.1f} s CPU)")
+        print(f"    {'t':>7} {'t*-t':>8} {'kappa':>8} {'r':>9} {'Theta':>6} {'W':>9} {'T':>7} {'l_B':>8} {'l_B kappa':>9}")
+        for q in e["rows"]:
+            print(f"    {q['t']:7.4f} {ts - q['t']:8.2e} {q['kappa']:8.1f} {q['r_kappa']:9.3e} {q['theta']:6.3f} "
+                  f"{q['width']:9.3e} {q['T']:7.3g} {q['l_B']:8.2e} {q['l_B'] * q['kappa']:9.3f}")
+
+
 #: the default set: the rise's cell at two levels (the second resolves the bending length at the fold),
 #: every variant on the coarser, bending confined in space (tipX, outX) and in time (ib@T, bi@T); the
 #: other betas and the controls chi = 0.3 and 0.5
@@ -504,9 +561,16 @@ def main(argv=None):
                     help=f"of {', '.join(VARIANTS)}; tipX / outX for any X")
     ap.add_argument("--out", default=OUT)
     ap.add_argument("--table", action="store_true", help="only print what is done")
-    ap.add_argument("--figure", default=None, help="draw the fold's curvature and v_max against t* - t")
+    ap.add_argument("--figure", default=None, help="draw the fold's curvature and v_end against t* - t, and the tip")
+    ap.add_argument("--fold-profile", action="store_true",
+                    help="the fold through the fall (ideal, bent-cat, bent) at chi=0.1 beta=7.2e-8 level 2, or at the "
+                         "one --chi, --beta, --k given")
     a = ap.parse_args(argv)
     os.makedirs(os.path.dirname(a.out), exist_ok=True)
+    if a.fold_profile:
+        cell = (a.chi[0], a.beta[0], a.k[0]) if a.chi else (0.1, 7.2e-8, 2)
+        fold_profiles(*cell, a.out)
+        return
     todo = [(c, b, k, tuple(a.variants)) for k in a.k for c in a.chi for b in a.beta] if a.chi else \
         ([] if a.table else DEFAULT)
     for chi, beta, k, vs in todo:
