@@ -16,8 +16,9 @@ bandwidth 5 and upper 4 factored by Gaussian elimination with partial pivoting
 (:func:`band_lu`, O(N); loops of fixed length, the reciprocal pivots kept for the
 solves), six stages (five new evaluations; a stage's solve is one fused pass for its right
 side and one forward and one column-wise back substitution), the error
-estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``),
-the new state, and on acceptance one evaluation there (the next step's ``f``). The
+estimate ``U_6`` in the max norm of DOP853 (``|U_6,i| / (tol (1 + max(|y_i|, |y_new,i|)))``; an
+angular velocity's scale floored at the roundoff of its estimate, :func:`omega_floor`), the new
+state, and on acceptance one evaluation there (the next step's ``f``). The
 continuous extension of order 3 (``rodas.f``'s CONTRO: ``y(t0 + s h) = (1 - s) y0 + s (y1 +
 (1 - s)(c2 + s c3))`` with ``c2, c3`` fixed combinations of ``U_1 .. U_5``) gives the state
 between steps at no cost (:func:`dense_eval`).
@@ -34,6 +35,7 @@ from . import forced as FR
 from . import general as G
 from . import models as MD
 from . import rk as R
+from . import stiff as ST
 from .stiff import RODAS4
 from . import stiff_system as SS
 
@@ -48,7 +50,7 @@ if NCOL != SS.NCOL:  # pragma: no cover - a guard for editors
 
 __all__ = ["band_lu", "band_solve", "assemble", "WROW", "rodas_step", "advance_rodas", "dense_eval", "jacobian_at",
            "NSTG",
-           "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3"]
+           "ERR_EXPONENT", "MAX_FACTOR", "D2", "D3", "omega_floor", "ROUND"]
 
 GAMMA = RODAS4["gamma"]
 C_NODE = np.array(RODAS4["c"])
@@ -63,8 +65,11 @@ for _i in range(6):
 #: the dense output's weights of U_1 .. U_5 (rodas.f, METH = 1: D21 .. D25, D31 .. D35)
 D2 = np.array([10.12623508344586, -7.487995877610167, -34.80091861555747, -7.992771707568823, 1.025137723295662])
 D3 = np.array([-0.6762803392801253, 6.087714651680015, 16.43084320892478, 24.76722511418386, -6.594389125716872])
-#: the unit roundoff of the error norm's floor (:func:`omega_floor`)
-ROUND = 2.0 * float(np.finfo(np.float64).eps)
+#: the unit roundoff of the error norm's floor (:func:`omega_floor`; twice the double's eps),
+#: written out here as NCOL is (numba bakes it into this module's cache)
+ROUND = 4.440892098500626e-16
+if ROUND != ST.ROUND:  # pragma: no cover - a guard for editors
+    raise ImportError("rosenbrock's ROUND differs from stiff's: update both")
 #: the step-size rule of an error estimate of order 3 (rodas.f: at most 6x larger)
 ERR_EXPONENT = -0.25
 MAX_FACTOR = 6.0
