@@ -284,8 +284,9 @@ def omega_floor(N, j, Dj, y, hl):
     (gamma h)^2) over h). The derivatives are the angle row's (``da_j/dx_l = -(dR_2j/dx_l)/h_j``,
     the tension coupling left out), from the step's Jacobian ``Dj``. It is ~eps |theta|
     sqrt(k), i.e. eps |theta| omega_max for the shortest bending wave: far below tol on
-    ordinary chains (N = 1000, beta = 1e-2: ~1e-11), but ~1e-6 on a link of 1.7e-7 with
-    beta = 7.2e-8, where no step size can bring the estimate below tol = 1e-7."""
+    ordinary chains (at the catenary, N = 100 and 1000, beta = 1e-2: 2e-12 and 2e-10 with grid
+    damping, twice that without), but ~2e-6 on a link of 1.7e-7 with beta = 7.2e-8, where no step
+    size brings the estimate below tol = 1e-7 (``tests/test_tiplinks.py``)."""
     s = 0.0
     kth = 0.0
     kom = 0.0
