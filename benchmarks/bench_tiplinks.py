@@ -4,8 +4,8 @@ The reproduction of the defect the ``tinylink`` branch fixed: a fold-graded chai
 beta = 7.2e-8, the regime study's grid damping ratio 1) whose free end's links fall to 1.7e-7
 (153 links: ``grading.fold_following(0.1, frac=0.5, h_min=1e-7, h_max=0.1, gamma=1)``). Before
 the roundoff floor of the error norm (:func:`snapping.simulate.rosenbrock.omega_floor`) tol 1e-7
-took 69,758 steps of ~1e-11 to t = 1e-6 (562,284 evaluations, 9.2 s of CPU; after: 199 steps, 1,346 evaluations); tol 1e-6 to
-the snap 13,829 evaluations (after: 12,616). Costs in CPU time (``time.process_time``) and evaluations.
+took 69,758 steps of ~1e-11 to t = 1e-6 (562,284 evaluations, 9.2 s of CPU; after: 199
+steps, 1,346 evaluations); tol 1e-6 to the snap 13,829 evaluations (after: 12,616). Costs in CPU time (``time.process_time``) and evaluations.
 
 Usage::
 
