@@ -27,6 +27,7 @@ reached by one step from the step's start).
 Usage::
 
     PYTHONPATH=src python benchmarks/elastic_polar_prototype.py --N 200 --c 300 3000 --tol 3e-6 --ref-tol 1e-8
+    PYTHONPATH=src python benchmarks/elastic_polar_prototype.py --cell 0.3 442 -3 --tol 1e-6
 """
 
 from __future__ import annotations
@@ -236,6 +237,36 @@ def rodas_polar(pl, q, t_end, tol, h=1e-4, samples=24):
     return nstep, nrej, best, refined
 
 
+def cell(a):
+    """One stretching cell (``snapping.regimes.cell_problem``, the tip links 1.7e-5 long at
+    level -3), matched start, undamped: the Cartesian run (stop rule, ``stop_floor=1``) and the
+    prototype to its end, at each tol."""
+    from snapping.continuum import level_parameters
+    from snapping.regimes import cell_problem
+
+    chi, c, k = a.cell
+    lv = level_parameters(8, 0.5, first=-4)
+    p = cell_problem(chi, "stretching", 1.0 / c, lv[int(k) + 4], damping=0.0)
+    el = Elastic.from_wave_speed(c)
+    line = ElasticLine(p, el)
+    print(f"machine: {platform.node()} {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, load "
+          f"{os.getloadavg()[0]:.1f}; cell chi {chi} c {c:g} level {int(k)}: N = {line.N}, shortest link "
+          f"{line.h.min():.2g}, matched start, undamped")
+    for tol in a.tol:
+        t0 = time.process_time()
+        cs = solve(p, el, tol=tol, method="rodas4", start="matched", stop_floor=1.0, max_rhs=a.max_rhs).summary()
+        print(f"  Cartesian tol {tol:g}: steps {cs['n_steps']} n_rhs {cs['n_rhs']} slack steps {cs['n_slack_steps']} "
+              f"cpu {time.process_time() - t0:.1f} s {cs['status']} ({cs['stop_reason']}) t_final {cs['t_final']:.5f} "
+              f"peaks v {cs['v_peak']:.7g} a {cs['a_peak']:.7g} sigma {cs['sigma_peak']:.7g}", flush=True)
+        pl = PolarLine(line)
+        q0 = pl.from_cartesian(line.start("matched"))
+        t0 = time.process_time()
+        ns, nr, best, refined = rodas_polar(pl, q0, cs["t_final"], tol)
+        print(f"  polar     tol {tol:g}: steps {ns} (rejected {nr}) n_rhs {6 * (ns + nr) + ns} cpu "
+              f"{time.process_time() - t0:.1f} s (numpy) peaks (refined) v {refined[0]:.7g} a {refined[1]:.7g} "
+              f"sigma {refined[2]:.7g}", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--N", type=int, default=200)
@@ -243,7 +274,13 @@ def main(argv=None):
     ap.add_argument("--chi", type=float, default=0.25)
     ap.add_argument("--tol", type=float, nargs="+", default=[3e-6])
     ap.add_argument("--ref-tol", type=float, default=1e-8)
+    ap.add_argument("--cell", type=float, nargs=3, default=None, metavar=("CHI", "C", "K"),
+                    help="instead: the stretching study's cell (fold-graded links at level K, as "
+                         "benchmarks/stretch_cell.py), undamped, against the Cartesian run at --tol")
+    ap.add_argument("--max-rhs", type=int, default=1_500_000)
     a = ap.parse_args(argv)
+    if a.cell:
+        return cell(a)
     print(f"machine: {platform.node()} {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, load "
           f"{os.getloadavg()[0]:.1f}; N = {a.N}, chi = {a.chi}, matched start, no damping")
     p = Problem.catenary(a.chi, links=Links.uniform(a.N, lumping="shared"))
