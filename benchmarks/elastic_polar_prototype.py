@@ -247,22 +247,24 @@ def cell(a):
     chi, c, k = a.cell
     lv = level_parameters(8, 0.5, first=-4)
     p = cell_problem(chi, "stretching", 1.0 / c, lv[int(k) + 4], damping=0.0)
-    el = Elastic.from_wave_speed(c)
-    line = ElasticLine(p, el)
+    line = ElasticLine(p, Elastic.from_wave_speed(c))
     print(f"machine: {platform.node()} {platform.processor() or platform.machine()}, {os.cpu_count()} cpus, load "
           f"{os.getloadavg()[0]:.1f}; cell chi {chi} c {c:g} level {int(k)}: N = {line.N}, shortest link "
-          f"{line.h.min():.2g}, matched start, undamped")
+          f"{line.h.min():.2g}, matched start")
     for tol in a.tol:
-        t0 = time.process_time()
-        cs = solve(p, el, tol=tol, method="rodas4", start="matched", stop_floor=1.0, max_rhs=a.max_rhs).summary()
-        print(f"  Cartesian tol {tol:g}: steps {cs['n_steps']} n_rhs {cs['n_rhs']} slack steps {cs['n_slack_steps']} "
-              f"cpu {time.process_time() - t0:.1f} s {cs['status']} ({cs['stop_reason']}) t_final {cs['t_final']:.5f} "
-              f"peaks v {cs['v_peak']:.7g} a {cs['a_peak']:.7g} sigma {cs['sigma_peak']:.7g}", flush=True)
+        for zeta in a.cell_zeta:
+            t0 = time.process_time()
+            cs = solve(p, Elastic.from_wave_speed(c, grid_damping=zeta), tol=tol, method="rodas4", start="matched",
+                       stop_floor=1.0, max_rhs=a.max_rhs).summary()
+            print(f"  Cartesian tol {tol:g} zeta {zeta:g}: steps {cs['n_steps']} n_rhs {cs['n_rhs']} slack steps "
+                  f"{cs['n_slack_steps']} cpu {time.process_time() - t0:.1f} s {cs['status']} ({cs['stop_reason']}) "
+                  f"t_final {cs['t_final']:.5f} peaks v {cs['v_peak']:.7g} a {cs['a_peak']:.7g} "
+                  f"sigma {cs['sigma_peak']:.7g}", flush=True)
         pl = PolarLine(line)
         q0 = pl.from_cartesian(line.start("matched"))
         t0 = time.process_time()
         ns, nr, best, refined = rodas_polar(pl, q0, cs["t_final"], tol)
-        print(f"  polar     tol {tol:g}: steps {ns} (rejected {nr}) n_rhs {6 * (ns + nr) + ns} cpu "
+        print(f"  polar     tol {tol:g} undamped: steps {ns} (rejected {nr}) n_rhs {6 * (ns + nr) + ns} cpu "
               f"{time.process_time() - t0:.1f} s (numpy) peaks (refined) v {refined[0]:.7g} a {refined[1]:.7g} "
               f"sigma {refined[2]:.7g}", flush=True)
 
@@ -278,6 +280,9 @@ def main(argv=None):
                     help="instead: the stretching study's cell (fold-graded links at level K, as "
                          "benchmarks/stretch_cell.py), undamped, against the Cartesian run at --tol")
     ap.add_argument("--max-rhs", type=int, default=1_500_000)
+    ap.add_argument("--cell-zeta", type=float, nargs="+", default=[0.0],
+                    help="grid damping of the Cartesian run(s) in --cell (the study's is 4); the prototype is undamped "
+                         "and runs to the last one's end")
     a = ap.parse_args(argv)
     if a.cell:
         return cell(a)
