@@ -25,6 +25,8 @@ instead made with fixed steps (no error control) to ``--t-fixed``, printing the 
 rate at five times (the line's own, from a converged run, is about 1e-9 at c = 3000). With
 ``--pendulum WH ...`` a stiff pendulum (one mass on a two-sided spring, released horizontal) is
 stepped by the same RODAS4 with fixed steps omega h, in Cartesian coordinates and in polar ones.
+With ``--ringing TOL ...`` runs at those tolerances are compared at ten times (the largest
+stretch rate of each; speed, position and tension differences from the tightest).
 
 Usage::
 
@@ -32,6 +34,7 @@ Usage::
     PYTHONPATH=src python benchmarks/probe_elastic_steps.py --N 1000 --c 300 --tol 3e-6 --hscan
     PYTHONPATH=src python benchmarks/probe_elastic_steps.py --N 200 --c 3000 --fixed 2e-5 5e-5 1e-4 2e-4
     PYTHONPATH=src python benchmarks/probe_elastic_steps.py --c 1000 --pendulum 1 3 10 30 100 1000
+    PYTHONPATH=src python benchmarks/probe_elastic_steps.py --N 200 --c 3000 --ringing 1e-8 3e-6
 
 CPU times are process times (a shared machine); evaluations are the primary measure.
 """
@@ -202,6 +205,36 @@ def fixed_steps(p, c, zeta, start, hs, t1):
               flush=True)
 
 
+def ringing(p, c, zeta, start, tols):
+    """Runs at several tolerances with snapshots at ten times: the largest stretch rate
+    |u_j . (v_{j+1} - v_j)| of each (the line's own, quasi-static, from the tightest), and the
+    others' differences from the tightest in node speed, position and tension (relative to the
+    largest tension)."""
+    ts = np.array([0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0, 1.1, 1.15])
+    out = {}
+    for tol in sorted(tols):
+        t0 = time.process_time()
+        r = solve(p, Elastic.from_wave_speed(c, grid_damping=zeta), tol=tol, method="rodas4", start=start,
+                  snapshot_times=ts)
+        ds, a = r.dataset, r.dataset.attrs
+        k = ds.snapshot_kind.values == "requested"
+        x, y, vx, vy, T = (ds[n].values[k] for n in ("x", "y", "vx", "vy", "tension"))
+        dx, dy = np.diff(x, axis=1), np.diff(y, axis=1)
+        ln = np.hypot(dx, dy)
+        sd = (dx * np.diff(vx, axis=1) + dy * np.diff(vy, axis=1)) / ln
+        out[tol] = (x, y, vx, vy, T)
+        print(f"  c = {c:g} tol {tol:g}: n_rhs {a['n_rhs']} cpu {time.process_time() - t0:.1f} s; largest stretch rate "
+              f"at t = {', '.join(f'{t:g}' for t in ts)}: " + " ".join(f"{v:.1e}" for v in np.abs(sd).max(axis=1)),
+              flush=True)
+    ref = out[min(tols)]
+    for tol in sorted(tols)[1:]:
+        x, y, vx, vy, T = out[tol]
+        print(f"    tol {tol:g} - tol {min(tols):g}: |dv| " + " ".join(
+            f"{v:.1e}" for v in np.hypot(vx - ref[2], vy - ref[3]).max(axis=1)) + "; |dr| " + " ".join(
+            f"{v:.1e}" for v in np.hypot(x - ref[0], y - ref[1]).max(axis=1)) + "; |dT|/max T " + " ".join(
+            f"{v:.1e}" for v in np.abs(T - ref[4]).max(axis=1) / ref[4].max(axis=1)))
+
+
 def _rodas_step(f, y, h):
     """One RODAS4 step (the tableau of :mod:`snapping.simulate.rosenbrock`, as
     :func:`elastic_rodas.rodas_step` takes it) of the small autonomous system ``f`` with its
@@ -266,6 +299,8 @@ def main(argv=None):
     ap.add_argument("--fixed", type=float, nargs="+", default=None,
                     help="instead: fixed steps of these sizes (no error control) to --t-fixed")
     ap.add_argument("--t-fixed", type=float, default=0.5)
+    ap.add_argument("--ringing", type=float, nargs="+", default=None,
+                    help="instead: runs at these tolerances, their stretch rates and differences at ten times")
     ap.add_argument("--pendulum", type=float, nargs="+", default=None,
                     help="instead: the stiff pendulum at c (the first --c) with fixed steps of these omega h")
     a = ap.parse_args(argv)
@@ -276,6 +311,10 @@ def main(argv=None):
         pendulum(a.c[0], a.pendulum)
         return
     p = Problem.catenary(a.chi, links=Links.uniform(a.N, lumping="shared"))
+    if a.ringing:
+        for c in a.c:
+            ringing(p, c, a.grid_damping, a.start, a.ringing)
+        return
     if a.fixed:
         for c in a.c:
             fixed_steps(p, c, a.grid_damping, a.start, a.fixed, a.t_fixed)
