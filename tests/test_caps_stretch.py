@@ -93,3 +93,21 @@ def test_one_level_is_the_elastic_line_over_the_rigid_chain():
     for q in Q:
         assert f[q] == pytest.approx(float(el[q]) / float(rigid[q]), rel=1e-9)
     assert f["t_snap"] == pytest.approx(float(rigid["t_snap_sigma"]), rel=1e-12)
+
+
+def test_stretching_judged_at_the_speed_the_line_reaches(monkeypatch):
+    """Whether stretching matters is judged on the full run's peak speed (drag slows the line), not
+    the ideal chain's: a wave speed between the two speeds' 1/STRETCH_MATTERS leaves it out. The
+    two speeds come from an answer without EA (no stretching), not from the rule."""
+    kw = dict(check=False, alone=False, length=L, mass=M, ei=1e-9, diameter=0.05)
+    base = caps.cap(None, 0.3, N=N, **kw)
+    v_ideal, v_full = base["ideal"]["v_peak"], base["full"]["v_peak"]
+    assert v_full < 0.95 * v_ideal  # drag slows the line (0.88 here)
+    c = 0.5 * (v_ideal + v_full) / caps.STRETCH_MATTERS  # m/s
+    called = _fake_levels(monkeypatch, {30: dict.fromkeys(Q, 0.5), 60: dict.fromkeys(Q, 0.5)})
+    r = caps.cap(None, 0.3, N=N, ea=c**2 * M / L, **kw)
+    s = r["stretching"]
+    assert called == [] and s["run"] is False and r["real"] == r["full"]
+    assert s["v_over_c"] == pytest.approx(v_full / c, rel=1e-9)
+    assert s["v_over_c_ideal"] == pytest.approx(v_ideal / c, rel=1e-9) and s["v_over_c_ideal"] > caps.STRETCH_MATTERS
+    assert "the full run's" in s["why"]

@@ -25,8 +25,10 @@ lengths and extrapolated at order 2, with an error estimate per peak (the nylon 
 links, its tension within 0.11% of the converged value, estimate 0.55%).
 
 **Stretching** is the elastic model (:func:`snapping.simulate.elastic.solve`), which has no
-bending or drag; it is run when EA is given and matters: when the ideal run's peak speed
-reaches ``STRETCH_MATTERS`` = 5% of the longitudinal wave speed c = sqrt(EA/lambda) (the
+bending or drag; it is run when EA is given and matters: when the line's peak speed (the full
+inextensible run's, with every other mechanism: the speed the line reaches, not the ideal
+chain's, ``stretching["v_over_c_ideal"]``) reaches ``STRETCH_MATTERS`` = 5% of the longitudinal
+wave speed c = sqrt(EA/lambda) (the
 elastic guide's measurements put the peaks' change at 0.1-0.3% for v/c of 1-3% and 4-11% for
 v/c of about 20%). Then it runs the elastic line (from the rigid chain's release, ``"matched"``:
 no release wave; grid damping 1; RODAS4) and the rigid chain on the same uniform links, on two
@@ -84,7 +86,7 @@ from .caps_runs import grading_for as _grading
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
-#: the ideal run's peak speed over the wave speed above which the stretching is run
+#: the full run's peak speed (the speed the line reaches) over the wave speed above which the stretching is run
 STRETCH_MATTERS = 0.05
 #: the links tried by ``N="auto"``, doubling, and the change of a peak from one to the next that stops it
 AUTO_N = (100, 200, 400, 800, 1600)
@@ -317,8 +319,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     factor_s = {q: 1.0 for q in QUANTITIES}
     if sp.has("stretching"):
         c = math.sqrt(sp.ea / (sp.mass / sp.length)) / math.sqrt(sp.g * sp.length)
-        ratio = ideal_nd["v_peak"] / c
-        stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio})
+        ratio = full_nd["v_peak"] / c  # the speed the line reaches: the full run's, not the ideal chain's
+        stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio,
+                           "v_over_c_ideal": ideal_nd["v_peak"] / c})
         if ratio >= STRETCH_MATTERS:
             sl = [stretch_factor(sp, chi, runs.tol, n) for n in STRETCH_LEVELS]
             for f in sl:
@@ -334,7 +337,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
             if alone:
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
-            stretching["why"] = f"v_peak/c = {ratio:.3g} < {STRETCH_MATTERS:g}: left out (the line is inextensible here)"
+            stretching["why"] = (f"v_peak/c = {ratio:.3g} < {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
+                                 f"{stretching['v_over_c_ideal']:.3g}): left out (the line is inextensible at the speed it "
+                                 "reaches)")
     else:
         stretching["why"] = "no EA given: inextensible"
     real_nd = {q: full_nd[q] * factor_s[q] for q in QUANTITIES}

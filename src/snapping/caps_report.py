@@ -150,7 +150,7 @@ def report_section(answers: list[dict], study_list: list, figure_names=()) -> li
              "stretching, drag and an end mass besides. Each line of the catalogue (`snapping.lines`) released from "
              f"its catenary, from runs of the real model (`snapping.caps.cap`): the ideal chain on the same links, "
              "the full inextensible model (bending + drag + end mass + taper), stretching as an elastic/rigid factor "
-             f"where the ideal peak speed reaches {caps.STRETCH_MATTERS:g} of the wave speed (each peak's factor "
+             f"where the full run's peak speed reaches {caps.STRETCH_MATTERS:g} of the wave speed (each peak's factor "
              f"applied only where it agrees within {caps.RESOLVED:.0%} on {caps.STRETCH_LEVELS[0]} and "
              f"{caps.STRETCH_LEVELS[1]} links, else left out), and each mechanism "
              f"alone. Rule: {answers[0]['rule'] if answers else ''}.", ""]
