@@ -332,7 +332,8 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                "levels": [{"N": f["N"], **{q: f[q] for q in QUANTITIES}, "s_sigma": f["s_sigma"],
                                            "t_sigma": f["t_sigma"], "t_snap": f["t_snap"]} for f in sl],
                                "strain_peak": sl[1]["strain_peak"],
-                               "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g}: run (elastic over rigid on "
+                               "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
+                                      f"{stretching['v_over_c_ideal']:.3g}): run (elastic over rigid on "
                                       f"{sl[0]['N']} and {sl[1]['N']} links); " + stretch_words(sl, ok)})
             if alone:
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
