@@ -53,6 +53,7 @@ import math
 import os
 import platform
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -292,6 +293,7 @@ def load(path):
 
 
 def run_one(chi, beta, k, variant, path):
+    from snapping._files import write_atomic
     from snapping.simulate import run
 
     db = load(path)
@@ -318,9 +320,7 @@ def run_one(chi, beta, k, variant, path):
     row["load"] = os.getloadavg()[0]
     db = load(path)
     db[kk] = row
-    tmp = path + ".tmp"
-    json.dump(db, open(tmp, "w"), indent=1)
-    os.replace(tmp, path)
+    write_atomic(path, lambda tmp: Path(tmp).write_text(json.dumps(db, indent=1)), name="bending_rise results")
     print(f"{kk}: v_peak={row['v_peak']:.5g} N={row['N']} rhs={row['n_rhs']} cpu={cpu:.1f}s "
           f"load={row['load']:.1f}", flush=True)
     return row
