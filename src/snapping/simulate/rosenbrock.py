@@ -38,6 +38,7 @@ from . import rk as R
 from . import stiff as ST
 from .stiff import RODAS4
 from . import stiff_system as SS
+from .stiff_system import colour_link
 
 from .banded import IDIAG, KL, KU, WROW, _band_solve_stage, band_lu, band_solve  # noqa: F401 (re-exported)
 
@@ -291,10 +292,7 @@ def omega_floor(N, j, Dj, y, hl):
     kth = 0.0
     kom = 0.0
     for k in range(NCOL):
-        d = (k - j) % NCOL
-        if d > 2:
-            d -= NCOL
-        lk = j + d
+        lk = colour_link(j, k)
         if 0 <= lk < N:
             a0 = abs(Dj[0, k, 2 * j])
             a1 = abs(Dj[1, k, 2 * j])

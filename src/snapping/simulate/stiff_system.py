@@ -159,6 +159,16 @@ def _jacobian(N, th, om, a, T, h, invm, invm_next, invh, Bl, K0L, El, clamped, h
                 x[v, j] -= 1j * _EPS_CS  # (exact: the real part is untouched)
 
 
+@njit(cache=True, inline="always")
+def colour_link(j, k):
+    """The link of colour ``k`` within two links of link ``j`` (``j - 2 .. j + 2``; it may lie
+    outside ``0 .. N - 1``): the column of the coloured Jacobian ``D[., k, row of j]``."""
+    d = (k - j) % NCOL
+    if d > 2:
+        d -= NCOL
+    return j + d
+
+
 @njit(cache=True, fastmath=False, error_model="numpy")
 def _matvec(N, Dv, x, out):
     """``out += sum_k Dv[k, i] x[link of colour k near row i]`` (the coloured columns times x)."""
@@ -166,10 +176,7 @@ def _matvec(N, Dv, x, out):
         j = i // 2
         acc = 0.0
         for k in range(NCOL):
-            d = (k - j) % NCOL
-            if d > 2:
-                d -= NCOL
-            lk = j + d
+            lk = colour_link(j, k)
             if 0 <= lk < N:
                 acc += Dv[k, i] * x[lk]
         out[i] += acc
@@ -182,10 +189,7 @@ def _assemble(N, D, gh, ab):
     for i in range(2 * N):
         j = i // 2
         for k in range(NCOL):
-            d = (k - j) % NCOL
-            if d > 2:
-                d -= NCOL
-            lk = j + d
+            lk = colour_link(j, k)
             if 0 <= lk < N:
                 ab[KL + KU + i - 2 * lk, 2 * lk] = D[2, k, i] + gh * gh * D[0, k, i] + gh * D[1, k, i]
                 ab[KL + KU + i - 2 * lk - 1, 2 * lk + 1] = D[3, k, i]
