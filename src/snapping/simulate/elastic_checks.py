@@ -36,6 +36,9 @@ T_CUT = 0.9
 #: the ringing rule needs at least this many windows of 8 L / c before the cut (else: not judged;
 #: at small c the ringing and the fall share one time scale, and the steps follow the motion)
 MIN_WINDOWS = 10
+#: the quantile over the windows that is the measure (0.5: the median; higher catches ringing that
+#: grows late in the fall)
+RING_QUANTILE = 0.5
 #: steps a window needs to be counted
 MIN_STEPS = 4
 #: largest ringing measure from the matched start (fitted: converged runs 0.001-0.012 at N = 30,
@@ -84,7 +87,7 @@ def ringing_tension(t, sigma_max, wave_speed: float, length: float, t_snap_sigma
             rel.append(half / med if med > 0.0 else np.inf)
     if len(rel) < MIN_WINDOWS:
         return float("nan")
-    return float(np.median(rel))
+    return float(np.quantile(rel, RING_QUANTILE))
 
 
 def slack_share(t, dt, n_slack, t_snap_sigma: float) -> float:
