@@ -4,8 +4,8 @@ tol and start. Each row: the peaks, the guard's ringing measure and verdict, and
 sigma_peak's relative difference from the tightest tol's run of the same (N, c, start).
 ``verdict``: ``ok`` (resolved and within ``--agree`` of the tightest), ``caught`` (flagged and
 off), ``FALSE`` (flagged but within ``--agree``: a converged run flagged), ``MISS`` (passed but
-off), ``ref`` (the tightest run: flagged or not, nothing to compare). Runs stopped by
-``--max-rhs`` are reported with their stop reason.
+off), ``ref`` (the tightest run: flagged or not, nothing to compare; ``no ref`` when it did not reach
+the snap). Runs stopped by ``--max-rhs`` are reported with their stop reason (``no snap``).
 
 Usage::
 
@@ -52,8 +52,10 @@ def main(argv=None) -> None:
                         da = at["a_peak"] / ref["a_peak"] - 1.0
                         ds = at["sigma_peak"] / ref["sigma_peak"] - 1.0
                     ok = bool(at["peaks_resolved"])
-                    if at is ref or ref is None:
-                        verdict = "ref"
+                    if at is rows[0][1]:
+                        verdict = "ref" if ref is not None else "no snap"
+                    elif ref is None:
+                        verdict = "no ref"
                     elif at["stop_reason"] != "snap":
                         verdict = "no snap"
                     else:

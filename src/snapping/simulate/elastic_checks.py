@@ -14,7 +14,7 @@ rough):
   From the matched start the line's own ringing has a tension amplitude ``T''(0)/omega^2``, O(c^-2)
   (measured 0.001 at c = 3000, 0.011 at c = 300, N = 30); from a release (stretched, unstretched
   or a given initial state) the unloading wave's amplitude is at most the start's own tensions,
-  0.37-0.42 measured converged, undamped. Limits: :data:`RING_MATCHED` and :data:`RING_RELEASE`.
+  0.35-0.42 measured converged, undamped. Limits: :data:`RING_MATCHED` and :data:`RING_RELEASE`.
 * **slack** (:func:`slack_share`): the share of that time with a slack link, from the matched start
   whose links all start taut (the rigid chain's tensions, positive before the snap: none is slack
   in a converged run; 0.89-0.98 in the ringing runs measured). Limit :data:`SLACK_MAX`.
@@ -45,8 +45,8 @@ MIN_STEPS = 4
 #: c = 300-3000; the ringing runs 1.3-2.7)
 RING_MATCHED = 0.1
 #: largest ringing measure from a release (fitted: the unloading wave's tension amplitude is at most
-#: the start's tensions, relative amplitude <= 1, but undamped releases measure 0.37-0.42 converged
-#: (N = 30, c = 300 tol 1e-5 to 1e-7, c = 3000 tol 1e-7) and 0.60 at c = 3000 tol 1e-6, whose
+#: the start's tensions, relative amplitude <= 1, but undamped releases measure 0.35-0.42 converged
+#: (N = 30, c = 300 tol 1e-5 to 1e-7, c = 3000 tol 1e-7; N = 100, c = 300 tol 1e-7) and 0.60 at c = 3000 tol 1e-6, whose
 #: a_peak is 32% off: the margin is thin)
 RING_RELEASE = 0.5
 #: largest share of the fall with a slack link from the matched start (fitted: 0 in converged runs,
