@@ -209,7 +209,10 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
     (:func:`grading_rule`; ``present``: the line's mechanisms; ``graded``: "auto", True or False):
     only when the bending length is under :data:`GRADE_LINKS` links, the run without bending on N
     links; when its fold stays under pi/2 at one node, the same on 2N links (does it narrow with them?);
-    when it does, the full run on N links (the uniform answer's own)."""
+    when it does, the full run on N links (the uniform answer's own), and when that one's fold stays
+    under pi/2 too but the bending length is under one link, the full run on 2N links: a full run
+    whose fold does not narrow as the links halve is graded (the fly line at chi 0.25 on 100 links:
+    curvature peak x link 0.59 on 100, 0.76 on 200)."""
     if graded is False or "bending" not in present:
         return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
     lb = bending_length(runs.sp)
@@ -225,6 +228,8 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
                 kf = runs.get(tuple(present), N)["kappa_peak"] / N
                 if kf >= COLLAPSE:
                     kh, kh2, where = kf, None, "with bending"
+                elif lb * N < 1.0:  # the bending length under one link: does the full run's fold narrow on 2N?
+                    kh, kh2, where = kf, runs.get(tuple(present), 2 * N)["kappa_peak"] / (2 * N), "with bending"
     used, why = grading_rule(lb, 1.0 / N, kh, where, halved=kh2)
     if used:
         n = graded_h(runs.chi, lb, 1).size
