@@ -166,7 +166,8 @@ GRADE_LINKS = 20.0
 #: by a factor 0.5-0.8 per halving)
 COLLAPSE = 1.5707963267948966
 #: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
-#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
+#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved;
+#: also the most links of a level run by the escalation (:func:`graded_levels`: the nylon line's 2127)
 MAX_GRADED_LINKS = 2500
 
 
