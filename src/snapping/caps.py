@@ -530,10 +530,11 @@ def format_design(d: dict) -> list[str]:
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
                    f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
                    f"{'yes' if r['ideal_admissible'] else 'no':>8}")
-    gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%})" for r in d["rows"]
-          if r.get("graded", {}).get("used")]
+    gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%}"
+          + ("" if r["graded"].get("stopped", "within") == "within" else ", NOT all peaks within 1%") + ")"
+          for r in d["rows"] if r.get("graded", {}).get("used")]
     if gr:
-        out.append(f"  real peaks from graded links, two levels extrapolated, at chi: {', '.join(gr)}")
+        out.append(f"  real peaks from graded links, the last two levels extrapolated, at chi: {', '.join(gr)}")
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:
