@@ -65,8 +65,6 @@ def _graded(r: dict) -> str:
 def _order(name: str, chi: float, levels=(0, 1, 2)) -> int:
     """Three graded levels of the full model (``levels``, default 0, 1, 2): observed order,
     extrapolations of the first two and of the last two."""
-    import math
-
     from snapping import caps_runs
 
     sp = caps.spec(name)
@@ -95,7 +93,7 @@ def _escalation(names, chi: float, N: int) -> int:
     caps.cap("nylon-monofilament", chi, N=8, check=False, alone=False, graded=False)  # compile
     for name in names:
         r = caps.cap(name, chi, N=N, check=False)
-        g, sp = r["graded"], caps.spec(name)
+        g = r["graded"]
         if not g.get("used"):
             print(f"{name}, chi = {chi:g}, N = {N}: not graded ({g.get('why')}); T {r['real']['sigma_peak']:.5g} N")
             continue
