@@ -41,8 +41,8 @@ MIN_WINDOWS = 10
 RING_QUANTILE = 0.5
 #: steps a window needs to be counted
 MIN_STEPS = 4
-#: largest ringing measure from the matched start (fitted: converged runs 0.001-0.012 at N = 30,
-#: c = 300-3000; the ringing runs 1.3-2.7)
+#: largest ringing measure from the matched start (fitted: converged runs 0.001-0.014 at N = 30, 100,
+#: c = 300-3000; the ringing runs 0.38-3.7)
 RING_MATCHED = 0.1
 #: largest ringing measure from a release (fitted: the unloading wave's tension amplitude is at most
 #: the start's tensions, relative amplitude <= 1, but undamped releases measure 0.35-0.42 converged
@@ -50,7 +50,7 @@ RING_MATCHED = 0.1
 #: a_peak is 32% off: the margin is thin)
 RING_RELEASE = 0.5
 #: largest share of the fall with a slack link from the matched start (fitted: 0 in converged runs,
-#: 0.89-0.98 in the ringing ones)
+#: 0.85-0.999 in the ringing ones, N = 12 and 30)
 SLACK_MAX = 0.1
 #: energy_drift above this fraction of |E0| + |W| + U0 flags the run (ENERGY_ERROR_FAIL / 10)
 ENERGY_FLAG = 0.01
