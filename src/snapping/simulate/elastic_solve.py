@@ -41,6 +41,7 @@ from scipy.integrate import DOP853, Radau
 from .. import _validate as V
 from .. import schema
 from . import elastic_advance as EA
+from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
@@ -62,6 +63,9 @@ ENERGY_ERROR_FAIL = 0.1
 #: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
 #: below, one step a call (the reference the compiled loop equals, bit for bit)
 COMPILED_LOOP = True
+#: a compiled RODAS4 run refines its peaks compiled (:func:`elastic_refine.refine`); False:
+#: :meth:`_Peaks.refine` on the kept steps (the reference it equals, bit for bit)
+COMPILED_REFINE = True
 #: the per-step record's columns (the Dataset's step variables, in this order)
 STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
               "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
@@ -114,6 +118,7 @@ class _Peaks:
         self.keep = {k: [] for k in self.COLS}
         self.after = dict.fromkeys(self.COLS, False)
         self.prev = None
+        self.run = None  # (a compiled RODAS4 run whose kept steps elastic_refine.refine refines)
 
     def update(self, t, mm, seg):
         """Record the accepted step ``seg = (t_old, y_old, t, dense)`` (None for the initial
@@ -246,8 +251,11 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
         elif code == EA.R_ENERGY:
             status, stop_reason = "failed", _ENERGY_MSG
         break
-    for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
-        peaks.best[k], peaks.keep[k] = (val, tp), segs
+    if COMPILED_REFINE:
+        peaks.run = run
+    else:
+        for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
+            peaks.best[k], peaks.keep[k] = (val, tp), segs
     sc = run.sctl
     if sc[EA.S_RUN] > 0.0:
         peak_state = (float(sc[EA.S_PEAKT]), run.peak_z.copy())
@@ -409,7 +417,11 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     snap_z += [peak_state[1], zf]
     snap_kind += ["peak", "final"]
     rec = np.asarray(rows, dtype=float)
-    ref = peaks.refine(line, restep)
+    if peaks.run is not None:
+        ref, nf = ERF.refine(peaks.run, PEAK_SAMPLES, PEAK_RESTEP)
+        n_restep[0] += nf
+    else:
+        ref = peaks.refine(line, restep)
     wall = time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
