@@ -102,7 +102,9 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
     ts = np.empty(samples + 1)
     y = np.empty(n)
     yd = np.empty(n)
-    mm = np.zeros(EK.NMEAS)
+    nslot = PT.shape[0]
+    gm = np.zeros((nslot, samples, EK.NMEAS))
+    done = np.zeros(nslot, dtype=np.bool_)
     # the cache of integrated states: (step start, sample) -> measures (or failed)
     cap = nk * (2 * window + 1)
     ck_t = np.empty(cap)
@@ -120,18 +122,21 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
         gval = -np.inf
         for q in range(nkeep[k]):
             s = keep[k, q]
-            t_old = PT[s, 0]
-            t_new = PT[s, 1]
-            grid(t_old, t_new, samples, ts)
+            if not done[s]:  # (the measures of a step's samples, for every kind that keeps it)
+                done[s] = True
+                t_old = PT[s, 0]
+                t_new = PT[s, 1]
+                grid(t_old, t_new, samples, ts)
+                for i in range(1, samples):
+                    x = (ts[i] - t_old) / (t_new - t_old)
+                    for r in range(n):
+                        yd[r] = PY0[s, r] * (1.0 - x) + x * (PY1[s, r] + (1.0 - x) * (PC[s, 0, r] + x * PC[s, 1, r]))
+                    _measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
             for i in range(1, samples):
-                x = (ts[i] - t_old) / (t_new - t_old)
-                for r in range(n):
-                    yd[r] = PY0[s, r] * (1.0 - x) + x * (PY1[s, r] + (1.0 - x) * (PC[s, 0, r] + x * PC[s, 1, r]))
-                _measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, mm)
-                if mm[c] > gval:
+                if gm[s, i, c] > gval:
                     gs = s
                     gi = i
-                    gval = mm[c]
+                    gval = gm[s, i, c]
         if gs < 0:
             out[k, 0] = val
             out[k, 1] = tp
