@@ -373,8 +373,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
             solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
-        rows += rec_steps[:, 1:].tolist()
-        times += rec_steps[:, 0].tolist()
+        rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
+        times = np.concatenate([times, rec_steps[:, 0]])
     else:
         while solver.status == "running":
             msg = solver.step()
@@ -413,7 +413,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
             if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
                 status, stop_reason = "failed", _ENERGY_MSG
                 break
-    t_final = times[-1]
+    t_final = float(times[-1])
     zf = solver.y.copy()
     snap_t += [peak_state[0], t_final]
     snap_z += [peak_state[1], zf]
