@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from snapping.simulate import elastic_dataset as ED
 from snapping.simulate import elastic_refine as ERF
 from snapping.simulate import elastic_solve as ES
 from snapping.simulate.elastic import Elastic, solve
@@ -30,7 +31,7 @@ CASES = {
 def _run(case, *, compiled_refine=True, direct=True, monkeypatch):
     mk_p, mk_e, kw = CASES[case]
     monkeypatch.setattr(ES, "COMPILED_REFINE", compiled_refine)
-    monkeypatch.setattr(ES, "DIRECT_DATASET", direct)
+    monkeypatch.setattr(ED, "DIRECT_DATASET", direct)
     return solve(mk_p(), mk_e(), method="rodas4", **kw)
 
 
@@ -85,7 +86,7 @@ def test_assemble_falls_back_to_public(monkeypatch):
     """Without xarray's private constructor (absent, or raising), the public one."""
     data = {"v": (("step",), np.arange(3.0), {"units": "x"})}
     coords = {"t": (("step",), np.arange(3.0) * 0.5, {})}
-    good = ES._public(data, coords, {"a": 1})
+    good = ED._public(data, coords, {"a": 1})
     seen = []
 
     class Absent:  # an xarray whose Dataset has no _construct_direct
@@ -100,8 +101,8 @@ def test_assemble_falls_back_to_public(monkeypatch):
             raise TypeError("another signature")
 
     for fake in (Absent, Raising):
-        monkeypatch.setattr(ES, "xr", type("xr", (), {"Dataset": fake, "Variable": xr.Variable}))
-        fb = ES._assemble(data, coords, {"a": 1})
+        monkeypatch.setattr(ED, "xr", type("xr", (), {"Dataset": fake, "Variable": xr.Variable}))
+        fb = ED._assemble(data, coords, {"a": 1})
         monkeypatch.undo()
         assert fb.identical(good) and fb.attrs == {"a": 1} and set(fb.coords) == {"t"}
     assert seen == ["public", "direct", "public"]
