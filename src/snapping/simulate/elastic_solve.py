@@ -11,7 +11,10 @@ Jacobian, W and D rows included, the stage system reduced to the velocities, O(N
 as many evaluations as Radau for the same peak accuracy or fewer (5x fewer at N = 100, c = 300)
 and 10-70x less wall time. Its step loop and the bookkeeping below (records, peaks, snapshots,
 the stop rule) are compiled (:mod:`snapping.simulate.elastic_advance`; Python runs once per
-snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = False``).
+snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = False``); so is
+the refinement of its peaks (:mod:`snapping.simulate.elastic_refine`; ``COMPILED_REFINE =
+False``: :meth:`_Peaks.refine`, the same numbers). The Dataset is built by
+:mod:`snapping.simulate.elastic_dataset`.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
