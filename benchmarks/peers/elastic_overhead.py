@@ -9,8 +9,9 @@ Each run of ``elastic.solve(..., method="rodas4")`` is split, by timing wrappers
   (``RodasStepper``: its arrays, the first step's guess) and the compiled loop's buffers
   (``RodasRun``);
 * ``loop``: the compiled step loop (``RodasRun.advance``: steps, records, peaks, stop rule);
-* ``refine``: the peaks' refinement (``_Peaks.refine``: the dense output sampled in Python, a few
-  states integrated again from a step's start);
+* ``refine``: the peaks' refinement (``elastic_refine.refine``, compiled, or ``_Peaks.refine``
+  with ``COMPILED_REFINE = False``: the dense output sampled, a few states integrated again from a
+  step's start);
 * ``dataset``: the xarray Dataset (``_dataset``);
 * ``other``: the rest of ``solve`` (argument checks, the records' concatenation, the attrs).
 
@@ -45,6 +46,7 @@ def instrument():
     """Wrap the parts of ``elastic_solve.solve`` with CPU timers; returns the accumulator dict."""
     from snapping.simulate import elastic_advance as EA
     from snapping.simulate import elastic_model as EM
+    from snapping.simulate import elastic_refine as ERF
     from snapping.simulate import elastic_rodas as ER
     from snapping.simulate import elastic_solve as ES
 
@@ -70,6 +72,7 @@ def instrument():
     EA.RodasRun.__init__ = timed("setup", EA.RodasRun.__init__)
     EA.RodasRun.advance = timed("loop", EA.RodasRun.advance)
     ES._Peaks.refine = timed("refine", ES._Peaks.refine)
+    ERF.refine = timed("refine", ERF.refine)
     ES._dataset = timed("dataset", ES._dataset)
     return acc
 
@@ -121,11 +124,13 @@ _ORIG = {}
 def _save_originals():
     from snapping.simulate import elastic_advance as EA
     from snapping.simulate import elastic_model as EM
+    from snapping.simulate import elastic_refine as ERF
     from snapping.simulate import elastic_rodas as ER
     from snapping.simulate import elastic_solve as ES
 
     for obj, name in ((EM.ElasticLine, "__init__"), (ES, "_initial"), (ER.RodasStepper, "__init__"),
-                      (EA.RodasRun, "__init__"), (EA.RodasRun, "advance"), (ES._Peaks, "refine"), (ES, "_dataset")):
+                      (EA.RodasRun, "__init__"), (EA.RodasRun, "advance"), (ES._Peaks, "refine"), (ES, "_dataset"),
+                      (ERF, "refine")):
         _ORIG[(obj, name)] = getattr(obj, name)
 
 

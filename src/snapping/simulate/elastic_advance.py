@@ -13,8 +13,9 @@ state, ``max_rhs``, the energy balance, the stop rule (v_max below ``stop_fracti
 running peak once that peak is above the floor), the energy-error failure. It returns to
 Python at the end, at a stop or failure, after the step that passes the next snapshot time,
 and when the record buffer is full (:class:`RodasRun` then drains it). The peaks are then
-refined on the kept steps by ``elastic_solve._Peaks.refine`` (:meth:`RodasRun.segments`: the
-dense output guides it, the states are integrated from the step's start).
+refined on the kept steps by :func:`elastic_refine.refine` (compiled, on the step slots), or by
+``elastic_solve._Peaks.refine`` (:meth:`RodasRun.segments`; ``COMPILED_REFINE = False``): the
+dense output guides it, the states are integrated from the step's start.
 """
 
 from __future__ import annotations

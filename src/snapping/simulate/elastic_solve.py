@@ -11,7 +11,10 @@ Jacobian, W and D rows included, the stage system reduced to the velocities, O(N
 as many evaluations as Radau for the same peak accuracy or fewer (5x fewer at N = 100, c = 300)
 and 10-70x less wall time. Its step loop and the bookkeeping below (records, peaks, snapshots,
 the stop rule) are compiled (:mod:`snapping.simulate.elastic_advance`; Python runs once per
-snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = False``).
+snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = False``); so is
+the refinement of its peaks (:mod:`snapping.simulate.elastic_refine`; ``COMPILED_REFINE =
+False``: :meth:`_Peaks.refine`, the same numbers). The Dataset is built by
+:mod:`snapping.simulate.elastic_dataset`.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -35,14 +38,14 @@ import json
 import time
 
 import numpy as np
-import xarray as xr
 from scipy.integrate import DOP853, Radau
 
 from .. import _validate as V
-from .. import schema
 from . import elastic_advance as EA
 from . import elastic_checks as EC
+from . import elastic_refine as ERF
 from . import elastic_rodas as ER
+from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
 
@@ -63,10 +66,9 @@ ENERGY_ERROR_FAIL = 0.1
 #: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
 #: below, one step a call (the reference the compiled loop equals, bit for bit)
 COMPILED_LOOP = True
-#: the per-step record's columns (the Dataset's step variables, in this order)
-STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
-              "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
-              "strain_max", "n_slack")
+#: a compiled RODAS4 run refines its peaks compiled (:func:`elastic_refine.refine`); False:
+#: :meth:`_Peaks.refine` on the kept steps (the reference it equals, bit for bit)
+COMPILED_REFINE = True
 
 
 class ElasticRun:
@@ -115,6 +117,7 @@ class _Peaks:
         self.keep = {k: [] for k in self.COLS}
         self.after = dict.fromkeys(self.COLS, False)
         self.prev = None
+        self.run = None  # (a compiled RODAS4 run whose kept steps elastic_refine.refine refines)
 
     def update(self, t, mm, seg):
         """Record the accepted step ``seg = (t_old, y_old, t, dense)`` (None for the initial
@@ -247,8 +250,11 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
         elif code == EA.R_ENERGY:
             status, stop_reason = "failed", _ENERGY_MSG
         break
-    for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
-        peaks.best[k], peaks.keep[k] = (val, tp), segs
+    if COMPILED_REFINE:
+        peaks.run = run
+    else:
+        for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
+            peaks.best[k], peaks.keep[k] = (val, tp), segs
     sc = run.sctl
     if sc[EA.S_RUN] > 0.0:
         peak_state = (float(sc[EA.S_PEAKT]), run.peak_z.copy())
@@ -364,8 +370,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
             solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
-        rows += rec_steps[:, 1:].tolist()
-        times += rec_steps[:, 0].tolist()
+        rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
+        times = np.concatenate([times, rec_steps[:, 0]])
     else:
         while solver.status == "running":
             msg = solver.step()
@@ -404,13 +410,17 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
             if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
                 status, stop_reason = "failed", _ENERGY_MSG
                 break
-    t_final = times[-1]
+    t_final = float(times[-1])
     zf = solver.y.copy()
     snap_t += [peak_state[0], t_final]
     snap_z += [peak_state[1], zf]
     snap_kind += ["peak", "final"]
     rec = np.asarray(rows, dtype=float)
-    ref = peaks.refine(line, restep)
+    if peaks.run is not None:
+        ref, nf = ERF.refine(peaks.run, PEAK_SAMPLES, PEAK_RESTEP)
+        n_restep[0] += nf
+    else:
+        ref = peaks.refine(line, restep)
     wall = time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
@@ -448,46 +458,3 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
               "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
     ds = _dataset(line, np.asarray(times), rec, snap_t, snap_z, snap_kind, {**inputs, **results})
     return ElasticRun(ds, {k: {"value": v[0], "t": v[1]} for k, v in ref.items()}, zf, line)
-
-
-def _attrs(name: str) -> dict:
-    for table in (schema.STEP_VARS, schema.PIN_STEP_VARS, schema.BODY_STEP_VARS, schema.ELASTIC_STEP_VARS,
-                  schema.NODE_PROFILE_VARS, schema.LINK_PROFILE_VARS, schema.ELASTIC_LINK_VARS,
-                  schema.COORDS, schema.PROBLEM_VARS):
-        if name in table:
-            return dict(table[name])
-    raise KeyError(name)
-
-
-def _dataset(line, times, rec, snap_t, snap_z, snap_kind, attrs) -> xr.Dataset:
-    """The run Dataset: per-step records, profiles at the snapshots, the problem's arrays."""
-    N = line.N
-    st, sd, nd, ld = schema.STEP_DIM, schema.SNAPSHOT_DIM, schema.NODE_DIM, schema.LINK_DIM
-    data = {name: ((st,), rec[:, k], _attrs(name)) for k, name in enumerate(STEP_NAMES)}
-    order = np.argsort(np.asarray(snap_t), kind="stable")
-    prof = {k: [] for k in ("x", "y", "vx", "vy", "ax", "ay", "speed", "accel", "tension", "strain")}
-    for i in order:
-        t, z = snap_t[i], snap_z[i]
-        x, y, vx, vy = line.unpack(z, t)
-        dz = line.rhs(t, z)
-        pa = line.pin.kinematics(float(t))
-        ax = np.concatenate([dz[2:4 * N:4], [pa[4]]])
-        ay = np.concatenate([dz[3:4 * N:4], [pa[5]]])
-        T, E, _ = line.link_state(t, z)
-        for k, v in (("x", x), ("y", y), ("vx", vx), ("vy", vy), ("ax", ax), ("ay", ay),
-                     ("speed", np.hypot(vx, vy)), ("accel", np.hypot(ax, ay)), ("tension", T), ("strain", E)):
-            prof[k].append(v)
-    for k, v in prof.items():
-        data[k] = ((sd, ld if k in ("tension", "strain") else nd), np.asarray(v), _attrs(k))
-    data["link_length"] = ((ld,), line.h, _attrs("link_length"))
-    data["node_mass"] = ((nd,), np.concatenate([line.m, [0.0]]), _attrs("node_mass"))
-    data["axial_stiffness"] = ((ld,), line.ea, _attrs("axial_stiffness"))
-    coords = {"t": ((st,), times, _attrs("t")),
-              "t_snapshot": ((sd,), np.asarray(snap_t)[order], _attrs("t_snapshot")),
-              "snapshot_kind": ((sd,), np.asarray(snap_kind)[order].astype(str), _attrs("snapshot_kind")),
-              "s_node": ((nd,), np.concatenate([line.snode, [0.0]]), _attrs("s_node")),
-              "s_link": ((ld,), line.snode - 0.5 * line.h, _attrs("s_link"))}
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update({k: (int(v) if isinstance(v, (bool, np.bool_)) else v) for k, v in attrs.items()})
-    ds.attrs["units"] = "nondimensional (length L, mass M, time sqrt(L/g), force M g)"
-    return ds
