@@ -132,19 +132,29 @@ def _slopes(j, z, h, ea, damp, tabe, tabt, T, E):
 
 
 @njit(cache=True, error_model="numpy")
-def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, J, gW, gD):
+def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, J, gW, gD, cw):
     """The exact Jacobian of :func:`rhs` at ``z`` (``T, E, ED, FV, gx, gy`` those :func:`rhs`
     left there): the compact blocks ``J`` (N x 3 x 8), the W row's gradient by link N - 1's
-    variables ``gW`` (4) and the D row's ``gD`` (4N)."""
+    variables ``gW`` (4) and the D row's ``gD`` (4N); ``cw`` (4 x N) work space."""
     J[:] = 0.0
     for i in range(4 * N):
         gD[i] = 0.0
     for k in range(4):
         gW[k] = 0.0
+    co = cw[0]
+    si = cw[1]
+    tls = cw[2]
+    tvs = cw[3]
+    for j in range(N):
+        co[j] = math.cos(z[4 * j + 1])
+        si[j] = math.sin(z[4 * j + 1])
+        tl, tv = _slopes(j, z, h, ea, damp, tabe, tabt, T, E)
+        tls[j] = tl
+        tvs[j] = tv
     for j in range(N):
         l = z[4 * j]
-        cj = math.cos(z[4 * j + 1])
-        sj = math.sin(z[4 * j + 1])
+        cj = co[j]
+        sj = si[j]
         ld = z[4 * j + 2]
         thd = z[4 * j + 3]
         dax, day = _dacc(N, j, pin, invm, g, gx, gy)
@@ -159,9 +169,10 @@ def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, 
                 a = invm[j + 1]
             else:
                 a = -invm[j] - (invm[j + 1] if j + 1 < N else 0.0)
-            tl, tv = _slopes(m, z, h, ea, damp, tabe, tabt, T, E)
-            cm = math.cos(z[4 * m + 1])
-            sm = math.sin(z[4 * m + 1])
+            tl = tls[m]
+            tv = tvs[m]
+            cm = co[m]
+            sm = si[m]
             uu = cj * cm + sj * sm  # u_j . u_m
             un = -cj * sm + sj * cm  # u_j . n_m
             nu = -sj * cm + cj * sm  # n_j . u_m
@@ -193,13 +204,12 @@ def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, 
                 gD[4 * j + 2] = -f
     j = N - 1
     if T[j] > 0.0:
-        tl, tv = _slopes(j, z, h, ea, damp, tabe, tabt, T, E)
-        cj = math.cos(z[4 * j + 1])
-        sj = math.sin(z[4 * j + 1])
+        cj = co[j]
+        sj = si[j]
         uvp = cj * pin[2] + sj * pin[3]
-        gW[0] = tl * uvp
+        gW[0] = tls[j] * uvp
         gW[1] = T[j] * (-sj * pin[2] + cj * pin[3])
-        gW[2] = tv * uvp
+        gW[2] = tvs[j] * uvp
 
 
 @njit(cache=True, error_model="numpy")
@@ -359,7 +369,7 @@ class LinkLine:
         dz = np.empty_like(zl)
         rhs(N, zl, pin, *self.args(), dz, *self.work)
         J, gW, gD = np.zeros((N, 3, 8)), np.zeros(4), np.zeros(4 * N)
-        jacobian(N, zl, pin, *self.args(), *self.work, J, gW, gD)
+        jacobian(N, zl, pin, *self.args(), *self.work, J, gW, gD, np.zeros((4, N)))
         return J, gW, gD
 
     def full_jacobian(self, t, zl):

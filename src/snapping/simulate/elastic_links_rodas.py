@@ -91,11 +91,11 @@ def links_step(N, hs, z0, zn0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g,
 
 @njit(cache=True, error_model="numpy")
 def f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, g, f, B, gW, gD, dsp, T, E, ED, FV,
-                   gx, gy):
+                   gx, gy, cw):
     """``f(t, z)`` and the exact Jacobian there (``dsp``: the D row's span)."""
     EL.pin6_at(t, pinpar, pintab, pin)
     EL.rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, f, T, E, ED, FV, gx, gy)
-    EL.jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, B, gW, gD)
+    EL.jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, g, T, E, ED, FV, gx, gy, B, gW, gD, cw)
     lo, hi = gradient_span(N, gD)
     dsp[0] = lo
     dsp[1] = hi
@@ -103,7 +103,7 @@ def f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, 
 
 @njit(cache=True, error_model="numpy")
 def links_accept(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g,
-                 ytmp, btmp, w, ft, z1, zn1, y0d, yn0d, c23, ctl, T, E, ED, FV, gx, gy):
+                 ytmp, btmp, w, ft, z1, zn1, y0d, yn0d, c23, ctl, T, E, ED, FV, gx, gy, cw):
     """:func:`elastic_rodas.rodas_accept` for the link state ``y`` (node state ``yn``): attempt
     steps, shrinking until one is accepted; then ``y0d``, ``yn0d`` hold the old states, ``y``,
     ``yn`` the new. Returns 0, or 1 when the step fell below 1e-14 |t| (FAILED)."""
@@ -161,7 +161,7 @@ def links_accept(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h,
             ctl[C_TOLD] = t
             ctl[C_T] = tn
             f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
-                           dsp, T, E, ED, FV, gx, gy)
+                           dsp, T, E, ED, FV, gx, gy, cw)
             ctl[C_NFEV] += 1.0
             ctl[C_NJEV] += 1.0
             ctl[C_H] = hnew
@@ -213,6 +213,7 @@ class LinksStepper(RodasStepper):
         self.w = np.zeros(2 * N)
         self.c23 = np.zeros((2, n))
         self.work = tuple(np.zeros(N) for _ in range(6))
+        self.cw = np.zeros((4, N))
         self.pins = np.zeros((7, 6))
         self._dense = None
         self.f_and_jacobian()
@@ -224,7 +225,7 @@ class LinksStepper(RodasStepper):
 
     def f_and_jacobian(self):
         f_and_jacobian(self.N, self.ctl[C_T], self.zl, self.pinpar, self.pintab, self.pins[6], *self.args(),
-                       self.St[0], self.B, self.gW, self.gD, self.dsp, *self.work)
+                       self.St[0], self.B, self.gW, self.gD, self.dsp, *self.work, self.cw)
 
     def _initial_step(self):
         """:meth:`RodasStepper._initial_step` on the node model (the same first step as
@@ -247,7 +248,7 @@ class LinksStepper(RodasStepper):
         t = self.t
         if links_accept(self.N, self.zl, self.yn, self.St, self.B, self.gW, self.gD, self.dsp, self.ab, self.piv,
                         self.pins, self.pinpar, self.pintab, *self.args(), self.ytmp, self.btmp, self.w, self.ft,
-                        self.z1, self.zn1, self.y0d, self.yn0d, self.c23, self.ctl, *self.work) != 0:
+                        self.z1, self.zn1, self.y0d, self.yn0d, self.c23, self.ctl, *self.work, self.cw) != 0:
             return f"step size {self.ctl[C_HFAIL]:.3g} too small at t = {t:.9g}"
         self._dense = LinksDense(self.links, self.t_old, self.t, self.y0d.copy(), self.zl.copy(), self.c23)
         self.yn = self.yn.copy()  # (a new array per step, as scipy's solvers give)
