@@ -182,3 +182,23 @@ def test_energy_balance_closes(damping):
         assert s["dissipated_total"] == pytest.approx(b.summary()["dissipated_total"], rel=1e-4)
     assert s["energy_drift"] < 1e-7
     assert np.abs(a.state - b.state).max() < 1e-6
+
+
+def test_cli_method_rodas4_links(capsys):
+    """``snapping simulate --stretching c --method rodas4-links`` runs the link method (its peaks
+    those of --method rodas4 to 1e-5 at tol 1e-8); on the rigid chain it is bad input (exit 2)."""
+    import json
+
+    from snapping.cli import main
+
+    base = ["simulate", "--chi", "0.25", "--N", "6", "--t-end", "0.3", "--tol", "1e-8", "--no-progress",
+            "--stretching", "20", "--json"]
+    out = {}
+    for m in ("rodas4-links", "rodas4"):
+        assert main(base + ["--method", m]) == 0
+        out[m] = json.loads(capsys.readouterr().out)
+    assert out["rodas4-links"]["method"] == "rodas4-links" and out["rodas4"]["method"] == "rodas4"
+    for k in ("v_peak", "a_peak", "sigma_peak"):
+        assert out["rodas4-links"][k] == pytest.approx(out["rodas4"][k], rel=1e-5)
+    assert main(["simulate", "--chi", "0.25", "--N", "6", "--method", "rodas4-links", "--no-progress"]) == 2
+    assert "extensible line only" in capsys.readouterr().err
