@@ -21,12 +21,17 @@ RODAS4 took; for the nylon line the full run's tension against its converged val
 (``NYLON_T``: levels of 535, 1054 and 2091 graded links by DOP853, tol 1e-6, undamped, order 2.0).
 ``--after-only`` skips the before answers. ``--order LINE`` instead runs LINE's full model on
 graded levels 0, 1, 2 (:meth:`snapping.caps_runs.Runs.graded`) and prints the observed order of
-each peak and the extrapolations from levels 0-1 (what :func:`snapping.caps.cap` answers) and 1-2.
+each peak and the extrapolations from levels 0-1 and 1-2 (``--levels a b c``: other levels).
+``--escalation LINE ...`` runs the answer of each LINE at ``--chi`` on ``--N[0]`` links and, where
+graded, prints every level :func:`snapping.caps_runs.graded_levels` ran, the pair it extrapolated,
+why it stopped, the graded runs' CPU, and beside it the levels-0-1 answer (before the escalation).
 
 Usage::
 
     python benchmarks/bench_caps.py                      # N = 100 200 400 1000, every line
     python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
+    python benchmarks/bench_caps.py --escalation nylon-monofilament fly-line --chi 0.1 --N 200
+    python benchmarks/bench_caps.py --order nylon-monofilament --chi 0.1 --levels 1 2 3
 """
 
 from __future__ import annotations
@@ -52,30 +57,58 @@ def _graded(r: dict) -> str:
     g = r["graded"]
     if not g.get("used"):
         return "-"
-    return f"{g['levels'][0]}/{g['levels'][1]} (T +- {g['relative_error']['sigma_peak']:.2%})"
+    pair = "/".join(str(g["levels"][k]) for k in g["pair"])
+    return (f"{'/'.join(map(str, g['levels']))}: {pair} (T +- {g['relative_error']['sigma_peak']:.2%}, "
+            f"stopped: {g['stopped']})")
 
 
-def _order(name: str, chi: float) -> int:
-    """Graded levels 0, 1, 2 of the full model: observed order, extrapolations 0-1 and 1-2."""
-    import math
-
+def _order(name: str, chi: float, levels=(0, 1, 2)) -> int:
+    """Three graded levels of the full model (``levels``, default 0, 1, 2): observed order,
+    extrapolations of the first two and of the last two."""
     from snapping import caps_runs
 
     sp = caps.spec(name)
     runs = caps_runs.Runs(sp, chi, 1e-6, caps_runs.STIFF_TOL, caps_runs.GRID_DAMPING)
     on = tuple(m for m in caps.MECHANISMS[:-1] if sp.has(m))
-    lv = [runs.graded(on, k) for k in (0, 1, 2)]
+    lv = [runs.graded(on, k) for k in levels]
     si = [caps._si(sp, x) for x in lv]
     print(f"{name}, chi = {chi:g}: graded levels {[x['links'] for x in lv]} links, evaluations "
           f"{[x['n_rhs'] for x in lv]}, CPU s {[round(x['cpu'], 2) for x in lv]}; load {os.getloadavg()[0]:.1f}")
     for q in caps.QUANTITIES:
         v = [x[q] for x in si]
-        p_obs = math.log2(abs((v[1] - v[0]) / (v[2] - v[1])))
+        p_obs = caps_runs.observed_order(*v)
         e01, e12 = caps_runs.richardson(v[0], v[1]), caps_runs.richardson(v[1], v[2])
+        a, b, c = levels
         print(f"  {q}: levels {v[0]:.6g}, {v[1]:.6g}, {v[2]:.6g}; observed order {p_obs:.2f}; extrapolated "
-              f"0-1 {e01[0]:.6g} +- {e01[1]:.2g}, 1-2 {e12[0]:.6g} +- {e12[1]:.2g}")
+              f"{a}-{b} {e01[0]:.6g} +- {e01[1]:.2g}, {b}-{c} {e12[0]:.6g} +- {e12[1]:.2g}")
     if name == "nylon-monofilament":
         print(f"  converged (DOP853, undamped, 535/1054/2091 links): T {NYLON_T} +- {NYLON_T_ERR} N, v {NYLON_V} m/s")
+    return 0
+
+
+def _escalation(names, chi: float, N: int) -> int:
+    """The escalated graded answers (:func:`snapping.caps_runs.graded_levels`) against levels 0-1 alone."""
+    from snapping import caps_runs
+
+    caps.cap("nylon-monofilament", chi, N=8, check=False, alone=False, graded=False)  # compile
+    for name in names:
+        r = caps.cap(name, chi, N=N, check=False)
+        g = r["graded"]
+        if not g.get("used"):
+            print(f"{name}, chi = {chi:g}, N = {N}: not graded ({g.get('why')}); T {r['real']['sigma_peak']:.5g} N")
+            continue
+        lp = g["levels_peaks"]
+        cpu = [x["cpu"] for x in r["runs"] if "graded" in x["run"]]
+        print(f"{name}, chi = {chi:g}, N = {N}: levels {g['levels']} links, graded CPU s "
+              f"{[round(c, 1) for c in cpu]}; answer CPU {r['cpu']:.1f} s, wall {r['wall']:.1f} s; "
+              f"load {os.getloadavg()[0]:.1f}")
+        for q in caps.QUANTITIES:
+            b = caps_runs.richardson(lp[0][q], lp[1][q])
+            obs = g["observed_order"][q] if g["observed_order"] else float("nan")
+            print(f"  {q}: levels {', '.join(f'{x[q]:.6g}' for x in lp)}; before (0-1) {b[0]:.6g} +- "
+                  f"{b[1] / abs(b[0]):.2%}; after {g['pair']} {r['full'][q]:.6g} +- {g['relative_error'][q]:.2%}"
+                  f"; observed order {obs:.2f}")
+        print(f"  stopped: {g['stopped']} ({g['stop_why']}); real T {r['real']['sigma_peak']:.6g} N, cap {r['cap']}")
     return 0
 
 
@@ -87,9 +120,15 @@ def main(argv=None) -> int:
     p.add_argument("--after-only", action="store_true")
     p.add_argument("--before", choices=("uniform", "undamped"), default="uniform")
     p.add_argument("--order", choices=lines.names(), help="verify the graded levels' order on this line")
+    p.add_argument("--levels", nargs=3, type=int, default=[0, 1, 2], help="the three graded levels of --order")
+    p.add_argument("--escalation", nargs="+", choices=lines.names(),
+                   help="the escalated graded answer of these lines at --chi on --N[0] links: each level, the "
+                        "pair extrapolated, why it stopped, CPU; beside it the levels-0-1 answer (before)")
     a = p.parse_args(argv)
     if a.order:
-        return _order(a.order, a.chi)
+        return _order(a.order, a.chi, tuple(a.levels))
+    if a.escalation:
+        return _escalation(a.escalation, a.chi, a.N[0])
     before_kw = {"graded": False} if a.before == "uniform" else {"graded": False, "damping": 0.0}
     caps.cap("bungee-cord", a.chi, N=12)  # compile the kernels (both methods)
     caps.cap("bungee-cord", a.chi, N=12, damping=0.0)

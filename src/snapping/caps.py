@@ -22,7 +22,9 @@ waves grid-damped, :func:`snapping.caps_runs.method_for`):
 (:func:`snapping.caps_runs.grading_rule`: the bending length under 20 links, a run on them folded
 onto one link), the full run is made on two levels of links graded to the free end in bending
 lengths and extrapolated at order 2, with an error estimate per peak (the nylon line: 545 and 1072
-links, its tension within 0.11% of the converged value, estimate 0.55%).
+links, its tension within 0.11% of the converged value, estimate 0.55%); while any peak's estimate
+is over 1% a finer level is run and the last two extrapolated, up to
+:data:`snapping.caps_runs.MAX_GRADED_LINKS` links (:func:`snapping.caps_runs.graded_levels`).
 
 **Stretching** is the elastic model (:func:`snapping.simulate.elastic.solve`), which has no
 bending or drag; it is run when EA is given and matters: when the line's peak speed (the full
@@ -80,7 +82,8 @@ from dataclasses import dataclass, replace
 from . import _validate as V
 from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO,  # noqa: F401
                         STIFF_TOL, STRETCH_LEVELS, STRETCH_METHOD, STRETCH_N, STRETCH_START, Runs, accept_factors,
-                        bending_length, grading_rule, method_for, problem, richardson, stretch_factor)
+                        bending_length, graded_h, graded_levels, grading_rule, method_for, problem, richardson,
+                        stretch_factor)
 from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
@@ -264,8 +267,11 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         the two levels agreed within :data:`RESOLVED`, i.e. whether the factor was applied) and
         ``levels`` (each level's links and factors, where and when its tension peaked)), ``resolution``
         (relative change N/2 -> N per peak; graded: coarse -> fine level), ``graded`` (``used``,
-        ``why``, and when used ``levels`` (links), ``bending_length``, ``error`` (SI) and
-        ``relative_error`` per peak, ``within`` (every peak's error <= 1%)), ``runs`` (each run:
+        ``why``, and when used ``levels`` (links of each level run), ``pair`` (the two levels
+        extrapolated), ``observed_order`` (per peak, from the last three levels; None with two),
+        ``stopped`` (``"within"`` or ``"max_links"``: why no finer level was run) and ``stop_why``,
+        ``bending_length``, ``error`` (SI) and ``relative_error`` per peak, ``within`` (every peak's
+        error <= 1%)), ``runs`` (each run:
         what, links, method, evaluations, CPU s), ``n_rhs``, ``wall`` and ``cpu`` (s).
     """
     from .estimates import check_chi
@@ -300,14 +306,15 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     ideal_nd = runs.get((), N)
     grade = _grading(runs, N, present, graded)
     if grade["used"]:
-        lv = [runs.graded(tuple(present), k) for k in (0, 1)]
-        ext = {q: richardson(lv[0][q], lv[1][q]) for q in QUANTITIES}
-        full_nd = {**{q: ext[q][0] for q in QUANTITIES}, "method": lv[1]["method"]}
-        grade.update(levels=[x["links"] for x in lv], order=GRADED_ORDER,
-                     relative_error={q: ext[q][1] / abs(ext[q][0]) for q in QUANTITIES},
-                     levels_peaks=[_si(sp, x) for x in lv])
-        grade["error"] = _si(sp, {q: ext[q][1] for q in QUANTITIES})
-        grade["within"] = all(v <= RESOLVED for v in grade["relative_error"].values())
+        on, lb = tuple(present), bending_length(sp)
+        gl = graded_levels(lambda k: runs.graded(on, k), lambda k: graded_h(chi, lb, k).size, RESOLVED)
+        lv = [gl["levels"][k] for k in gl["pair"]]  # the two extrapolated: the last two levels run
+        full_nd = {**gl["extrapolated"], "method": lv[1]["method"]}
+        grade.update(levels=[x["links"] for x in gl["levels"]], pair=gl["pair"], order=GRADED_ORDER,
+                     relative_error=gl["relative_error"], observed_order=gl["observed_order"],
+                     stopped=gl["stopped"], stop_why=gl["why"], levels_peaks=[_si(sp, x) for x in gl["levels"]])
+        grade["error"] = _si(sp, gl["error"])
+        grade["within"] = gl["stopped"] == "within"
         check = False
     else:
         full_nd = runs.get(tuple(present), N)
@@ -489,8 +496,12 @@ def format_answer(r: dict) -> list[str]:
     if g.get("too_fine"):
         out.append(f"  graded links: {g['why']}")
     if g.get("used"):
-        out.append(f"  graded links: {g['why']}; full run on {g['levels'][0]} and {g['levels'][1]} links, "
-                   f"extrapolated (order {g['order']:g}): " + ", ".join(
+        a, b = (g["levels"][k] for k in g["pair"])
+        obs = g.get("observed_order")
+        out.append(f"  graded links: {g['why']}; full run on levels of {', '.join(map(str, g['levels']))} links, "
+                   f"{a} and {b} extrapolated (order {g['order']:g}"
+                   + (", observed " + ", ".join(f"{q} {v:.2f}" for q, v in obs.items()) if obs else "")
+                   + f"; {g['stop_why']}): " + ", ".join(
                        f"{q} +- {g['relative_error'][q]:.2%}" for q in QUANTITIES)
                    + f" ({'within' if g['within'] else 'NOT within'} 1%)")
     if r["resolution"]:
@@ -519,10 +530,11 @@ def format_design(d: dict) -> list[str]:
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
                    f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
                    f"{'yes' if r['ideal_admissible'] else 'no':>8}")
-    gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%})" for r in d["rows"]
-          if r.get("graded", {}).get("used")]
+    gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%}"
+          + ("" if r["graded"].get("stopped", "within") == "within" else ", NOT all peaks within 1%") + ")"
+          for r in d["rows"] if r.get("graded", {}).get("used")]
     if gr:
-        out.append(f"  real peaks from graded links, two levels extrapolated, at chi: {', '.join(gr)}")
+        out.append(f"  real peaks from graded links, the last two levels extrapolated, at chi: {', '.join(gr)}")
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:

@@ -56,7 +56,7 @@ def resolved_words(r: dict) -> str:
     if g.get("used"):
         e = g["relative_error"]["sigma_peak"]
         return (f"{'resolved' if e <= RESOLVED else f'not resolved to {RESOLVED:.0%}'} on graded links "
-                f"({g['levels'][0]}/{g['levels'][1]}, extrapolated: +-{e:.1%})")
+                f"({'/'.join(str(g['levels'][k]) for k in g.get('pair', (0, 1)))}, extrapolated: +-{e:.1%})")
     res = r.get("resolution")
     if not res:
         return "not checked"
