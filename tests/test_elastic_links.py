@@ -202,3 +202,21 @@ def test_cli_method_rodas4_links(capsys):
         assert out["rodas4-links"][k] == pytest.approx(out["rodas4"][k], rel=1e-5)
     assert main(["simulate", "--chi", "0.25", "--N", "6", "--method", "rodas4-links", "--no-progress"]) == 2
     assert "extensible line only" in capsys.readouterr().err
+
+
+def test_a_collapsing_link_fails_the_run_at_the_guard():
+    """A slack free-end link at half its rest length closing at speed 20 (no force on it: its
+    length falls linearly) reaches 1e-3 of its rest length at t = (0.5 - 1e-3) h/20: the link
+    method stops there ('failed': an angle is undefined at zero length), where the node method
+    lets the nodes pass each other."""
+    p = Problem.catenary(0.25, links=Links.uniform(20, lumping="shared"))
+    x, y = p.x.copy(), p.y.copy()
+    vx, vy = np.zeros(21), np.zeros(21)
+    d = np.array([x[1] - x[0], y[1] - y[0]])
+    x[0], y[0] = x[1] - 0.5 * d[0], y[1] - 0.5 * d[1]
+    vx[0], vy[0] = 20.0 * d / np.hypot(*d)
+    kw = dict(tol=1e-6, t_end=0.01, initial=(x, y, vx, vy))
+    s = solve(p, Elastic.from_wave_speed(30.0), method="rodas4-links", **kw).summary()
+    assert s["status"] == "failed" and "too small" in s["stop_reason"]
+    assert s["t_final"] == pytest.approx((0.5 - 1e-3) * p.links.h[0] / 20.0, rel=1e-5)
+    assert solve(p, Elastic.from_wave_speed(30.0), method="rodas4", **kw).summary()["status"] == "completed"
