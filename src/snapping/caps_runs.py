@@ -283,7 +283,8 @@ def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start:
     el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method=STRETCH_METHOD,
                start=start).dataset.attrs
     if el.get("status") != "completed":
-        raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')})")
+        raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')}"
+                           + (f"; {el['peak_note']})" if el.get("peak_note") else ")"))
     return {**{q: float(el[q]) / float(rigid[q]) for q in QUANTITIES}, "N": N,
             "n_rhs": int(el["n_rhs"]) + int(rigid["n_rhs"]), "wall": time.perf_counter() - t0,
             "cpu": time.process_time() - c0, "strain_peak": float(el["strain_peak"]),

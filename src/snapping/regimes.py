@@ -186,7 +186,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     a = ds.attrs
     if a.get("status") != "completed":
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
-                           f"{a.get('stop_reason', '')}")
+                           f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
     row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row

@@ -261,6 +261,12 @@ ELASTIC_RESULT_ATTRS: dict[str, str] = {
     "stop_speed_floor": ("running peak of v_max above which the stop rule judges the snap, 2 sqrt(2 U0 / m_min) / "
                          "(1 - stop_fraction) (U0 the elastic energy at t = 0, m_min the smallest node mass)"),
     "t_stop_armed": "time from which the stop rule judged the snap (NaN: never; then no snap is reported)",
+    "peak_ringing": ("the largest tension's oscillation about its level before the snap, over windows of two "
+                     "periods 8 L/c of the slowest longitudinal mode (snapping.simulate.elastic_checks; NaN: "
+                     "not judged)"),
+    "peaks_resolved": ("1 if the peak guard finds a_peak and sigma_peak the line's, 0 if they are the "
+                       "integrator's ringing (then status 'failed'; peak_note says why)"),
+    "peak_note": "the peak guard's rules broken (ringing, slack, energy; empty when resolved)",
 }
 
 ALL_VARS = {**STEP_VARS, **NODE_PROFILE_VARS, **LINK_PROFILE_VARS, **PIN_STEP_VARS, **PROBLEM_VARS,

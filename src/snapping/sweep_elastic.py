@@ -141,8 +141,14 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "str
 
             atomic_to_netcdf(ds, path, overwrite=True)
     a = ds.attrs
+    if a.get("peak_note"):
+        import sys
+
+        print(f"level_row chi={chi:g} ({len(h)} links): elastic run {a.get('status')}: {a['peak_note']}",
+              file=sys.stderr, flush=True)
     row = {q: float(a[q]) if q in a else float("nan") for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak",
                                                                   "t_snap_v")}
     row.update({"n_links": int(len(h)), "wall_time": float(a["wall_time"]), "cpu_time": cpu, "n_rhs": int(a["n_rhs"]),
-                "energy_drift": float(a["energy_drift"]), "link_drift": float("nan")})
+                "energy_drift": float(a["energy_drift"]), "link_drift": float("nan"),
+                "status": str(a.get("status", "")), "peak_note": str(a.get("peak_note", ""))})
     return row

@@ -308,7 +308,8 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
         _print_dimensionless(numbers)
     if summary["status"] != "completed":
-        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}", file=sys.stderr)
+        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}"
+              + (f" (peak guard: {summary['peak_note']})" if summary.get("peak_note") else ""), file=sys.stderr)
         return 1
     return 0
 

@@ -44,6 +44,7 @@ from scipy.integrate import DOP853, Radau
 from .. import _validate as V
 from .. import schema
 from . import elastic_advance as EA
+from . import elastic_checks as EC
 from . import elastic_rodas as ER
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
@@ -443,6 +444,14 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
         "t_stop_armed": float(t_armed),
     }
+    cols = {k: rec[:, STEP_NAMES.index(k)] for k in ("sigma_max", "dt", "n_slack", "sigma_min")}
+    ring, ok, note = EC.peak_guard(np.asarray(times), cols, wave_speed=line.wave_speed, length=float(np.sum(line.h)),
+                                   start=start if initial is None else "initial", t_snap_sigma=ref["sigma"][1],
+                                   energy_drift=results["energy_drift"],
+                                   energy_scale=abs(E0) + abs(float(rec[-1, i_w])) + U0)
+    results.update(peak_ringing=ring, peaks_resolved=int(ok), peak_note=note)
+    if not ok:
+        results["status"] = "failed"  # stop_reason unchanged: peak_note says why
     inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
               "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
               "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
