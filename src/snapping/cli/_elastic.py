@@ -22,7 +22,8 @@ ELASTIC_STARTS = ("stretched", "matched", "unstretched")
 
 
 #: the elastic solver's method for each --method (fast: Radau, the elastic line's default)
-ELASTIC_METHOD = {"dop853": "dop853", "rodas4": "rodas4", "stiff": "rodas4", "radau": "radau"}
+ELASTIC_METHOD = {"dop853": "dop853", "rodas4": "rodas4", "stiff": "rodas4", "radau": "radau",
+                  "rodas4-links": "rodas4-links"}
 
 
 def add_elastic_options(p) -> None:
@@ -123,10 +124,11 @@ def elastic_from_args(args, scales):
         if dest in getattr(args, "_explicit", ()) and getattr(args, dest, None) not in (None, False):
             raise SnappingInputError(f"{why} cannot be given with the extensible line (--ea/--stretching/...)")
     if getattr(args, "method", None) not in (None, "fast", "dop853", "radau", "rodas4", "stiff", "euler-richardson",
-                                             "euler-richardson-fixed"):
+                                             "euler-richardson-fixed", "rodas4-links"):
         opt = "--" + given[0].replace("axial_damping_si", "damping").replace("_", "-")
         raise SnappingInputError(f"--method {args.method} with {opt} (the extensible line): its methods are fast "
-                                 f"(Radau on the banded Jacobian), rodas4 (or stiff: the compiled RODAS4) and dop853")
+                                 f"(Radau on the banded Jacobian), rodas4 (or stiff: the compiled RODAS4), "
+                                 f"rodas4-links (RODAS4 in link coordinates) and dop853")
     from ._body import body_from_args
     from .simulate3d import wants_3d
 

@@ -38,6 +38,8 @@ def _add_simulate(sub) -> None:
             "                          bending stiffness (a body), whose bending waves limit dop853's steps\n"
             "  fast                    always the project's best exact method (the default): dop853, or\n"
             "                          rodas4 for a body whose damped bending waves make dop853 stiff\n"
+            "  rodas4-links            the extensible line only (--ea/--stretching/...): RODAS4 in link\n"
+            "                          coordinates, steps not capped by the wave speed\n"
             "\n"
             "examples:\n"
             "  snapping simulate --chi 0.25 --N 500 -o run.nc\n"
@@ -90,7 +92,8 @@ def _add_simulate(sub) -> None:
     p.add_argument("--tol", type=float, default=None,
                    help="stepper tolerance (default: the method's, fast 1e-6 and euler-richardson the paper's 1e-8)")
     p.add_argument("--method", default="fast",
-                   choices=["fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed"],
+                   choices=["fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed",
+                            "rodas4-links"],
                    help="time stepper (default: fast; every method is listed below)")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")
@@ -166,6 +169,10 @@ def _cmd_simulate(args) -> int:
     from ._elastic import elastic_from_args
 
     elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
+    if elastic is None and args.method == "rodas4-links":
+        raise SnappingInputError("--method rodas4-links steps the extensible line only: give --ea, --stretching or "
+                                 "--strain-table (the rigid chain's methods: fast, dop853, rodas4, stiff, "
+                                 "euler-richardson)")
     from .simulate3d import cmd_simulate3d, wants_3d
 
     if wants_3d(args):  # the chain in space (snapping.spatial)

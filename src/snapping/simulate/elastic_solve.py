@@ -15,6 +15,9 @@ snapshot or 4096 steps), the same numbers as the Python loop (``COMPILED_LOOP = 
 the refinement of its peaks (:mod:`snapping.simulate.elastic_refine`; ``COMPILED_REFINE =
 False``: :meth:`_Peaks.refine`, the same numbers). The Dataset is built by
 :mod:`snapping.simulate.elastic_dataset`.
+``"rodas4-links"`` is the same RODAS4 in link coordinates (each link's length and angle:
+:mod:`snapping.simulate.elastic_links_rodas`), whose steps the wave speed does not cap (the
+elastic guide, "Link coordinates"); it runs the Python loop below.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -48,10 +51,11 @@ from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .elastic_rodas import RodasStepper
+from .elastic_links_rodas import LinksStepper
 
 __all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
 
-METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper}
+METHODS = {"radau": Radau, "dop853": DOP853, "rodas4": RodasStepper, "rodas4-links": LinksStepper}
 #: intervals per step at whose interior points the dense output around each peak is sampled
 PEAK_SAMPLES = 24
 #: samples on either side of the dense output's best one whose states are integrated from the
@@ -279,10 +283,13 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         exceeds 0.1 of the energy the line holds).
     tol : float
         Relative and absolute tolerance of the error control (rtol = atol).
-    method : {"radau", "dop853", "rodas4"}
+    method : {"radau", "dop853", "rodas4", "rodas4-links"}
         scipy's Radau IIA (with the analytic banded Jacobian), explicit DOP853, or the compiled
         RODAS4 of :mod:`snapping.simulate.elastic_rodas` (exact banded Jacobian, O(N) a step;
-        its tolerance is a max norm, Radau's and DOP853's an rms norm).
+        its tolerance is a max norm, Radau's and DOP853's an rms norm); ``"rodas4-links"`` the
+        same RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`: each
+        link's length and angle, steps not capped by the wave speed c; its error measured in
+        node values, so tol means the same; the Python step loop).
     start : {"stretched", "unstretched", "matched"}
         See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
         both ends held, then released (its unloading wave rings); ``"matched"`` the start's
@@ -335,6 +342,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
 
     if method == "rodas4":
         solver = RodasStepper(line, 0.0, z0, t_bound, tol)
+    elif method == "rodas4-links":
+        solver = LinksStepper(line, 0.0, z0, t_bound, tol)
     else:
         kw = {"jac": line.jac} if method == "radau" else {}
         solver = METHODS[method](fun, 0.0, z0, t_bound, rtol=tol, atol=tol, **kw)
@@ -358,6 +367,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     def restep(t0, y0, t1):  # the state at t1 integrated from (t0, y0) with the run's method and tol
         if method == "rodas4":
             st = RodasStepper(line, t0, y0, t1, tol, h0=t1 - t0)
+        elif method == "rodas4-links":
+            st = LinksStepper(line, t0, y0, t1, tol, h0=t1 - t0)
         else:
             kw = {"jac": line.jac} if method == "radau" else {}
             st = METHODS[method](line.rhs, t0, y0, t1, rtol=tol, atol=tol, first_step=t1 - t0, **kw)
