@@ -430,6 +430,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     if peaks.run is not None:
         ref, nf = ERF.refine(peaks.run, PEAK_SAMPLES, PEAK_RESTEP)
         n_restep[0] += nf
+    elif method == "rodas4-links" and COMPILED_REFINE:
+        ref, nf = ERF.refine_segments(solver, peaks.best, peaks.keep, PEAK_SAMPLES, PEAK_RESTEP)
+        n_restep[0] += nf
     else:
         ref = peaks.refine(line, restep)
     wall = time.perf_counter() - wall0
