@@ -25,7 +25,7 @@ from . import elastic_links_rodas as ELR
 from . import elastic_rodas as ER
 from . import elastic_stage as ES
 
-__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "grid"]
+__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "grid", "measure"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -126,7 +126,7 @@ def restep_links(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, ta
 
 
 @njit(cache=True, error_model="numpy")
-def _measure(N, t, z, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, out):
+def measure(N, t, z, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, out):
     """``ElasticLine.measure(t, z)`` into ``out``."""
     pin = np.zeros(4)
     ER.pin_at(t, pinpar, pintab, pin)
@@ -184,9 +184,9 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
                     if links:
                         EL.pin6_at(ts[i], pinpar, pintab, p6)
                         EL.to_nodes(N, yd, p6, yn)
-                        _measure(N, ts[i], yn, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
+                        measure(N, ts[i], yn, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
                     else:
-                        _measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
+                        measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
             for i in range(1, samples):
                 if gm[s, i, c] > gval:
                     gs = s
@@ -218,7 +218,7 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
                 nfev += nf
                 ck_ok[e] = ok
                 if ok:
-                    _measure(N, ts[j], y, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, ck_mm[e])
+                    measure(N, ts[j], y, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, ck_mm[e])
             if ck_ok[e] and ck_mm[e, c] > val:
                 val = ck_mm[e, c]
                 tp = ts[j]
@@ -235,10 +235,11 @@ def refine(run, samples: int, window: int):
 
     st = run.st
     ln = st.line
+    links = hasattr(run, "PN0")
     out = np.zeros((3, 2))
     nfev = refine_slots(st.N, KCOL, run.best, run.keep, run.nkeep, run.PT, run.PY0, run.PY1, run.PC, int(samples),
                         int(window), st.tol, st.ctl[ER.C_AUTO], st.pinpar, st.pintab, ln.h, ln._invm, ln.m, ln.ea,
-                        ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, False, run.PY0)
+                        ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, links, run.PN0 if links else run.PY0)
     return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)
 
 

@@ -226,7 +226,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
     the same bookkeeping, many steps a call). Returns the record rows (t first), the running
     peak's state, the first slack time, when the stop rule was armed, status and reason; the
     snapshots and the peaks' kept steps (refined by :meth:`_Peaks.refine`) are filled in."""
-    run = EA.RodasRun(solver, mm0, energy_fail=ENERGY_ERROR_FAIL, **kw)
+    run = (EA.LinksRun if isinstance(solver, LinksStepper) else EA.RodasRun)(solver, mm0, energy_fail=ENERGY_ERROR_FAIL,
+                                                                            **kw)
     chunks, status = [], "completed"
     while True:
         code = run.advance(snaps[0] if snaps else np.inf)
@@ -241,7 +242,7 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
             if ts >= 0.0:
                 dense = dense or run.last_dense()
                 snap_t.append(ts)
-                snap_z.append(_snapshot(ts, dense.t_old, dense.y0, t, solver.y, restep, lambda: dense))
+                snap_z.append(_snapshot(ts, dense.t_old, run.last_start(), t, solver.y, restep, lambda: dense))
                 snap_kind.append("requested")
         if code in (EA.R_SNAPSHOT, EA.R_BUFFER):
             continue
@@ -377,7 +378,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         n_restep[0] += st.nfev
         return st.y if st.status == "finished" else None
 
-    if method == "rodas4" and COMPILED_LOOP:
+    if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
             solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
