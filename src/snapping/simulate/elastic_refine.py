@@ -44,11 +44,8 @@ def grid(t0, t1, samples, out):
 
 
 @njit(cache=True, error_model="numpy")
-def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, y):
-    """The state at ``t1`` integrated from ``(t0, y0)`` into ``y``, as ``RodasStepper(line, t0,
-    y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it (fresh arrays, the same
-    calls). Returns (finished, evaluations)."""
-    n = y0.shape[0]
+def _fresh_ctl(t0, t1, tol, auto):
+    """A fresh stepper's controls from ``t0`` to ``t1`` (``RodasStepper.__init__``'s)."""
     ctl = np.zeros(ER.NCTL)
     ctl[ER.C_T] = t0
     ctl[ER.C_TOLD] = np.nan
@@ -56,12 +53,33 @@ def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, ta
     ctl[ER.C_TOL] = tol
     ctl[ER.C_HACC] = -1.0
     ctl[ER.C_AUTO] = auto
+    return ctl
+
+
+@njit(cache=True, error_model="numpy")
+def _first_step(ctl, h0):
+    """The first evaluation and Jacobian counted, the first step ``h0``."""
+    ctl[ER.C_NFEV] += 1.0
+    ctl[ER.C_NJEV] += 1.0
+    ctl[ER.C_H] = h0
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobian_work(N, n):
+    """Fresh stage rows ``St`` and Jacobian blocks ``B, gW, gD, dsp`` of a stepper."""
+    return np.zeros((7, n)), np.zeros((N, 3, 8)), np.zeros(4), np.zeros(4 * N), np.zeros(2)
+
+
+@njit(cache=True, error_model="numpy")
+def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, y):
+    """The state at ``t1`` integrated from ``(t0, y0)`` into ``y``, as ``RodasStepper(line, t0,
+    y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it (fresh arrays, the same
+    calls). Returns (finished, evaluations)."""
+    n = y0.shape[0]
+    ctl = _fresh_ctl(t0, t1, tol, auto)
     for i in range(n):
         y[i] = y0[i]
-    St = np.zeros((7, n))
-    B = np.zeros((N, 3, 8))
-    gW, gD = np.zeros(4), np.zeros(4 * N)
-    dsp = np.zeros(2)
+    St, B, gW, gD, dsp = _jacobian_work(N, n)
     F = np.zeros((N, ES.NF))
     ab = np.zeros((2 * N, ES.WIDTH))
     piv = np.zeros(2 * N, dtype=np.int64)
@@ -72,9 +90,7 @@ def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, ta
     pins = np.zeros((7, 4))
     ER.f_and_jacobian(N, t0, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD, dsp,
                       T, E, ED, FV)
-    ctl[ER.C_NFEV] += 1.0
-    ctl[ER.C_NJEV] += 1.0
-    ctl[ER.C_H] = t1 - t0
+    _first_step(ctl, t1 - t0)
     while ctl[ER.C_STATUS] == ER.RUNNING:
         if ER.rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt,
                            g, ytmp, btmp, w, ft, z1, y0d, c23, ctl, T, E, ED, FV) != 0:
@@ -88,23 +104,14 @@ def restep_links(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, ta
     t0, y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it; the node state into
     ``y``. Returns (finished, evaluations)."""
     n = y0.shape[0]
-    ctl = np.zeros(ER.NCTL)
-    ctl[ER.C_T] = t0
-    ctl[ER.C_TOLD] = np.nan
-    ctl[ER.C_TB] = t1
-    ctl[ER.C_TOL] = tol
-    ctl[ER.C_HACC] = -1.0
-    ctl[ER.C_AUTO] = auto
+    ctl = _fresh_ctl(t0, t1, tol, auto)
     pins = np.zeros((7, 6))
     EL.pin6_at(t0, pinpar, pintab, pins[6])
     z = np.empty(n)
     EL.from_nodes(N, y0, pins[6], z)
     for i in range(n):
         y[i] = y0[i]
-    St = np.zeros((7, n))
-    B = np.zeros((N, 3, 8))
-    gW, gD = np.zeros(4), np.zeros(4 * N)
-    dsp = np.zeros(2)
+    St, B, gW, gD, dsp = _jacobian_work(N, n)
     ab = np.zeros((2 * N, ES.WIDTH))
     piv = np.zeros(2 * N, dtype=np.int64)
     ytmp, btmp, z1, zn1, ft, y0d, yn0d = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
@@ -115,9 +122,7 @@ def restep_links(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, ta
     cw = np.zeros((4, N))
     ELR.f_and_jacobian(N, t0, z, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD, dsp,
                        T, E, ED, FV, gx, gy, cw)
-    ctl[ER.C_NFEV] += 1.0
-    ctl[ER.C_NJEV] += 1.0
-    ctl[ER.C_H] = t1 - t0
+    _first_step(ctl, t1 - t0)
     while ctl[ER.C_STATUS] == ER.RUNNING:
         if ELR.links_accept(N, z, y, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt,
                             g, ytmp, btmp, w, ft, z1, zn1, y0d, yn0d, c23, ctl, T, E, ED, FV, gx, gy, cw) != 0:
