@@ -1,5 +1,7 @@
 """The elastic line's RODAS4 run loop, compiled: many steps and their bookkeeping between two
-returns to Python (``elastic.solve(..., method="rodas4")``).
+returns to Python (``elastic.solve(..., method="rodas4")``; :func:`advance_links` and
+:class:`LinksRun` for ``"rodas4-links"``: the link-coordinate step, the node state's measures,
+the same bookkeeping, :func:`_book`).
 
 :func:`advance` takes accepted steps (:func:`snapping.simulate.elastic_rodas.rodas_accept`)
 and after each does what :func:`snapping.simulate.elastic_solve.solve`'s step loop does for

@@ -17,7 +17,9 @@ False``: :meth:`_Peaks.refine`, the same numbers). The Dataset is built by
 :mod:`snapping.simulate.elastic_dataset`.
 ``"rodas4-links"`` is the same RODAS4 in link coordinates (each link's length and angle:
 :mod:`snapping.simulate.elastic_links_rodas`), whose steps the wave speed does not cap (the
-elastic guide, "Link coordinates"); it runs the Python loop below.
+elastic guide, "Link coordinates"); its loop and refinement are compiled too
+(:func:`elastic_advance.advance_links`, :func:`elastic_refine.refine_segments` for the Python
+loop), the same numbers.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -67,11 +69,13 @@ PEAK_RESTEP = 1
 #: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
 #: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
 ENERGY_ERROR_FAIL = 0.1
-#: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
+#: RODAS4 (node and links) runs its step loop compiled (:func:`elastic_advance.advance`,
+#: ``advance_links``); False: the Python loop
 #: below, one step a call (the reference the compiled loop equals, bit for bit)
 COMPILED_LOOP = True
-#: a compiled RODAS4 run refines its peaks compiled (:func:`elastic_refine.refine`); False:
-#: :meth:`_Peaks.refine` on the kept steps (the reference it equals, bit for bit)
+#: a compiled RODAS4 run (and a rodas4-links run of either loop) refines its peaks compiled
+#: (:func:`elastic_refine.refine`, ``refine_segments``); False: :meth:`_Peaks.refine` on the
+#: kept steps (the reference it equals, bit for bit)
 COMPILED_REFINE = True
 
 
@@ -290,7 +294,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         its tolerance is a max norm, Radau's and DOP853's an rms norm); ``"rodas4-links"`` the
         same RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`: each
         link's length and angle, steps not capped by the wave speed c; its error measured in
-        node values, so tol means the same; the Python step loop).
+        node values, so tol means the same; its loop compiled as RODAS4's).
     start : {"stretched", "unstretched", "matched"}
         See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
         both ends held, then released (its unloading wave rings); ``"matched"`` the start's
