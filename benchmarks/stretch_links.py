@@ -85,11 +85,47 @@ def table(rows):
         n, l4, l0 = (by.get(cell + (x,)) for x in ("node z4", "links z4", "links z0"))
         if n is None or l4 is None or l0 is None:
             continue
+        if n["status"] != "completed":
+            print(f"| {cell[0]:g} | {cell[1]:g} | {cell[2]} | {n['cpu']:.2f} / {l4['cpu']:.2f} / {l0['cpu']:.2f} | "
+                  f"node {n['status']} ({n['n_rhs']} evaluations) | "
+                  + ", ".join(f"{l0[q] / l4[q] - 1:+.1e}" for q in ("v_peak", "sigma_peak")) + " |")
+            continue
         print(f"| {cell[0]:g} | {cell[1]:g} | {cell[2]} | {n['cpu']:.2f} / {l4['cpu']:.2f} / {l0['cpu']:.2f} | "
               + ", ".join(f"{l4[q] / n[q] - 1:+.1e}" for q in KEYS) + " | "
               + ", ".join(f"{l0[q] / l4[q] - 1:+.1e}" for q in ("v_peak", "sigma_peak")) + " |")
+    for name in ("node z4", "links z4", "links z0"):
+        rs = [by[cl + (name,)] for cl in cells if all(cl + (x,) in by for x in ("node z4", "links z4", "links z0"))]
+        if rs:
+            print(f"{name}: {len(rs)} runs (the cells with all three), {sum(r['cpu'] for r in rs):.1f} s CPU, "
+                  f"{sum(r['n_rhs'] for r in rs)} evaluations, {sum(r['status'] != 'completed' for r in rs)} failed")
     loads = [r["load"] for r in rows]
     print(f"\n{len(rows)} runs, {sum(r['cpu'] for r in rows):.0f} s CPU, load {min(loads):.1f}-{max(loads):.1f}")
+
+
+def summary(rows, levels=(-4, -3, -2)):
+    """Per cell (chi, c) over ``levels``: summed CPU and evaluations of each method, the worst peak
+    differences to the reference of the same damping, and the grid damping's effect on v_peak."""
+    by = {(r["chi"], r["c"], r["k"], r["run"]): r for r in rows}
+    cells = sorted({(r["chi"], r["c"]) for r in rows}, key=lambda x: (-x[0], -x[1]))
+    print(f"levels {list(levels)}")
+    print("| chi | c | CPU s node z4 / links z4 / links z0 | evaluations node z4 / links z4 / links z0 | "
+          "worst peak error (v, a, sigma) node z4 | links z4 | links z0 | v_peak z0 / z4 - 1 |")
+    print("|---|---|---|---|---|---|---|---|")
+    for chi, c in cells:
+        if not all((chi, c, k, n) in by for k in levels for n in RUNS):
+            continue
+        cpu = [sum(by[(chi, c, k, n)]["cpu"] for k in levels) for n in ("node z4", "links z4", "links z0")]
+        ev = [sum(by[(chi, c, k, n)]["n_rhs"] for k in levels) for n in ("node z4", "links z4", "links z0")]
+        worst = []
+        for n, ref in (("node z4", "ref z4"), ("links z4", "ref z4"), ("links z0", "ref z0")):
+            rs = [(by[(chi, c, k, n)], by[(chi, c, k, ref)]) for k in levels]
+            nf = sum(r["status"] != "completed" for r, _ in rs)
+            w = [max(abs(r[q] / f[q] - 1) for r, f in rs if r["status"] == "completed") if nf < len(rs) else float("nan")
+                 for q in KEYS]
+            worst.append(", ".join(f"{x:.0e}" for x in w) + (f" ({nf} failed)" if nf else ""))
+        dz = [by[(chi, c, k, "links z0")]["v_peak"] / by[(chi, c, k, "links z4")]["v_peak"] - 1 for k in levels]
+        print(f"| {chi:g} | {c:g} | {cpu[0]:.2f} / {cpu[1]:.2f} / {cpu[2]:.2f} | {ev[0]} / {ev[1]} / {ev[2]} | "
+              f"{worst[0]} | {worst[1]} | {worst[2]} | " + ", ".join(f"{x:+.1e}" for x in dz) + " |")
 
 
 def main(argv=None):
@@ -103,13 +139,14 @@ def main(argv=None):
     ap.add_argument("--max-rhs", type=int, default=STRETCH_MAX_RHS)
     ap.add_argument("--out", default="benchmarks/results/stretch_links.jsonl")
     ap.add_argument("--table", action="store_true")
+    ap.add_argument("--summary", action="store_true", help="per cell over the study's levels -4, -3, -2")
     a = ap.parse_args(argv)
     rows = []
     if os.path.exists(a.out):
         with open(a.out) as f:
             rows = [json.loads(line) for line in f if line.strip()]
-    if a.table:
-        table(rows)
+    if a.table or a.summary:
+        table(rows) if a.table else summary(rows)
         return
     done = {(r["chi"], r["c"], r["k"], r["run"]) for r in rows}
     small = cell_problem(0.5, "stretching", 0.1, {"n_links": 4, "frac": 0.25})  # (compile)
