@@ -9,7 +9,9 @@ criterion ``--peak``
 point would be exceeded (the next run's cost is projected from the last: it is not started if
 it would go past the budget):
 
-* this project: ``--methods`` (default ``dop853,rodas4``) at tolerances 1e-3, 3e-4, ...;
+* this project: ``--methods`` (default ``dop853,rodas4``; ``rodas4-links`` the link-coordinate
+  RODAS4) at tolerances 1e-3, 3e-4, ...; with ``--table-only``, ``--methods`` given keeps only
+  this project's cached runs of those methods (the table then is per method);
 * MoorDyn: ``--schemes`` (default ``rk2,rk4``) at steps 0.25 h/c (RK2; h/c for RK4, stable to
   1.41 h/c), halved;
 * PyElastica (``--pyelastica``): PositionVerlet at 0.8 h/c, halved, each with the softest
@@ -52,6 +54,11 @@ TOLS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7)
 
 def _key(code, setting, N, c, start):
     return f"{code}|{setting}|N={N}|c={c:g}|start={start}"
+
+
+def _method(setting):
+    """This project's method in a run's setting (``"tol=0.0003 (rodas4-links)"``)."""
+    return setting.rsplit("(", 1)[-1].rstrip(")")
 
 
 def load():
@@ -226,7 +233,9 @@ def main(argv=None) -> int:
     ap.add_argument("--N", default="100", help="links, comma-separated")
     ap.add_argument("--c", default="30", help="wave speeds c/sqrt(gL), comma-separated")
     ap.add_argument("--start", default="stretched", help="starts, comma-separated (stretched, matched)")
-    ap.add_argument("--methods", default="dop853,rodas4", help="this project's methods")
+    ap.add_argument("--methods", default=None,
+                    help="this project's methods (default dop853,rodas4; rodas4-links); with --table-only, "
+                         "only the cached runs of these (default: all)")
     ap.add_argument("--tols", default="", help="this project's tolerances, in the order tried (default 1e-3 ... 1e-7)")
     ap.add_argument("--schemes", default="rk2,rk4", help="MoorDyn's schemes (its tScheme names)")
     ap.add_argument("--pyelastica", action="store_true", help="run PyElastica too")
@@ -243,6 +252,9 @@ def main(argv=None) -> int:
                     help="runs of more CPU seconds than this are timed once (default 10)")
     ap.add_argument("--table-only", action="store_true", help="only the cached runs (nothing new is run)")
     a = ap.parse_args(argv)
+    only = None if a.methods is None else {m.strip() for m in a.methods.split(",") if m.strip()}
+    if a.methods is None:
+        a.methods = "dop853,rodas4"
     REPEATS, REPEAT_CAP = max(1, a.repeats), a.repeat_cap
     sys.stdout.reconfigure(line_buffering=True)
     E.CRITERION, E.REF_METHOD = a.peak, a.ref_method.lower()
@@ -276,7 +288,8 @@ def main(argv=None) -> int:
                     ref = E.reference(a.chi, N, c, start=start)
                     cache = load()
                     rows = [E.score(E.Result(**v), ref) for k, v in cache.items()
-                            if k.endswith(f"|N={N}|c={c:g}|start={start}")]
+                            if k.endswith(f"|N={N}|c={c:g}|start={start}")
+                            and (only is None or v["code"] != "snapping" or _method(v["setting"]) in only)]
                     points[(N, c, start)] = (ref, rows)
                 else:
                     points[(N, c, start)] = point(a.chi, N, c, start, a, moordyn_ok, elastica_ok)
