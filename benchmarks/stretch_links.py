@@ -56,7 +56,7 @@ def one(chi, c, k, name, tol, ref_tol, max_rhs):
     a = ds.attrs
     return {"chi": chi, "c": c, "k": k, "run": name, "N": int(p.links.N), "tol": ref_tol if is_ref else stretch_tol(tol, c),
             **{q: float(a[q]) for q in KEYS}, "n_rhs": int(a["n_rhs"]), "n_steps": int(a["n_steps"]),
-            "cpu": cpu, "status": str(a["status"]), "stop_reason": str(a.get("stop_reason", "")),
+            "cpu": cpu, "status": str(a["status"]), "stop_reason": str(a.get("stop_reason", "")), "peak_note": str(a.get("peak_note", "")),
             "load": os.getloadavg()[0]}
 
 
