@@ -19,6 +19,11 @@ Usage::
     PYTHONPATH=src python benchmarks/stretch_links.py --chi 0.5 0.3 0.1 --c 442 38.5 7.52 --levels -4 -3 -2 \\
         --out benchmarks/results/stretch_links.jsonl
     PYTHONPATH=src python benchmarks/stretch_links.py --table --out benchmarks/results/stretch_links.jsonl
+    PYTHONPATH=src python benchmarks/stretch_links.py --summary    # per cell over levels -4, -3, -2
+    PYTHONPATH=src python benchmarks/stretch_links.py --chi 0.5 0.1 --c 442 38.5 7.52 --levels -1 0 1 2 \
+        --runs "links z4" --max-rhs 100000                         # the 1% levels
+    PYTHONPATH=src python benchmarks/stretch_links.py --tol 1e-7 --chi 0.5 --c 196 87 442 1000 --levels 2 \
+        --runs "links z4" --max-rhs 100000 --out benchmarks/results/stretch_links_tol1e-7.jsonl
 
 CPU times are noisy on a shared machine: the load average is stored with each run.
 """
