@@ -33,7 +33,7 @@ def test_two_levels_that_agree_are_applied_and_others_left_out():
 def _fake_levels(monkeypatch, levels):
     calls = []
 
-    def fake(sp, chi, tol=1e-6, N=caps.STRETCH_N, start=caps.STRETCH_START):
+    def fake(sp, chi, tol=1e-6, N=caps.STRETCH_N, start=caps.STRETCH_START, method=caps.STRETCH_METHOD):
         calls.append(N)
         return {**levels[N], "N": N, "n_rhs": 7, "wall": 0.0, "cpu": 0.0, "strain_peak": 0.01,
                 "s_sigma": 0.5, "t_sigma": 1.2, "t_snap": 1.19}

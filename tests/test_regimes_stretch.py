@@ -70,7 +70,7 @@ def test_study_records_the_elastic_settings(monkeypatch):
 
     calls = []
 
-    def fake(chi, mech, number, level, tol, damping=None, start=None):
+    def fake(chi, mech, number, level, tol, damping=None, start=None, method=None):
         calls.append((mech, damping, start))
         return {**{q: 1.0 for q in QUANTITIES}, "n_links": 1, "n_rhs": 1, "cpu_time": 0.0}
 

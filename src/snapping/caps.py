@@ -222,7 +222,7 @@ def _si(sp: LineSpec, nd: dict) -> dict:
 
 def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quantity: str = "sigma_peak",
         check: bool = True, alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL,
-        graded="auto", **params) -> dict:
+        graded="auto", stretch_method: str = STRETCH_METHOD, **params) -> dict:
     """The snap of a real line from runs of the real model, the ideal chain's beside it, and
     what caps it (the module's text says how).
 
@@ -247,6 +247,9 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
     damping : float
         The grid damping ratio of a bending line's shortest waves (:data:`GRID_DAMPING`; 0: none,
         every run by the fast method as before).
+    stretch_method : {"rodas4", "rodas4-links"}
+        The elastic line's method in the stretching factor's runs (:func:`stretch_factor`; default
+        :data:`STRETCH_METHOD`, node coordinates; ``"rodas4-links"``: link coordinates).
     stiff_tol : float
         RODAS4's tolerance, in the runs it takes (:func:`method_for`).
     graded : "auto", bool
@@ -283,12 +286,15 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
     tol = V.open_interval("tol", tol, 0.0, 1e-2)
     stiff_tol = V.open_interval("stiff_tol", stiff_tol, 0.0, 1e-2)
+    if not isinstance(stretch_method, str) or stretch_method not in ("rodas4", "rodas4-links"):
+        raise V.SnappingInputError(f"stretch_method={stretch_method!r} is not one of ('rodas4', 'rodas4-links') "
+                                   f"(the elastic line's methods of the stretching factor)")
     damping = V.real("damping", damping)
     if not (math.isfinite(damping) and 0.0 <= damping <= 100.0):
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
     if not (graded == "auto" or graded is True or graded is False):
         raise V.SnappingInputError(f"graded={graded!r} is not one of 'auto', True, False")
-    runs = Runs(sp, chi, tol, stiff_tol, damping)
+    runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method)
     if isinstance(N, str) and N == "auto":
         r = _auto(runs, quantity, alone, graded)
     else:
@@ -330,9 +336,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio,
                            "v_over_c_ideal": ideal_nd["v_peak"] / c})
         if ratio >= STRETCH_MATTERS:
-            sl = [stretch_factor(sp, chi, runs.tol, n) for n in STRETCH_LEVELS]
+            sl = [stretch_factor(sp, chi, runs.tol, n, method=runs.stretch_method) for n in STRETCH_LEVELS]
             for f in sl:
-                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {STRETCH_METHOD}",
+                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {runs.stretch_method}",
                                  "tol": runs.tol, "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
             factor_s, ok = accept_factors(*({q: f[q] for q in QUANTITIES} for f in sl), RESOLVED)
             stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"],

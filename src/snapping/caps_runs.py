@@ -266,12 +266,14 @@ def _run(problem_, method: str, tol: float) -> dict:
             "method": str(a["method"]), "tol": tol, "wall": time.perf_counter() - t0, "cpu": time.process_time() - c0}
 
 
-def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start: str = STRETCH_START) -> dict:
+def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start: str = STRETCH_START,
+                   method: str = STRETCH_METHOD) -> dict:
     """The elastic line over the rigid chain on the same ``N`` uniform links (shared lumping),
     peak by peak: one level of the stretching factor of :func:`snapping.caps.cap` (which takes two,
     :data:`STRETCH_LEVELS`, and applies a peak's factor only where they agree: :func:`accept_factors`).
     The elastic line starts ``start`` (:data:`STRETCH_START`), grid damping 1, by
-    :data:`STRETCH_METHOD` at ``tol``; the rigid chain by the fast method at ``tol``.
+    ``method`` (default :data:`STRETCH_METHOD`; ``"rodas4-links"``: link coordinates) at ``tol``; the rigid
+    chain by the fast method at ``tol``.
     Besides the ratios: ``s_sigma`` and ``t_sigma``, where (arclength from the held end) and when the
     elastic line's tension peaks, ``t_snap`` the rigid chain's (its tension peak's) time."""
     from .simulate import Links, Problem, run
@@ -280,7 +282,7 @@ def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start:
     t0, c0 = time.perf_counter(), time.process_time()
     p = Problem.catenary(chi, links=Links.uniform(N, lumping="shared"))
     rigid = run(p, method="fast", tol=tol, progress=False).dataset.attrs
-    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method=STRETCH_METHOD,
+    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=tol, method=method,
                start=start).dataset.attrs
     if el.get("status") != "completed":
         raise RuntimeError(f"the elastic run did not complete ({el.get('stop_reason', '')}"
@@ -309,8 +311,9 @@ class Runs:
     """The runs of one answer of :func:`snapping.caps.cap`, each made once: ``get(on, N)`` (``on``
     the mechanisms, () the ideal) runs it or returns it; ``log`` says what each cost."""
 
-    def __init__(self, sp, chi, tol, stiff_tol, damping):
+    def __init__(self, sp, chi, tol, stiff_tol, damping, stretch_method=STRETCH_METHOD):
         self.sp, self.chi, self.tol, self.stiff_tol, self.damping = sp, chi, tol, stiff_tol, damping
+        self.stretch_method = stretch_method  # the stretching factor's elastic method (:func:`stretch_factor`)
         self.done, self.log = {}, []
 
     def get(self, on, N: int) -> dict:

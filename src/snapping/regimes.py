@@ -66,7 +66,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TOL_C, stretch_tol)
+                           STRETCH_METHODS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TOL_C, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
@@ -167,9 +167,9 @@ def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping
     return Problem.catenary(chi, links=Links.graded(h, lumping=lumping, tip_mass=tip), chords="exact", body=body)
 
 
-def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=STRETCH_START):
+def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=STRETCH_START, method=STRETCH_METHOD):
     """Worker: one run of one cell at one level; its peaks and cost (no file: the study keeps them).
-    ``start``: the elastic line's (stretching only)."""
+    ``start``, ``method``: the elastic line's (stretching only)."""
     from .simulate import run
 
     problem = cell_problem(chi, mechanism, number, level, damping=damping)
@@ -178,7 +178,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
         from .simulate.elastic import Elastic, solve
 
         ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
-                   tol=stretch_tol(tol, 1.0 / number), method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR,
+                   tol=stretch_tol(tol, 1.0 / number), method=method, stop_floor=STRETCH_STOP_FLOOR,
                    start=start, max_rhs=STRETCH_MAX_RHS).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
@@ -314,7 +314,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 
 def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
             first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
-            damping: float | None = None, start: str = STRETCH_START, workers: int = 1, scheduler=None, out=None,
+            damping: float | None = None, start: str = STRETCH_START, method: str | None = None, workers: int = 1, scheduler=None, out=None,
             progress: bool = True) -> xr.Dataset:
     """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
 
@@ -343,6 +343,10 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         Stretching only: the elastic line's start (:func:`snapping.simulate.elastic.solve`),
         stored as the attribute ``elastic_start`` (and, other than ``"stretched"``, in the
         study's key: a stop-29 file, run from ``"stretched"``, is resumed by that value).
+    method : {"rodas4", "rodas4-links"}, optional
+        Stretching only: the elastic line's method (default ``STRETCH_METHOD``, ``"rodas4"``, the shipped
+        study's; ``"rodas4-links"``: RODAS4 in link coordinates, steps not capped by c). Stored as the
+        attribute ``elastic_method`` and in the study's key (a file of the other method is refused).
     workers : int
         Local worker processes (the sweep's, :mod:`snapping._workers`).
     scheduler : str or dask.distributed.Client, optional
@@ -394,10 +398,17 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
 
         if not isinstance(start, str) or start not in STARTS:
             raise V.SnappingInputError(f"start={start!r} is not one of {STARTS} (the elastic line's starts)")
-        acc.update(elastic_method=STRETCH_METHOD, stop_floor=STRETCH_STOP_FLOOR)
+        method = STRETCH_METHOD if method is None else method
+        if not isinstance(method, str) or method not in STRETCH_METHODS:
+            raise V.SnappingInputError(f"method={method!r} is not one of {STRETCH_METHODS} (a stretching study's "
+                                       f"elastic methods)")
+        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR)
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
             acc["elastic_start"] = start
             acc["tol_c"] = STRETCH_TOL_C  # stiffer lines' runs at tol (tol_c/c)^2 (regimes_spec.stretch_tol)
+    elif method is not None:
+        raise V.SnappingInputError(f"method={method!r}: the elastic method is for the stretching mechanism only, "
+                                   f"not {mechanism!r}")
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
@@ -452,7 +463,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         if j is None:
             calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
         else:
-            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start)
+            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start,
+                        acc.get("elastic_method", STRETCH_METHOD))
     for args in calls.values():  # every run's problem is checked before any starts
         cell_problem(*args[:4], damping=damping)
 

@@ -6,7 +6,7 @@ line can build its parser, and answer a table query, without importing them.
 
 from __future__ import annotations
 
-__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_STOP_FLOOR", "STRETCH_START",
+__all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_METHODS", "STRETCH_STOP_FLOOR", "STRETCH_START",
            "STRETCH_DAMPING", "STRETCH_MAX_RHS",
            "STRETCH_TOL_C", "stretch_tol"]
 
@@ -37,6 +37,10 @@ NUMBER_MAX = 1e4
 #: stretching: the elastic line's method in a study (the compiled RODAS4 of
 #: :mod:`snapping.simulate.elastic_rodas`; its grid damping is the study's ``damping``)
 STRETCH_METHOD = "rodas4"
+#: stretching: the elastic methods a study may take (``regimes(method=)``): the default node-coordinate
+#: RODAS4, or RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`), whose steps
+#: are not capped by the wave speed c (``benchmarks/stretch_links.py``, docs/guide/regimes.md)
+STRETCH_METHODS = ("rodas4", "rodas4-links")
 #: stretching: the running peak of v_max (units sqrt(g L)) above which the elastic run's stop rule
 #: judges the snap (:func:`snapping.simulate.elastic.solve`'s ``stop_floor``). Its default bound,
 #: from the release's elastic energy given to the lightest node, exceeds the snap itself on

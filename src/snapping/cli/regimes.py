@@ -46,6 +46,9 @@ def _add_regimes(sub) -> None:
                         "stretching (the longitudinal waves; default 4)")
     p.add_argument("--start", default="matched", choices=["matched", "stretched", "unstretched"],
                    help="stretching: the elastic line's start (default matched: no release wave)")
+    p.add_argument("--elastic-method", default=None, choices=["rodas4", "rodas4-links"],
+                   help="stretching: the elastic line's method (default rodas4, node coordinates, the shipped study's; "
+                        "rodas4-links: link coordinates, steps not capped by the wave speed)")
     p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     p.add_argument("-o", "--output", default=None, metavar="FILE", help="the study file (netCDF), resumable")
@@ -78,7 +81,8 @@ def _cmd_regimes(args) -> int:
         if missing:
             raise SnappingInputError(f"regimes needs {', '.join(missing)} (or --load FILE)")
         ds = R.regimes(args.mechanism, args.chi, args.numbers, accuracy=args.accuracy, levels=args.levels,
-                       first=args.first, n0=args.n0, damping=args.damping, start=args.start, workers=args.workers, scheduler=args.scheduler,
+                       first=args.first, n0=args.n0, damping=args.damping, start=args.start,
+                       method=args.elastic_method, workers=args.workers, scheduler=args.scheduler,
                        out=args.output, progress=not args.no_progress)
     if args.json:
         out = {q: A.analyze(ds, q) for q in ("v_peak", "a_peak", "sigma_peak")}
