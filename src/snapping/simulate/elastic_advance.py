@@ -1,5 +1,7 @@
 """The elastic line's RODAS4 run loop, compiled: many steps and their bookkeeping between two
-returns to Python (``elastic.solve(..., method="rodas4")``).
+returns to Python (``elastic.solve(..., method="rodas4")``; :func:`advance_links` and
+:class:`LinksRun` for ``"rodas4-links"``: the link-coordinate step, the node state's measures,
+the same bookkeeping, :func:`_book`).
 
 :func:`advance` takes accepted steps (:func:`snapping.simulate.elastic_rodas.rodas_accept`)
 and after each does what :func:`snapping.simulate.elastic_solve.solve`'s step loop does for
@@ -24,9 +26,11 @@ import numpy as np
 from numba import njit
 
 from . import elastic_kernels as EK
+from . import elastic_links_rodas as ELR
+from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 
-__all__ = ["advance", "RodasRun", "NREC", "NSLOT"]
+__all__ = ["advance", "advance_links", "RodasRun", "LinksRun", "NREC", "NSLOT"]
 
 #: columns of a record row: t, then elastic_solve.STEP_NAMES
 NREC = 19
@@ -79,6 +83,77 @@ def _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best):
 
 
 @njit(cache=True, error_model="numpy")
+def _free(ref):
+    """The first step slot no one uses."""
+    s = 0
+    while ref[s] > 0:
+        s += 1
+    return s
+
+
+@njit(cache=True, error_model="numpy")
+def _book(N, t, t_old, y, mm, s, s_node, s_link, nfev, finished, ref, keep, nkeep, after, best, sctl, rec, peak_z):
+    """The bookkeeping of the accepted step ``t_old -> t`` in slot ``s`` ending at the node state
+    ``y`` with the measures ``mm``: its record row, the peaks, the first slack time, the running
+    peak and its state, then the checks. Returns an ``R_*`` code, or -1 to go on."""
+    n = y.shape[0]
+    r = int(sctl[S_NREC])
+    row = rec[r]
+    W = y[4 * N]
+    D = y[4 * N + 1]
+    row[0] = t
+    row[1] = t - t_old
+    row[2] = mm[0]
+    row[3] = mm[2]
+    row[4] = mm[4]
+    row[5] = s_node[int(mm[1])]
+    row[6] = s_node[int(mm[3])]
+    row[7] = s_link[int(mm[5])]
+    row[8] = mm[6]
+    row[9] = mm[8]
+    row[10] = mm[9]
+    row[11] = mm[10]
+    row[12] = mm[11]
+    row[13] = mm[12] + mm[13] + mm[14]
+    row[14] = mm[14]
+    row[15] = W
+    row[16] = D
+    row[17] = mm[15]
+    row[18] = mm[16]
+    sctl[S_NREC] = r + 1
+    prev = int(sctl[S_PREV])
+    _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best)
+    sctl[S_PREV] = s
+    if mm[16] > 0 and np.isnan(sctl[S_SLACK]):
+        sctl[S_SLACK] = t
+    if mm[0] > sctl[S_RUN]:
+        sctl[S_RUN] = mm[0]
+        sctl[S_PEAKT] = t
+        for i in range(n):
+            peak_z[i] = y[i]
+    for i in range(n):
+        if not (y[i] - y[i] == 0.0):
+            return R_NONFINITE
+    if nfev > sctl[S_MAXRHS]:
+        return R_MAXRHS
+    tend = sctl[S_TEND] != 0.0
+    sctl[S_ERR] = max(sctl[S_ERR], abs(row[13] - W + D - sctl[S_E0]))
+    if np.isnan(sctl[S_ARMED]) and sctl[S_RUN] >= sctl[S_FLOOR]:
+        sctl[S_ARMED] = t
+    if not tend and not np.isnan(sctl[S_ARMED]) and mm[0] < sctl[S_FRAC] * sctl[S_RUN]:
+        return R_SNAP
+    if not tend and sctl[S_ERR] > sctl[S_EFAIL] * (abs(sctl[S_E0]) + abs(W) + sctl[S_U0]):
+        return R_ENERGY
+    if finished:
+        return R_FINISHED
+    if t >= sctl[S_TSNAP]:
+        return R_SNAPSHOT
+    if r + 1 == rec.shape[0]:
+        return R_BUFFER
+    return -1
+
+
+@njit(cache=True, error_model="numpy")
 def advance(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, ytmp,
             btmp, w, ft, ctl, T, E, ED, FV, m, tabw, snode, s_node, s_link, mm, PY0, PY1, PC, PT, ref, keep, nkeep,
             after, best, sctl, rec, peak_z):
@@ -86,13 +161,9 @@ def advance(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm,
     codes (see the module). Slot ``s`` of the pool holds a step's start ``PY0[s]``, end
     ``PY1[s]``, dense output ``PC[s]`` and ``PT[s] = (t_old, t)``; ``ref[s]`` counts its users
     (the kept steps of the peaks, the last step)."""
-    n = y.shape[0]
     pin = pins[6]
-    tend = sctl[S_TEND] != 0.0
     while True:
-        s = 0
-        while ref[s] > 0:
-            s += 1
+        s = _free(ref)
         if ER.rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe,
                            tabt, g, ytmp, btmp, w, ft, PY1[s], PY0[s], PC[s], ctl, T, E, ED, FV) != 0:
             return R_STEP_FAILED
@@ -101,58 +172,34 @@ def advance(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm,
         PT[s, 1] = t
         # St[0] = f(t, y) and T, E its tensions and strains, with the held end at t (pins[6])
         EK.measure_given(N, y, pin, h, m, ea, tabe, tabt, tabw, g, snode, St[0], T, E, mm)
-        r = int(sctl[S_NREC])
-        row = rec[r]
-        W = y[4 * N]
-        D = y[4 * N + 1]
-        row[0] = t
-        row[1] = t - ctl[ER.C_TOLD]
-        row[2] = mm[0]
-        row[3] = mm[2]
-        row[4] = mm[4]
-        row[5] = s_node[int(mm[1])]
-        row[6] = s_node[int(mm[3])]
-        row[7] = s_link[int(mm[5])]
-        row[8] = mm[6]
-        row[9] = mm[8]
-        row[10] = mm[9]
-        row[11] = mm[10]
-        row[12] = mm[11]
-        row[13] = mm[12] + mm[13] + mm[14]
-        row[14] = mm[14]
-        row[15] = W
-        row[16] = D
-        row[17] = mm[15]
-        row[18] = mm[16]
-        sctl[S_NREC] = r + 1
-        prev = int(sctl[S_PREV])
-        _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best)
-        sctl[S_PREV] = s
-        if mm[16] > 0 and np.isnan(sctl[S_SLACK]):
-            sctl[S_SLACK] = t
-        if mm[0] > sctl[S_RUN]:
-            sctl[S_RUN] = mm[0]
-            sctl[S_PEAKT] = t
-            for i in range(n):
-                peak_z[i] = y[i]
-        for i in range(n):
-            if not (y[i] - y[i] == 0.0):
-                return R_NONFINITE
-        if ctl[ER.C_NFEV] > sctl[S_MAXRHS]:
-            return R_MAXRHS
-        sctl[S_ERR] = max(sctl[S_ERR], abs(row[13] - W + D - sctl[S_E0]))
-        if np.isnan(sctl[S_ARMED]) and sctl[S_RUN] >= sctl[S_FLOOR]:
-            sctl[S_ARMED] = t
-        if not tend and not np.isnan(sctl[S_ARMED]) and mm[0] < sctl[S_FRAC] * sctl[S_RUN]:
-            return R_SNAP
-        if not tend and sctl[S_ERR] > sctl[S_EFAIL] * (abs(sctl[S_E0]) + abs(W) + sctl[S_U0]):
-            return R_ENERGY
-        if ctl[ER.C_STATUS] == ER.FINISHED:
-            return R_FINISHED
-        if t >= sctl[S_TSNAP]:
-            return R_SNAPSHOT
-        if r + 1 == rec.shape[0]:
-            return R_BUFFER
+        code = _book(N, t, ctl[ER.C_TOLD], y, mm, s, s_node, s_link, ctl[ER.C_NFEV], ctl[ER.C_STATUS] == ER.FINISHED,
+                     ref, keep, nkeep, after, best, sctl, rec, peak_z)
+        if code >= 0:
+            return code
+
+
+@njit(cache=True, error_model="numpy")
+def advance_links(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g,
+                  ytmp, btmp, w, ft, zn1, ctl, T, E, ED, FV, gx, gy, cw, m, tabw, snode, s_node, s_link, mm, PY0, PY1,
+                  PC, PT, PN0, ref, keep, nkeep, after, best, sctl, rec, peak_z):
+    """:func:`advance` for ``"rodas4-links"`` (:func:`elastic_links_rodas.links_accept` on the
+    link state ``y``, node state ``yn``): slot ``s`` holds the step's link states ``PY0[s]``,
+    ``PY1[s]``, dense output ``PC[s]`` and node start ``PN0[s]``; the measures are the node
+    state's (``ElasticLine.measure``), as the Python loop takes them."""
+    while True:
+        s = _free(ref)
+        if ELR.links_accept(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe,
+                            tabt, g, ytmp, btmp, w, ft, PY1[s], zn1, PY0[s], PN0[s], PC[s], ctl, T, E, ED, FV, gx, gy,
+                            cw) != 0:
+            return R_STEP_FAILED
+        t = ctl[ER.C_T]
+        PT[s, 0] = ctl[ER.C_TOLD]
+        PT[s, 1] = t
+        ERF.measure(N, t, yn, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, mm)
+        code = _book(N, t, ctl[ER.C_TOLD], yn, mm, s, s_node, s_link, ctl[ER.C_NFEV], ctl[ER.C_STATUS] == ER.FINISHED,
+                     ref, keep, nkeep, after, best, sctl, rec, peak_z)
+        if code >= 0:
+            return code
 
 
 class RodasRun:
@@ -205,9 +252,40 @@ class RodasRun:
     def last_dense(self):
         return self.dense(int(self.sctl[S_PREV]))
 
+    def start(self, s):
+        """The node state at the start of the step in slot ``s``."""
+        return self.PY0[s].copy()
+
+    def last_start(self):
+        return self.start(int(self.sctl[S_PREV]))
+
     def segments(self):
         """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
         (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
         return {k: (float(self.best[k, 0]), float(self.best[k, 1]),
-                    [(float(self.PT[s, 0]), self.PY0[s].copy(), float(self.PT[s, 1]), self.dense(int(s)))
+                    [(float(self.PT[s, 0]), self.start(int(s)), float(self.PT[s, 1]), self.dense(int(s)))
                      for s in self.keep[k, :self.nkeep[k]]]) for k in range(3)}
+
+
+class LinksRun(RodasRun):
+    """:class:`RodasRun` for a :class:`~snapping.simulate.elastic_links_rodas.LinksStepper`
+    (:func:`advance_links`): the slots hold link states, and ``PN0`` the steps' node starts."""
+
+    def __init__(self, stepper, mm0, **kw):
+        super().__init__(stepper, mm0, **kw)
+        self.PN0 = np.zeros_like(self.PY0)
+
+    def advance(self, t_snapshot=np.inf) -> int:
+        st = self.st
+        self.sctl[S_TSNAP] = t_snapshot
+        return advance_links(st.N, st.zl, st.yn, st.St, st.B, st.gW, st.gD, st.dsp, st.ab, st.piv, st.pins,
+                             st.pinpar, st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.zn1, st.ctl,
+                             *st.work, st.cw, *self.model, self.mm, self.PY0, self.PY1, self.PC, self.PT, self.PN0,
+                             self.ref, self.keep, self.nkeep, self.after, self.best, self.sctl, self.rec, self.peak_z)
+
+    def dense(self, s):
+        return ELR.LinksDense(self.st.links, self.PT[s, 0], self.PT[s, 1], self.PY0[s].copy(), self.PY1[s].copy(),
+                              self.PC[s])
+
+    def start(self, s):
+        return self.PN0[s].copy()

@@ -20,10 +20,12 @@ import numpy as np
 from numba import njit
 
 from . import elastic_kernels as EK
+from . import elastic_links as EL
+from . import elastic_links_rodas as ELR
 from . import elastic_rodas as ER
 from . import elastic_stage as ES
 
-__all__ = ["refine", "refine_slots", "restep", "grid"]
+__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "grid", "measure"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -42,11 +44,8 @@ def grid(t0, t1, samples, out):
 
 
 @njit(cache=True, error_model="numpy")
-def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, y):
-    """The state at ``t1`` integrated from ``(t0, y0)`` into ``y``, as ``RodasStepper(line, t0,
-    y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it (fresh arrays, the same
-    calls). Returns (finished, evaluations)."""
-    n = y0.shape[0]
+def _fresh_ctl(t0, t1, tol, auto):
+    """A fresh stepper's controls from ``t0`` to ``t1`` (``RodasStepper.__init__``'s)."""
     ctl = np.zeros(ER.NCTL)
     ctl[ER.C_T] = t0
     ctl[ER.C_TOLD] = np.nan
@@ -54,12 +53,33 @@ def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, ta
     ctl[ER.C_TOL] = tol
     ctl[ER.C_HACC] = -1.0
     ctl[ER.C_AUTO] = auto
+    return ctl
+
+
+@njit(cache=True, error_model="numpy")
+def _first_step(ctl, h0):
+    """The first evaluation and Jacobian counted, the first step ``h0``."""
+    ctl[ER.C_NFEV] += 1.0
+    ctl[ER.C_NJEV] += 1.0
+    ctl[ER.C_H] = h0
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobian_work(N, n):
+    """Fresh stage rows ``St`` and Jacobian blocks ``B, gW, gD, dsp`` of a stepper."""
+    return np.zeros((7, n)), np.zeros((N, 3, 8)), np.zeros(4), np.zeros(4 * N), np.zeros(2)
+
+
+@njit(cache=True, error_model="numpy")
+def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, y):
+    """The state at ``t1`` integrated from ``(t0, y0)`` into ``y``, as ``RodasStepper(line, t0,
+    y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it (fresh arrays, the same
+    calls). Returns (finished, evaluations)."""
+    n = y0.shape[0]
+    ctl = _fresh_ctl(t0, t1, tol, auto)
     for i in range(n):
         y[i] = y0[i]
-    St = np.zeros((7, n))
-    B = np.zeros((N, 3, 8))
-    gW, gD = np.zeros(4), np.zeros(4 * N)
-    dsp = np.zeros(2)
+    St, B, gW, gD, dsp = _jacobian_work(N, n)
     F = np.zeros((N, ES.NF))
     ab = np.zeros((2 * N, ES.WIDTH))
     piv = np.zeros(2 * N, dtype=np.int64)
@@ -70,9 +90,7 @@ def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, ta
     pins = np.zeros((7, 4))
     ER.f_and_jacobian(N, t0, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD, dsp,
                       T, E, ED, FV)
-    ctl[ER.C_NFEV] += 1.0
-    ctl[ER.C_NJEV] += 1.0
-    ctl[ER.C_H] = t1 - t0
+    _first_step(ctl, t1 - t0)
     while ctl[ER.C_STATUS] == ER.RUNNING:
         if ER.rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt,
                            g, ytmp, btmp, w, ft, z1, y0d, c23, ctl, T, E, ED, FV) != 0:
@@ -81,7 +99,39 @@ def restep(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, ta
 
 
 @njit(cache=True, error_model="numpy")
-def _measure(N, t, z, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, out):
+def restep_links(N, t0, y0, t1, tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g, y):
+    """:func:`restep` for ``"rodas4-links"``: from the node state ``y0``, as ``LinksStepper(line,
+    t0, y0, t1, tol, h0=t1 - t0)`` stepped until it stops would give it; the node state into
+    ``y``. Returns (finished, evaluations)."""
+    n = y0.shape[0]
+    ctl = _fresh_ctl(t0, t1, tol, auto)
+    pins = np.zeros((7, 6))
+    EL.pin6_at(t0, pinpar, pintab, pins[6])
+    z = np.empty(n)
+    EL.from_nodes(N, y0, pins[6], z)
+    for i in range(n):
+        y[i] = y0[i]
+    St, B, gW, gD, dsp = _jacobian_work(N, n)
+    ab = np.zeros((2 * N, ES.WIDTH))
+    piv = np.zeros(2 * N, dtype=np.int64)
+    ytmp, btmp, z1, zn1, ft, y0d, yn0d = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                                          np.zeros(n), np.zeros(n))
+    w = np.zeros(2 * N)
+    c23 = np.zeros((2, n))
+    T, E, ED, FV, gx, gy = np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N)
+    cw = np.zeros((4, N))
+    ELR.f_and_jacobian(N, t0, z, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD, dsp,
+                       T, E, ED, FV, gx, gy, cw)
+    _first_step(ctl, t1 - t0)
+    while ctl[ER.C_STATUS] == ER.RUNNING:
+        if ELR.links_accept(N, z, y, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt,
+                            g, ytmp, btmp, w, ft, z1, zn1, y0d, yn0d, c23, ctl, T, E, ED, FV, gx, gy, cw) != 0:
+            break
+    return ctl[ER.C_STATUS] == ER.FINISHED, ctl[ER.C_NFEV]
+
+
+@njit(cache=True, error_model="numpy")
+def measure(N, t, z, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, out):
     """``ElasticLine.measure(t, z)`` into ``out``."""
     pin = np.zeros(4)
     ER.pin_at(t, pinpar, pintab, pin)
@@ -93,11 +143,16 @@ def _measure(N, t, z, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode
 
 @njit(cache=True, error_model="numpy")
 def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, tol, auto, pinpar, pintab, h, invm,
-                 m, ea, damp, tabe, tabt, tabw, g, snode, out):
+                 m, ea, damp, tabe, tabt, tabw, g, snode, out, links, PR0):
     """``_Peaks.refine`` on the kept step slots (``keep[k, :nkeep[k]]`` of ``RodasRun``) of the
     kinds ``kcol`` (measure columns) with the running peaks ``best``: the refined (value, time)
-    of each kind into ``out``; returns the evaluations of the integrations."""
+    of each kind into ``out``; returns the evaluations of the integrations. ``links``: the
+    slots' ``PY0, PY1, PC`` are link states (their dense output is mapped to the nodes), the
+    integrations :func:`restep_links`'; ``PR0`` the node states the integrations start from
+    (``PY0`` itself for ``"rodas4"``)."""
     n = PY0.shape[1]
+    p6 = np.zeros(6)
+    yn = np.empty(n)
     nk = kcol.shape[0]
     ts = np.empty(samples + 1)
     y = np.empty(n)
@@ -131,7 +186,12 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
                     x = (ts[i] - t_old) / (t_new - t_old)
                     for r in range(n):
                         yd[r] = PY0[s, r] * (1.0 - x) + x * (PY1[s, r] + (1.0 - x) * (PC[s, 0, r] + x * PC[s, 1, r]))
-                    _measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
+                    if links:
+                        EL.pin6_at(ts[i], pinpar, pintab, p6)
+                        EL.to_nodes(N, yd, p6, yn)
+                        measure(N, ts[i], yn, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
+                    else:
+                        measure(N, ts[i], yd, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, gm[s, i])
             for i in range(1, samples):
                 if gm[s, i, c] > gval:
                     gs = s
@@ -154,12 +214,16 @@ def refine_slots(N, kcol, best, keep, nkeep, PT, PY0, PY1, PC, samples, window, 
                 nc += 1
                 ck_t[e] = t_old
                 ck_j[e] = j
-                ok, nf = restep(N, t_old, PY0[gs], ts[j], tol, auto, pinpar, pintab, h, invm, ea, damp, tabe, tabt,
-                                g, y)
+                if links:
+                    ok, nf = restep_links(N, t_old, PR0[gs], ts[j], tol, auto, pinpar, pintab, h, invm, ea, damp,
+                                          tabe, tabt, g, y)
+                else:
+                    ok, nf = restep(N, t_old, PR0[gs], ts[j], tol, auto, pinpar, pintab, h, invm, ea, damp, tabe,
+                                    tabt, g, y)
                 nfev += nf
                 ck_ok[e] = ok
                 if ok:
-                    _measure(N, ts[j], y, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, ck_mm[e])
+                    measure(N, ts[j], y, pinpar, pintab, h, m, ea, damp, tabe, tabt, tabw, g, snode, ck_mm[e])
             if ck_ok[e] and ck_mm[e, c] > val:
                 val = ck_mm[e, c]
                 tp = ts[j]
@@ -176,8 +240,40 @@ def refine(run, samples: int, window: int):
 
     st = run.st
     ln = st.line
+    links = hasattr(run, "PN0")
     out = np.zeros((3, 2))
     nfev = refine_slots(st.N, KCOL, run.best, run.keep, run.nkeep, run.PT, run.PY0, run.PY1, run.PC, int(samples),
                         int(window), st.tol, st.ctl[ER.C_AUTO], st.pinpar, st.pintab, ln.h, ln._invm, ln.m, ln.ea,
-                        ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out)
+                        ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, links, run.PN0 if links else run.PY0)
+    return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)
+
+
+def refine_segments(stepper, best, keep, samples: int, window: int):
+    """:func:`refine` for a ``"rodas4-links"`` run of the Python loop: ``best`` and ``keep`` of
+    ``elastic_solve._Peaks`` (kinds v, a, sigma; kept steps ``(t_old, y_old, t, LinksDense)``)
+    put on step slots, refined by :func:`refine_slots` (``links``)."""
+    from .elastic_advance import KCOL
+
+    segs, idx = [], {}
+    kk = np.full((3, 3), -1, dtype=np.int64)
+    nk = np.zeros(3, dtype=np.int64)
+    for k, lst in enumerate(keep.values()):
+        for q, seg in enumerate(lst):
+            if id(seg) not in idx:
+                idx[id(seg)] = len(segs)
+                segs.append(seg)
+            kk[k, q] = idx[id(seg)]
+        nk[k] = len(lst)
+    ns, n = max(1, len(segs)), stepper.yn.size
+    PT, PY0, PY1, PR0, PC = np.zeros((ns, 2)), np.zeros((ns, n)), np.zeros((ns, n)), np.zeros((ns, n)), np.zeros((ns, 2, n))
+    for s, (t0, y0, t1, dn) in enumerate(segs):
+        d = dn.dense
+        PT[s] = t0, t1
+        PY0[s], PY1[s], PR0[s], PC[s, 0], PC[s, 1] = d.y0, d.y1, y0, d.c2, d.c3
+    ln = stepper.line
+    bb = np.array([best[k] for k in ("v", "a", "sigma")], dtype=float)
+    out = np.zeros((3, 2))
+    nfev = refine_slots(stepper.N, KCOL, bb, kk, nk, PT, PY0, PY1, PC, int(samples), int(window), stepper.tol,
+                        stepper.ctl[ER.C_AUTO], stepper.pinpar, stepper.pintab, ln.h, ln._invm, ln.m, ln.ea, ln.damp,
+                        ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, True, PR0)
     return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)

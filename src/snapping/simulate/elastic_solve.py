@@ -17,7 +17,9 @@ False``: :meth:`_Peaks.refine`, the same numbers). The Dataset is built by
 :mod:`snapping.simulate.elastic_dataset`.
 ``"rodas4-links"`` is the same RODAS4 in link coordinates (each link's length and angle:
 :mod:`snapping.simulate.elastic_links_rodas`), whose steps the wave speed does not cap (the
-elastic guide, "Link coordinates"); it runs the Python loop below.
+elastic guide, "Link coordinates"); its loop and refinement are compiled too
+(:func:`elastic_advance.advance_links`, :func:`elastic_refine.refine_segments` for the Python
+loop), the same numbers.
 
 Slack-taut transitions make the force continuous with a jump in its derivative; the error
 control of the method meets them (steps shrink there); no events are used. The energy
@@ -67,11 +69,13 @@ PEAK_RESTEP = 1
 #: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
 #: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
 ENERGY_ERROR_FAIL = 0.1
-#: RODAS4 runs its step loop compiled (:func:`elastic_advance.advance`); False: the Python loop
+#: RODAS4 (node and links) runs its step loop compiled (:func:`elastic_advance.advance`,
+#: ``advance_links``); False: the Python loop
 #: below, one step a call (the reference the compiled loop equals, bit for bit)
 COMPILED_LOOP = True
-#: a compiled RODAS4 run refines its peaks compiled (:func:`elastic_refine.refine`); False:
-#: :meth:`_Peaks.refine` on the kept steps (the reference it equals, bit for bit)
+#: a compiled RODAS4 run (and a rodas4-links run of either loop) refines its peaks compiled
+#: (:func:`elastic_refine.refine`, ``refine_segments``); False: :meth:`_Peaks.refine` on the
+#: kept steps (the reference it equals, bit for bit)
 COMPILED_REFINE = True
 
 
@@ -226,7 +230,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
     the same bookkeeping, many steps a call). Returns the record rows (t first), the running
     peak's state, the first slack time, when the stop rule was armed, status and reason; the
     snapshots and the peaks' kept steps (refined by :meth:`_Peaks.refine`) are filled in."""
-    run = EA.RodasRun(solver, mm0, energy_fail=ENERGY_ERROR_FAIL, **kw)
+    run = (EA.LinksRun if isinstance(solver, LinksStepper) else EA.RodasRun)(solver, mm0, energy_fail=ENERGY_ERROR_FAIL,
+                                                                            **kw)
     chunks, status = [], "completed"
     while True:
         code = run.advance(snaps[0] if snaps else np.inf)
@@ -241,7 +246,7 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
             if ts >= 0.0:
                 dense = dense or run.last_dense()
                 snap_t.append(ts)
-                snap_z.append(_snapshot(ts, dense.t_old, dense.y0, t, solver.y, restep, lambda: dense))
+                snap_z.append(_snapshot(ts, dense.t_old, run.last_start(), t, solver.y, restep, lambda: dense))
                 snap_kind.append("requested")
         if code in (EA.R_SNAPSHOT, EA.R_BUFFER):
             continue
@@ -289,7 +294,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         its tolerance is a max norm, Radau's and DOP853's an rms norm); ``"rodas4-links"`` the
         same RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`: each
         link's length and angle, steps not capped by the wave speed c; its error measured in
-        node values, so tol means the same; the Python step loop).
+        node values, so tol means the same; its loop compiled as RODAS4's).
     start : {"stretched", "unstretched", "matched"}
         See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
         both ends held, then released (its unloading wave rings); ``"matched"`` the start's
@@ -377,7 +382,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         n_restep[0] += st.nfev
         return st.y if st.status == "finished" else None
 
-    if method == "rodas4" and COMPILED_LOOP:
+    if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
         rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
             solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
             t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
@@ -429,6 +434,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     rec = np.asarray(rows, dtype=float)
     if peaks.run is not None:
         ref, nf = ERF.refine(peaks.run, PEAK_SAMPLES, PEAK_RESTEP)
+        n_restep[0] += nf
+    elif method == "rodas4-links" and COMPILED_REFINE:
+        ref, nf = ERF.refine_segments(solver, peaks.best, peaks.keep, PEAK_SAMPLES, PEAK_RESTEP)
         n_restep[0] += nf
     else:
         ref = peaks.refine(line, restep)
