@@ -39,7 +39,7 @@ ROWS = 4096
 #: step slots of the pool (three kept steps per peak kind, the last step, one being taken)
 NSLOT = 12
 #: the peak kinds' columns of the measures (v_max, a_max, sigma_max)
-KCOL = np.array([0, 2, 4])
+KCOL = ERF.KCOL
 #: the run's controls (``sctl``): t_end given, stop_fraction, the stop floor, the running peak
 #: of v_max, when the stop rule was armed, the largest energy error, E(0), U(0), max_rhs, the
 #: next snapshot time, the first slack time, rows in the buffer, the running peak's time, the

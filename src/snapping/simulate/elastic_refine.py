@@ -25,6 +25,10 @@ from . import elastic_links_rodas as ELR
 from . import elastic_rodas as ER
 from . import elastic_stage as ES
 
+#: the peak kinds' columns of the measures (v_max, a_max, sigma_max; ``elastic_advance`` keeps its
+#: peaks in this order)
+KCOL = np.array([0, 2, 4])
+
 __all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "grid", "measure"]
 
 
@@ -236,8 +240,6 @@ def refine(run, samples: int, window: int):
     """The refined peaks ``{"v": (value, time), "a": ..., "sigma": ...}`` of the finished
     :class:`~snapping.simulate.elastic_advance.RodasRun` ``run`` (``samples``, ``window``:
     ``elastic_solve.PEAK_SAMPLES``, ``PEAK_RESTEP``), and the evaluations its integrations took."""
-    from .elastic_advance import KCOL
-
     st = run.st
     ln = st.line
     links = hasattr(run, "PN0")
@@ -252,8 +254,6 @@ def refine_segments(stepper, best, keep, samples: int, window: int):
     """:func:`refine` for a ``"rodas4-links"`` run of the Python loop: ``best`` and ``keep`` of
     ``elastic_solve._Peaks`` (kinds v, a, sigma; kept steps ``(t_old, y_old, t, LinksDense)``)
     put on step slots, refined by :func:`refine_slots` (``links``)."""
-    from .elastic_advance import KCOL
-
     segs, idx = [], {}
     kk = np.full((3, 3), -1, dtype=np.int64)
     nk = np.zeros(3, dtype=np.int64)
