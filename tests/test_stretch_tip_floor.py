@@ -65,7 +65,7 @@ def test_runs_get_the_floor_and_the_cap(monkeypatch):
     R._run_task(0.5, "stretching", 1.0 / 442.0, lv, 1e-6, 4.0, "matched", "rodas4-links")
     R._run_task(0.5, "stretching", 1.0 / 442.0, lv, 1e-6, 4.0, "matched", "rodas4")
     (h_l, cap_l, m_l), (h_n, cap_n, m_n) = seen
-    assert m_l == "rodas4-links" and h_l >= 3e-8 * 442.0 * (1 - 1e-3) and cap_l == 100_000
+    assert m_l == "rodas4-links" and h_l >= 3e-8 * 442.0 * (1 - 1e-3) and cap_l == 200_000
     assert m_n == "rodas4" and h_n < 3e-8 * 442.0 and cap_n == 2_500_000
 
 
