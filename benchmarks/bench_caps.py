@@ -167,10 +167,10 @@ def _step_parts(p, n: int = 200) -> str:
     out = []
     for name, fn in parts.items():
         fn()  # (compiled, warm)
-        c0 = time.perf_counter()
+        c0 = time.process_time()
         for _ in range(n):
             fn()
-        out.append(f"{name} {(time.perf_counter() - c0) / n * 1e6:.0f}")
+        out.append(f"{name} {(time.process_time() - c0) / n * 1e6:.0f}")
     return ", ".join(out)
 
 
