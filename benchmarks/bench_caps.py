@@ -28,7 +28,7 @@ why it stopped, the graded runs' CPU, and beside it the levels-0-1 answer (befor
 ``--profile LINE`` (``design10``) runs LINE's full model on the graded ``--levels`` at each ``--tols``
 (RODAS4's tolerance; default :data:`snapping.caps_runs.GRADED_TOL`) and prints, per run, its links,
 CPU, steps, rejected steps, evaluations and CPU per step attempt per link, its peaks and their change
-from the first tolerance; then the fold's smallest radius along its path on the first run (from the
+from the first tolerance; then the first run's steps by time, the fold's smallest radius along its path on the first run (from the
 per-step curvature peak and where it is) beside the grading's links there, and the cost of one step's
 parts on the last level (the right side, the Jacobian, the banded LU, a stage's solve).
 
@@ -131,6 +131,10 @@ def _profile(name: str, chi: float, levels, tols) -> int:
             first = first or (h, ds)
         last = p
     h, ds = first
+    t = ds["t"].values
+    edges = [0.0, 0.3, 0.6, 0.9, 1.2, 1.3, float(t[-1])]
+    print(f"\nsteps of level {levels[0]}, tol {tols[0]:g}, by time: " + ", ".join(
+        f"{a:g}-{b:.3g}: {int(((t > a) & (t <= b)).sum())}" for a, b in zip(edges[:-1], edges[1:])))
     s_k, k_max = ds["s_kappa_max"].values, ds["kappa_max"].values
     xs = np.cumsum(h) - 0.5 * h
     print(f"\nthe fold along its path (level {levels[0]}, tol {tols[0]:g}): x from the free end, its smallest radius, "
