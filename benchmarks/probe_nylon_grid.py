@@ -14,18 +14,23 @@ peaks (SI) of each. A variant is a JSON object of:
 * ``below``, ``by``, ``w``: the links refined by the factor ``by`` where x (from the free end) <
   ``below`` (a tanh step of width ``w``);
 * ``cap``: the fold's links at most ``cap`` l_b (times the level's factor);
-* ``tol``, ``damp``: RODAS4's tolerance and the damping ratio.
+* ``tol``, ``damp``: RODAS4's tolerance and the damping ratio;
+* ``nowd``: true to run without the stage terms of the work and dissipation rows (with drag each is one
+  forward difference, a full right side, per stage): those two rows come out wrong, the dynamics do
+  not; it measures what an exact derivative of them could save at most.
 
 Usage::
 
     python benchmarks/probe_nylon_grid.py --chi 0.1 '{}' '{"fold": 0.5}' '{"tip": 0.5}' '{"held": 0.5}'
     python benchmarks/probe_nylon_grid.py --chi 0.1 '{"below": 0.05, "by": 0.5, "w": 0.01}' '{"cap": 0.8}'
     python benchmarks/probe_nylon_grid.py --chi 0.1 --level 1 '{"gscale": true}' '{"damp": 0.1}'
+    python benchmarks/probe_nylon_grid.py --chi 0.1 --level 1 '{}' '{"nowd": true}'
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import time
@@ -36,7 +41,7 @@ from snapping import caps, estimates
 from snapping import caps_runs as CR
 from snapping.simulate import grading, run
 
-KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "tol", "damp"}
+KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "tol", "damp", "nowd"}
 
 
 def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale=False, below=0.0, by=1.0,
@@ -63,6 +68,29 @@ def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale
     return grading.from_spacing(spacing, h_min * min(by, 1.0))
 
 
+@contextlib.contextmanager
+def _without_wd(on: bool):
+    """RODAS4's engines made meanwhile drop the W/D rows' stage terms (``rosenbrock.RP_QUAD``, ``RP_QFD``)."""
+    if not on:
+        yield
+        return
+    from snapping.simulate import rosenbrock as RB
+    from snapping.simulate.methods import rodas4 as M4
+
+    orig = M4.Engine.__init__
+
+    def init(self, *a, **kw):
+        orig(self, *a, **kw)
+        self.rp[RB.RP_QUAD] = 0.0
+        self.rp[RB.RP_QFD] = 0.0
+
+    M4.Engine.__init__ = init
+    try:
+        yield
+    finally:
+        M4.Engine.__init__ = orig
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("variants", nargs="*", default=["{}"])
@@ -74,21 +102,22 @@ def main(argv=None) -> int:
     lb = CR.bending_length(sp)
     caps.cap("nylon-monofilament", a.chi, N=8, check=False, alone=False, graded=False)  # compile
     print(f"nylon-monofilament, chi = {a.chi:g}, level {a.level}; load {os.getloadavg()[0]:.1f}")
-    print("| variant | links | CPU s | steps | rejected | T (N) | v (m/s) | a (m/s^2) |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| variant | links | CPU s | steps | rejected | evaluations | T (N) | v (m/s) | a (m/s^2) |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for v in a.variants:
         d = json.loads(v)
         bad = set(d) - KEYS
         if bad:
             p.error(f"unknown keys {sorted(bad)} (known: {sorted(KEYS)})")
-        tol, damp = d.pop("tol", CR.GRADED_TOL), d.pop("damp", CR.GRADED_DAMPING)
+        tol, damp, nowd = d.pop("tol", CR.GRADED_TOL), d.pop("damp", CR.GRADED_DAMPING), d.pop("nowd", False)
         h = links(a.chi, lb, a.level, **d)
         pr = CR.problem(sp, a.chi, h.size, on, damping=damp, omega_min=0.0, h=h)
         c0 = time.process_time()
-        at = run(pr, method="rodas4", tol=tol, progress=False).dataset.attrs
+        with _without_wd(nowd):
+            at = run(pr, method="rodas4", tol=tol, progress=False).dataset.attrs
         cpu = time.process_time() - c0
         si = caps._si(sp, {q: float(at[q]) for q in CR.QUANTITIES})
-        print(f"| {v} | {h.size} | {cpu:.2f} | {at['n_steps']} | {at['n_rejected']} | {si['sigma_peak']:.6g} | "
+        print(f"| {v} | {h.size} | {cpu:.2f} | {at['n_steps']} | {at['n_rejected']} | {at['n_rhs']} | {si['sigma_peak']:.6g} | "
               f"{si['v_peak']:.5g} | {si['a_peak']:.5g} |", flush=True)
     print(f"load {os.getloadavg()[0]:.1f}")
     return 0
