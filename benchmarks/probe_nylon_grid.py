@@ -14,6 +14,9 @@ peaks (SI) of each. A variant is a JSON object of:
 * ``below``, ``by``, ``w``: the links refined by the factor ``by`` where x (from the free end) <
   ``below`` (a tanh step of width ``w``);
 * ``cap``: the fold's links at most ``cap`` l_b (times the level's factor);
+* ``radius``: instead, the links along the fold's path ``radius`` times the fold's smallest radius
+  there as measured on level 0 at chi 0.1 (:data:`FOLD_RADIUS`; ``bench_caps.py --profile``), at
+  least half the free end's link;
 * ``tol``, ``damp``: RODAS4's tolerance and the damping ratio;
 * ``nowd``: true to run without the stage terms of the work and dissipation rows (with drag each is one
   forward difference, a full right side, per stage): those two rows come out wrong, the dynamics do
@@ -41,11 +44,14 @@ from snapping import caps, estimates
 from snapping import caps_runs as CR
 from snapping.simulate import grading, run
 
-KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "tol", "damp", "nowd"}
+KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "radius", "tol", "damp", "nowd"}
+#: the nylon line's fold at chi 0.1: its smallest radius (bending lengths) against x from the free end, on
+#: graded level 0 at tol 1e-3 (``python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0``)
+FOLD_RADIUS = ((0.0, 0.01, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6), (0.96, 0.96, 1.32, 2.51, 3.49, 4.95, 8.17, 14.27, 14.27))
 
 
 def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale=False, below=0.0, by=1.0,
-          w=0.02, cap=None) -> np.ndarray:
+          w=0.02, cap=None, radius=None) -> np.ndarray:
     """Graded level ``level`` (:func:`snapping.caps_runs.graded_h`'s spacing) with the variant's changes."""
     k = 0.5 ** level
     a = estimates.catenary_parameter(chi)
@@ -59,13 +65,19 @@ def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale
         f = frac * a * np.power(np.minimum(2.0 * x, 1.0), 0.25)
         if cap is not None:
             f = np.minimum(f, cap * lb * k)
-        target = np.where(x <= xf, f, frac * a + gamma * (x - xf))
-        s = np.maximum(h_min, np.minimum(np.minimum(target, h_max), h_min + gamma * x))
+        if radius is not None:
+            X, R = FOLD_RADIUS
+            f = np.maximum(0.5 * h_min, radius * lb * k * np.exp(np.interp(x, X, np.log(R))))
+            target = np.where(x <= xf, f, radius * lb * k * R[-1] + gamma * (x - xf))
+        else:
+            target = np.where(x <= xf, f, frac * a + gamma * (x - xf))
+        lo = 0.5 * h_min if radius is not None else h_min
+        s = np.maximum(lo, np.minimum(np.minimum(target, h_max), h_min + gamma * x))
         if below > 0.0:
             s = np.maximum(h_min * min(by, 1.0), s * (by + (1.0 - by) * 0.5 * (1.0 + np.tanh((x - below) / w))))
         return s
 
-    return grading.from_spacing(spacing, h_min * min(by, 1.0))
+    return grading.from_spacing(spacing, h_min * min(by, 1.0) * (0.5 if radius is not None else 1.0))
 
 
 @contextlib.contextmanager
