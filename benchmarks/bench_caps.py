@@ -28,9 +28,10 @@ why it stopped, the graded runs' CPU, and beside it the levels-0-1 answer (befor
 ``--profile LINE`` (``design10``) runs LINE's full model on the graded ``--levels`` at each ``--tols``
 (RODAS4's tolerance; default :data:`snapping.caps_runs.GRADED_TOL`) and prints, per run, its links,
 CPU, steps, rejected steps, evaluations and CPU per step attempt per link, its peaks and their change
-from the first tolerance; then the first run's steps by time, the fold's smallest radius along its path on the first run (from the
-per-step curvature peak and where it is) beside the grading's links there, and the cost of one step's
-parts on the last level (the right side, the Jacobian, the banded LU, a stage's solve).
+from the first tolerance; then the first run's steps by time, the fold's smallest radius along its
+path on the first run (from the per-step curvature peak and where it is) beside the grading's links
+there, and the cost of one step's parts on the last level (the right side, the Jacobian, the banded
+LU, a stage's solve).
 
 Usage::
 
@@ -204,7 +205,7 @@ def _escalation(names, chi: float, N: int) -> int:
     return 0
 
 
-def caps_runs_tol() -> float:
+def _graded_tol() -> float:
     from snapping import caps_runs
 
     return caps_runs.GRADED_TOL
@@ -220,14 +221,15 @@ def main(argv=None) -> int:
     p.add_argument("--order", choices=lines.names(), help="verify the graded levels' order on this line")
     p.add_argument("--levels", nargs="+", type=int, default=[0, 1, 2],
                    help="the graded levels of --order (three) or --profile")
-    p.add_argument("--profile", choices=lines.names(), help="where this line's graded runs' time goes (--levels, --tols)")
+    p.add_argument("--profile", choices=lines.names(),
+                   help="where this line's graded runs' time goes (--levels, --tols)")
     p.add_argument("--tols", nargs="+", type=float, default=None, help="RODAS4's tolerances of --profile")
     p.add_argument("--escalation", nargs="+", choices=lines.names(),
                    help="the escalated graded answer of these lines at --chi on --N[0] links: each level, the "
                         "pair extrapolated, why it stopped, CPU; beside it the levels-0-1 answer (before)")
     a = p.parse_args(argv)
     if a.profile:
-        return _profile(a.profile, a.chi, a.levels, a.tols or [caps_runs_tol()])
+        return _profile(a.profile, a.chi, a.levels, a.tols or [_graded_tol()])
     if a.order:
         if len(a.levels) != 3:
             p.error("--order takes three --levels")

@@ -47,7 +47,8 @@ from snapping.simulate import grading, run
 KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "radius", "tol", "damp", "nowd"}
 #: the nylon line's fold at chi 0.1: its smallest radius (bending lengths) against x from the free end, on
 #: graded level 0 at tol 1e-3 (``python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0``)
-FOLD_RADIUS = ((0.0, 0.01, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6), (0.96, 0.96, 1.32, 2.51, 3.49, 4.95, 8.17, 14.27, 14.27))
+FOLD_RADIUS = ((0.0, 0.01, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6),
+               (0.96, 0.96, 1.32, 2.51, 3.49, 4.95, 8.17, 14.27, 14.27))
 
 
 def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale=False, below=0.0, by=1.0,
@@ -129,7 +130,8 @@ def main(argv=None) -> int:
             at = run(pr, method="rodas4", tol=tol, progress=False).dataset.attrs
         cpu = time.process_time() - c0
         si = caps._si(sp, {q: float(at[q]) for q in CR.QUANTITIES})
-        print(f"| {v} | {h.size} | {cpu:.2f} | {at['n_steps']} | {at['n_rejected']} | {at['n_rhs']} | {si['sigma_peak']:.6g} | "
+        print(f"| {v} | {h.size} | {cpu:.2f} | {at['n_steps']} | {at['n_rejected']} | {at['n_rhs']} | "
+              f"{si['sigma_peak']:.6g} | "
               f"{si['v_peak']:.5g} | {si['a_peak']:.5g} |", flush=True)
     print(f"load {os.getloadavg()[0]:.1f}")
     return 0
