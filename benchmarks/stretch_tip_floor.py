@@ -23,4 +23,4 @@ ds = solve(p, Elastic.from_wave_speed(c, grid_damping=STRETCH_DAMPING), tol=stre
 a = ds.attrs
 r = dict(chi=chi, c=c, k=k, hmin=lv["h_min"], N=int(p.links.N), h0=float(p.links.h[0]) if hasattr(p.links,'h') else None, tol=tol, status=str(a["status"]), v=float(a["v_peak"]), a=float(a["a_peak"]), s=float(a["sigma_peak"]),
          nrhs=int(a["n_rhs"]), steps=int(a["n_steps"]), cpu=round(time.process_time()-t0,2), note=str(a.get("peak_note","")), load=os.getloadavg()[0])
-print(json.dumps(r)); open("benchmarks/results/stretch_tip_floor.jsonl","a").write(json.dumps(r)+"\n")
+print(json.dumps(r)); open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "results", "stretch_tip_floor.jsonl"), "a").write(json.dumps(r)+"\n")
