@@ -4,7 +4,7 @@ Usage: ``PYTHONPATH=src python benchmarks/stretch_peak_phase.py CHI C K`` (K the
 ``level_parameters(8, 0.5, first=-4)``): the cell's ``rodas4-links`` run as the study runs it (tip
 links floored), then from its per-step records the step of the speed peak, of the acceleration and
 tension peaks, the first slack link and the slack links after it. ``0.3 442.71632328565266 1``,
-``0.5 38.41511522329253 1``, ``0.1 7.529275877145769 -1``: docs/guide/regimes.md.
+``0.5 38.41511522329253 1``, ``0.1 7.529275877145769 0``: docs/guide/regimes.md.
 """
 import sys, numpy as np
 from snapping.continuum import level_parameters
