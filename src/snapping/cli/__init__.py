@@ -232,6 +232,11 @@ def _outside_run(args) -> str:
     import os
 
     out = getattr(args, "output", None)
+    if getattr(args, "_elastic_running", False):  # (the extensible line's solve: no checkpoint, no resume)
+        kept = (f"{out} is unchanged" if out and os.path.exists(out) else
+                f"nothing was written{f' ({out} does not exist)' if out else ''}")
+        return (f"during the extensible line's run, which keeps no checkpoint and cannot be resumed: {kept}; "
+                f"run the command again")
     if args.command == "simulate" and out and not os.path.exists(out):
         return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
     return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"

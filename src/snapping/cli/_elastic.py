@@ -192,6 +192,7 @@ def run_elastic(args, problem, elastic, times):
     out = None
     if args.output is not None:
         out = _files.check_output(args.output, overwrite=args.overwrite)
+    args._elastic_running = True  # (an interruption now is inside a run that keeps no checkpoint: main says so)
     r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
               method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
               snapshot_times=times, start=elastic_start(args))

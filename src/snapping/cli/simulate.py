@@ -78,6 +78,8 @@ def _add_simulate(sub) -> None:
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
+            "The extensible line's run (--ea/--stretching/--strain-table) keeps no checkpoint: it\n"
+            "writes -o when it ends, and an interrupted one writes nothing (exit status 130 or 143).\n"
             "\n"
             "Output files: -o must be a new path or, with --overwrite, an existing regular file (a\n"
             "device, FIFO or directory is never replaced; a symbolic link is written through, to its\n"
