@@ -57,8 +57,9 @@ def test_unknown_keyword_is_an_input_error_naming_the_valid_ones():
                                                ("diameter", math.nan, r"diameter=nan must be a finite"),
                                                ("air_density", math.inf, r"air_density=inf must be a finite"),
                                                ("end_mass", "1", r"end_mass='1' is not a real number")])
-def test_overrides_of_a_linespec_are_checked(key, value, words):
+def test_overrides_of_a_linespec_are_checked(key, value, words, monkeypatch):
     """cap(LineSpec, **params) replaced the spec's fields unchecked: ei=-1 ran."""
+    monkeypatch.setattr(caps, "Runs", lambda *a, **k: pytest.fail("runs were set up before the check"))
     with pytest.raises(SnappingInputError, match=words):
         caps.cap(caps.spec("bungee-cord"), 0.25, N=4, **{key: value})
 
