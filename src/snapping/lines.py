@@ -64,6 +64,8 @@ __all__ = ["Line", "CATALOGUE", "get", "names"]
 #: the units of each SI field of a Line
 UNITS = {"mass_per_length": "kg m-1", "diameter": "m", "ei": "N m2", "ea": "N", "cd_normal": "1",
          "cd_tangential": "1", "tip_drag_area": "m2", "tip_mass": "kg", "length": "m"}
+#: the profiles of :meth:`Line.profile` (the diameter ratio's powers 1, 2, 4)
+PROFILES = ("diameter", "mass_per_length", "ei")
 #: the keywords of :meth:`snapping.simulate.Body.from_si` that :meth:`Line.body` passes on as overrides
 BODY_KEYS = ("ei", "bending_damping", "curvature", "diameter", "air_density", "cd_normal", "cd_tangential",
              "tip_drag_area", "wind", "drag_linear_normal", "drag_linear_tangential", "clamp")
@@ -171,10 +173,9 @@ class Line:
     def profile(self, name: str, length: float | None = None):
         """``"ei"``, ``"diameter"`` or ``"mass_per_length"`` as a function of the arclength s (m)
         from the held end of a line of ``length`` m (a number when the line has no taper)."""
-        powers = {"diameter": 1, "mass_per_length": 2, "ei": 4}
-        if not isinstance(name, str) or name not in powers:
-            raise V.SnappingInputError(f"name={name!r} is not a profile of a line; valid: {', '.join(powers)}")
-        power = powers[name]
+        if not isinstance(name, str) or name not in PROFILES:
+            raise V.SnappingInputError(f"name={name!r} is not a profile of a line; valid: {', '.join(PROFILES)}")
+        power = {"diameter": 1, "mass_per_length": 2, "ei": 4}[name]
         L = self.length if length is None else V.positive("length", length)
         v0 = getattr(self, name)
         if self.taper is None:
