@@ -83,6 +83,8 @@ def test_si_scales_out_of_the_doubles_are_refused(key, value):
 def test_air_density_without_anything_to_act_on_is_refused():
     with pytest.raises(SnappingInputError, match=r"air_density=1.2 \(kg m-3\) acts on nothing"):
         caps.spec(None, length=1.0, mass=0.1, air_density=1.2)
+    with pytest.raises(SnappingInputError, match=r"air_density=1.2 \(kg m-3\) acts on nothing"):
+        caps.spec(None, length=1.0, mass=0.1, air_density=1.2, tip_drag_area=0.0)  # (a tip body without drag)
     # with a diameter or a tip body it acts: accepted
     assert caps.spec(None, length=1.0, mass=0.1, air_density=1.2, diameter=0.01).air_density == 1.2
     assert caps.spec(None, length=1.0, mass=0.1, air_density=1.2, tip_drag_area=1e-3).air_density == 1.2
@@ -170,6 +172,8 @@ def test_line_inputs_are_input_errors():
      "--air-density=1.2 (kg m-3) acts on nothing"),
     (("simulate", "--chi", "0.25", "--N", "8", "--stretching", "1e300"),
      "--stretching=1e+300 is out of range: the wave speed c/sqrt(g L) must lie in (0, 1e+08]"),
+    (("simulate", "--chi", "0.25", "--N", "8", "--stretching", "1e9"),  # (c^2 = 1e18 M g: beyond EA's 1e16)
+     "--stretching=1000000000.0 is out of range: the wave speed c/sqrt(g L) must lie in (0, 1e+08]"),
     (("simulate", "--chi", "0.25", "--N", "8", "--length", "1", "--mass", "1", "--ea", "1e20"),
      "--ea=1e+20 is out of range: the axial stiffness EA must lie in (0, 9.81e+16] N"),
     (("regimes", "--mechanism", "drag", "--chi", "0.5", "--numbers", "0.3", "--damping", "2"),
