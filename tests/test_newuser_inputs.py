@@ -242,3 +242,16 @@ def test_stretched_start_of_one_link_is_its_start():
     p = Problem.catenary(0.25, links=Links.uniform(2, lumping="shared"))
     line = ElasticLine(p, Elastic.from_wave_speed(30.0))
     assert not np.array_equal(line.start("stretched"), line.start("unstretched"))
+
+
+def test_failed_elastic_run_words():
+    """A run that reached the snap with its peaks refused by the peak guard said 'failed: snap'."""
+    from snapping.cli.simulate import elastic_failure_words
+
+    s = {"status": "failed", "stop_reason": "snap", "peak_note": "slack: a link slack during 0.9 of the fall"}
+    w = elastic_failure_words(s, "g.nc")
+    assert w.startswith("the extensible line's run reached the snap, but its peaks are not resolved (peak guard: "
+                        "slack: a link slack during 0.9 of the fall)")
+    assert w.endswith("the run is written to g.nc with status 'failed'") and "failed: snap" not in w
+    s = {"status": "failed", "stop_reason": "energy error above 0.1", "peak_note": ""}
+    assert elastic_failure_words(s, None).startswith("the extensible line's run failed: energy error above 0.1;")

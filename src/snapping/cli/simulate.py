@@ -310,10 +310,22 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
         _print_dimensionless(numbers)
     if summary["status"] != "completed":
-        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}"
-              + (f" (peak guard: {summary['peak_note']})" if summary.get("peak_note") else ""), file=sys.stderr)
+        print(f"snapping simulate: error: {elastic_failure_words(summary, args.output)}", file=sys.stderr)
         return 1
     return 0
+
+
+def elastic_failure_words(summary: dict, output) -> str:
+    """What a failed extensible-line run says: why (its stop reason, or, when it reached the snap,
+    the peak guard's rules broken: its peaks are not resolved) and where the run was kept."""
+    note, why = summary.get("peak_note") or "", summary.get("stop_reason") or "unknown"
+    if why == "snap" and note:
+        head = f"the extensible line's run reached the snap, but its peaks are not resolved (peak guard: {note})"
+    else:
+        head = f"the extensible line's run failed: {why}" + (f" (peak guard: {note})" if note else "")
+    kept = (f"; the run is written to {output} with status 'failed'" if output
+            else "; the summary above is the failed run's")
+    return head + kept
 
 
 def _print_body(summary) -> None:
