@@ -168,6 +168,8 @@ def test_line_inputs_are_input_errors():
     (("design", "--max-tension", "20", "--length", "2", "--mass", "0.05", "--links", "100", "--quantity", "a_peak"),
      "--quantity is a real line's option"),
     (("design", "--max-tension", "3", "--line", "bungee-cord", "--resolve"), "unrecognized argument: --resolve"),
+    (("estimate", "--chi", "0.25", "--length", "1", "--mass", "0.1", "--cd-tangential", "0.02"),
+     "--cd-tangential=0.02 needs a diameter (m)"),
     (("estimate", "--chi", "0.25", "--length", "1", "--mass", "0.1", "--air-density", "1.2"),
      "--air-density=1.2 (kg m-3) acts on nothing"),
     (("simulate", "--chi", "0.25", "--N", "8", "--stretching", "1e300"),

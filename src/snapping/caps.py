@@ -198,11 +198,12 @@ def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None
             raise V.SnappingInputError(f"{missing}=None: without a catalogue line both length (m) and mass (kg) "
                                        f"are needed")
         if (cd_normal is not None or cd_tangential is not None) and diameter is None:
-            raise V.SnappingInputError("cd_normal/cd_tangential need diameter (m): the drag per length is "
-                                       "0.5 rho C d |v| v")
+            k, v = ("cd_normal", cd_normal) if cd_normal is not None else ("cd_tangential", cd_tangential)
+            raise V.SnappingInputError(f"{k}={v!r} needs a diameter (m): the drag per length is "
+                                       f"0.5 rho C d |v| v")
         if air_density is not None and diameter is None and not tip_drag_area:
-            raise V.SnappingInputError(f"air_density={air_density!r} (kg m-3) acts on nothing: give diameter (m) "
-                                       f"or tip_drag_area (m2) with it (the drag is 0.5 rho C d |v| v)")
+            raise V.SnappingInputError(f"air_density={air_density!r} (kg m-3) acts on nothing: give a diameter (m) "
+                                       f"or a tip body's drag area (m2) with it (the drag is 0.5 rho C d |v| v)")
         return LineSpec("custom", float(length), float(mass), g, float(ei or 0.0), None if ea is None else float(ea),
                         None if diameter is None else float(diameter), cd_normal, cd_tangential, air_density,
                         float(end_mass or 0.0), float(tip_drag_area or 0.0))
