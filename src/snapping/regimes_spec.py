@@ -36,7 +36,7 @@ NUMBER_MAX = 1e4
 
 #: stretching: the elastic line's method in a study (the compiled RODAS4 of
 #: :mod:`snapping.simulate.elastic_rodas`; its grid damping is the study's ``damping``)
-STRETCH_METHOD = "rodas4"
+STRETCH_METHOD = "rodas4-links"
 #: stretching: the elastic methods a study may take (``regimes(method=)``): the default node-coordinate
 #: RODAS4, or RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`), whose steps
 #: are not capped by the wave speed c (``benchmarks/stretch_links.py``, docs/guide/regimes.md)
