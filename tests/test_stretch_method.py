@@ -29,16 +29,35 @@ def _direct(level, method):
 
 def test_study_runs_its_cells_by_the_chosen_method():
     levels = level_parameters(2, 0.5, first=-4)
-    direct = {m: [_direct(lv, m) for lv in levels] for m in ("rodas4-links", "rodas4")}
-    for k in range(len(levels)):  # the two methods differ here
-        assert abs(float(direct["rodas4"][k]["v_peak"]) / float(direct["rodas4-links"][k]["v_peak"]) - 1) > 1e-9
-    for method in ("rodas4-links", "rodas4"):  # the default (links) and the other (branch shipstretch)
-        ds = R.regimes("stretching", [CHI], [1.0 / C], levels=2, first=-4, tol=TOL, method=method, progress=False)
-        assert ds.attrs["elastic_method"] == method
-        for k, want in enumerate(direct[method]):
-            got = float(ds.v_peak_level.sel(chi=CHI, number=1.0 / C).values[k])
-            assert got == float(want["v_peak"]), method  # the study's run is that method's run, bit for bit
-            assert int(ds.n_rhs_level.sel(chi=CHI, number=1.0 / C).values[k]) == int(want["n_rhs"])
+    ds = R.regimes("stretching", [CHI], [1.0 / C], levels=2, first=-4, tol=TOL, method="rodas4-links",
+                   progress=False)
+    assert ds.attrs["elastic_method"] == "rodas4-links"
+    for k, lv in enumerate(levels):
+        links, node = _direct(lv, "rodas4-links"), _direct(lv, "rodas4")
+        assert abs(float(node["v_peak"]) / float(links["v_peak"]) - 1) > 1e-9  # the two methods differ here
+        got = float(ds.v_peak_level.sel(chi=CHI, number=1.0 / C).values[k])
+        assert got == float(links["v_peak"])  # the study's run is the links run, bit for bit
+        assert int(ds.n_rhs_level.sel(chi=CHI, number=1.0 / C).values[k]) == int(links["n_rhs"])
+
+
+def test_cell_passes_the_node_method_when_asked(monkeypatch):
+    """The default is the links method (branch shipstretch): a cell asked for the node method runs it."""
+    import snapping.simulate.elastic as E
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def spy(problem, elastic, **kw):
+        seen.append(kw["method"])
+        raise Stop
+
+    monkeypatch.setattr(E, "solve", spy)
+    for method in ("rodas4", "rodas4-links"):
+        with pytest.raises(Stop):
+            R._run_task(CHI, "stretching", 1.0 / C, {"n_links": 4, "frac": 0.25}, TOL, method=method)
+    assert seen == ["rodas4", "rodas4-links"]
 
 
 def test_default_method_and_the_study_key():
