@@ -25,6 +25,13 @@ each peak and the extrapolations from levels 0-1 and 1-2 (``--levels a b c``: ot
 ``--escalation LINE ...`` runs the answer of each LINE at ``--chi`` on ``--N[0]`` links and, where
 graded, prints every level :func:`snapping.caps_runs.graded_levels` ran, the pair it extrapolated,
 why it stopped, the graded runs' CPU, and beside it the levels-0-1 answer (before the escalation).
+``--profile LINE`` (``design10``) runs LINE's full model on the graded ``--levels`` at each ``--tols``
+(RODAS4's tolerance; default :data:`snapping.caps_runs.GRADED_TOL`) and prints, per run, its links,
+CPU, steps, rejected steps, evaluations and CPU per step attempt per link, its peaks and their change
+from the first tolerance; then the first run's steps by time, the fold's smallest radius along its
+path on the first run (from the per-step curvature peak and where it is) beside the grading's links
+there, and the cost of one step's parts on the last level (the right side, the Jacobian, the banded
+LU, a stage's solve).
 
 Usage::
 
@@ -32,6 +39,7 @@ Usage::
     python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
     python benchmarks/bench_caps.py --escalation nylon-monofilament fly-line --chi 0.1 --N 200
     python benchmarks/bench_caps.py --order nylon-monofilament --chi 0.1 --levels 1 2 3
+    python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0 1 2 --tols 1e-3 3e-3 1e-2
 """
 
 from __future__ import annotations
@@ -86,6 +94,91 @@ def _order(name: str, chi: float, levels=(0, 1, 2)) -> int:
     return 0
 
 
+def _profile(name: str, chi: float, levels, tols) -> int:
+    """Where a graded answer's time goes: each level at each tolerance (steps, rejections, CPU per
+    step attempt per link, peaks), the fold's radius along its path, and one step's parts."""
+    import time
+
+    import numpy as np
+
+    from snapping import caps_runs
+    from snapping.simulate import run
+
+    sp = caps.spec(name)
+    on = tuple(m for m in caps.MECHANISMS[:-1] if sp.has(m))
+    lb = caps_runs.bending_length(sp)
+    caps.cap("nylon-monofilament", chi, N=8, check=False, alone=False, graded=False)  # compile
+    print(f"{name}, chi = {chi:g}, bending length {lb:.4g} L; load {os.getloadavg()[0]:.1f}")
+    print("| level | links | tol | CPU s | steps | rejected | evaluations | CPU us per attempt per link | T (N) | "
+          "v (m/s) | a (m/s^2) | T, v, a from the first tol |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    first, last = None, None
+    for k in levels:
+        h = caps_runs.graded_h(chi, lb, k)
+        p = caps_runs.problem(sp, chi, h.size, on, damping=caps_runs.GRADED_DAMPING, omega_min=0.0, h=h)
+        base = None
+        for tol in tols:
+            c0 = time.process_time()
+            ds = run(p, method="rodas4", tol=tol, progress=False).dataset
+            cpu = time.process_time() - c0
+            at = ds.attrs
+            si = caps._si(sp, {q: float(at[q]) for q in caps.QUANTITIES})
+            base = base or si
+            d = ", ".join(f"{si[q] / base[q] - 1.0:+.2%}" for q in ("sigma_peak", "v_peak", "a_peak"))
+            tries = int(at["n_steps"]) + int(at["n_rejected"])
+            print(f"| {k} | {h.size} | {tol:g} | {cpu:.2f} | {at['n_steps']} | {at['n_rejected']} | {at['n_rhs']} | "
+                  f"{cpu / tries / h.size * 1e6:.2f} | {si['sigma_peak']:.6g} | {si['v_peak']:.5g} | "
+                  f"{si['a_peak']:.5g} | {d} |", flush=True)
+            first = first or (h, ds)
+        last = p
+    h, ds = first
+    t = ds["t"].values
+    edges = [0.0, 0.3, 0.6, 0.9, 1.2, 1.3, float(t[-1])]
+    print(f"\nsteps of level {levels[0]}, tol {tols[0]:g}, by time: " + ", ".join(
+        f"{a:g}-{b:.3g}: {int(((t > a) & (t <= b)).sum())}" for a, b in zip(edges[:-1], edges[1:])))
+    s_k, k_max = ds["s_kappa_max"].values, ds["kappa_max"].values
+    xs = np.cumsum(h) - 0.5 * h
+    print(f"\nthe fold along its path (level {levels[0]}, tol {tols[0]:g}): x from the free end, its smallest radius, "
+          f"the link there, in bending lengths")
+    for x in (0.5, 0.4, 0.3, 0.2, 0.15, 0.1, 0.05, 0.02, 0.01):
+        m = np.abs((1.0 - s_k) - x) < 0.1 * x
+        if m.any():
+            print(f"  x {x:g}: radius {1.0 / k_max[m].max() / lb:.2f} l_b, link {np.interp(x, xs, h) / lb:.2f} l_b")
+    print(f"\none step's parts on {last.N} links (us): " + _step_parts(last) + f"; load {os.getloadavg()[0]:.1f}")
+    return 0
+
+
+def _step_parts(p, n: int = 200) -> str:
+    """The cost of one RODAS4 step's parts on problem ``p`` (at its start): the right side (a step makes
+    ~12 with drag: five stages, a difference along each stage for the quadratic damping, the new f), the
+    Jacobian, the banded LU, a stage's solve (six per step)."""
+    import time
+
+    import numpy as np
+
+    from snapping.simulate import models as MD, rosenbrock as RB
+    from snapping.simulate.banded import KL, KU
+    from snapping.simulate.methods import rodas4 as M4
+
+    y0 = p.initial_angles()
+    e = M4.Engine(y0, 0.0, mdl=p.model(), tol=1e-3, dt0=None, t_end=2.0, stop_fraction=0.0, thin=0.0,
+                  max_link_error=0.5, snapshot_times=())
+    N, w, f = e.N, e.w, np.empty_like(y0)
+    b, U = np.linspace(0.0, 1.0, y0.size), np.zeros_like(y0)
+    parts = {"rhs": lambda: MD.model_rhs(N, 0.1, y0, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, e.mdl),
+             "jacobian": lambda: RB.jacobian_at(N, 0.1, y0, f, w.sig, e.Dj, e.mdl, e.barr, e.rp),
+             "LU": lambda: (RB.assemble(N, e.Dj, 2.5e-4, e.ab), RB.band_lu(e.ab, 2 * N, KL, KU, e.piv)),
+             "stage solve": lambda: RB._stage_solve(N, e.Dj, 2.5e-4, e.ab, e.piv, b.copy(), U, e.rhs, e.tmp)}
+    out = []
+    for name, fn in parts.items():
+        fn()  # (compiled, warm)
+        c0 = time.process_time()
+        for _ in range(n):
+            fn()
+        out.append(f"{name} {(time.process_time() - c0) / n * 1e6:.0f}")
+    return ", ".join(out)
+
+
 def _escalation(names, chi: float, N: int) -> int:
     """The escalated graded answers (:func:`snapping.caps_runs.graded_levels`) against levels 0-1 alone."""
     from snapping import caps_runs
@@ -112,6 +205,12 @@ def _escalation(names, chi: float, N: int) -> int:
     return 0
 
 
+def _graded_tol() -> float:
+    from snapping import caps_runs
+
+    return caps_runs.GRADED_TOL
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--N", nargs="+", type=int, default=[100, 200, 400, 1000])
@@ -120,12 +219,20 @@ def main(argv=None) -> int:
     p.add_argument("--after-only", action="store_true")
     p.add_argument("--before", choices=("uniform", "undamped"), default="uniform")
     p.add_argument("--order", choices=lines.names(), help="verify the graded levels' order on this line")
-    p.add_argument("--levels", nargs=3, type=int, default=[0, 1, 2], help="the three graded levels of --order")
+    p.add_argument("--levels", nargs="+", type=int, default=[0, 1, 2],
+                   help="the graded levels of --order (three) or --profile")
+    p.add_argument("--profile", choices=lines.names(),
+                   help="where this line's graded runs' time goes (--levels, --tols)")
+    p.add_argument("--tols", nargs="+", type=float, default=None, help="RODAS4's tolerances of --profile")
     p.add_argument("--escalation", nargs="+", choices=lines.names(),
                    help="the escalated graded answer of these lines at --chi on --N[0] links: each level, the "
                         "pair extrapolated, why it stopped, CPU; beside it the levels-0-1 answer (before)")
     a = p.parse_args(argv)
+    if a.profile:
+        return _profile(a.profile, a.chi, a.levels, a.tols or [_graded_tol()])
     if a.order:
+        if len(a.levels) != 3:
+            p.error("--order takes three --levels")
         return _order(a.order, a.chi, tuple(a.levels))
     if a.escalation:
         return _escalation(a.escalation, a.chi, a.N[0])

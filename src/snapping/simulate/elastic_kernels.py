@@ -47,6 +47,17 @@ def law(e, ea, tabe, tabt):
 
 
 @njit(cache=True)
+def link_tension(e, ed, ea, damp, tabe, tabt):
+    """``(T, f)`` of one link at strain ``e`` and strain rate ``ed``: the law's ``f(e)`` (:func:`law`)
+    plus the damping ``damp ed``, cut at 0 (a link pushes nothing); both 0 for a slack link (e <= 0)."""
+    if e > 0.0:
+        f, _ = law(e, ea, tabe, tabt)
+        t = f + damp * ed
+        return (t if t > 0.0 else 0.0), f
+    return 0.0, 0.0
+
+
+@njit(cache=True)
 def law_energy(e, ea, tabe, tabt, tabw):
     """The elastic energy per rest length, the integral of f from 0 to ``e`` (> 0); ``tabw``
     holds its values at the table's strains."""
@@ -89,14 +100,7 @@ def tensions(N, z, pin, h, ea, damp, tabe, tabt, T, E, ED, FV):
         ed = (dx * (vx1 - vx0) + dy * (vy1 - vy0)) / (ln * h[j])
         E[j] = e
         ED[j] = ed
-        if e > 0.0:
-            f, _ = law(e, ea[j], tabe, tabt)
-            t = f + damp[j] * ed
-            T[j] = t if t > 0.0 else 0.0
-            FV[j] = f
-        else:
-            T[j] = 0.0
-            FV[j] = 0.0
+        T[j], FV[j] = link_tension(e, ed, ea[j], damp[j], tabe, tabt)
 
 
 @njit(cache=True, error_model="numpy")
@@ -132,15 +136,7 @@ def rhs(N, z, pin, h, invm, ea, damp, tabe, tabt, g, dz, T, E, ED, FV):
     dz[4 * j + 3] = dy / lu
     diss = 0.0
     for j in range(N):
-        e = E[j]
-        if e > 0.0:
-            f, _ = law(e, ea[j], tabe, tabt)
-            t = f + damp[j] * ED[j]
-            tj = t if t > 0.0 else 0.0
-            FV[j] = f
-        else:
-            tj = 0.0
-            FV[j] = 0.0
+        tj, FV[j] = link_tension(E[j], ED[j], ea[j], damp[j], tabe, tabt)
         T[j] = tj
         # (also where the damping cancels the tension, T = 0 < f: there the rate is -h f edot)
         diss += h[j] * (tj - FV[j]) * ED[j]

@@ -68,14 +68,7 @@ def _forces(N, z, h, ea, damp, tabe, tabt, T, E, ED, FV, gx, gy):
         ed = z[4 * j + 2] / h[j]
         E[j] = e
         ED[j] = ed
-        if e > 0.0:
-            f, _ = EK.law(e, ea[j], tabe, tabt)
-            t = f + damp[j] * ed
-            tj = t if t > 0.0 else 0.0
-            FV[j] = f
-        else:
-            tj = 0.0
-            FV[j] = 0.0
+        tj, FV[j] = EK.link_tension(e, ed, ea[j], damp[j], tabe, tabt)
         T[j] = tj
         diss += h[j] * (tj - FV[j]) * ed
         th = z[4 * j + 1]

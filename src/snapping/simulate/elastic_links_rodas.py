@@ -31,9 +31,9 @@ from numba import njit
 from . import elastic_links as EL
 from . import elastic_stage as ES
 from .elastic_jacobian import gradient_span
-from .elastic_rodas import (C_AUTO, C_ERRACC, C_H, C_HACC, C_HFAIL, C_NFEV, C_NJEV, C_NLU, C_NPIV, C_NREJ,
-                            C_STATUS, C_T, C_TB, C_TOL, C_TOLD, FAC_MAX, FAC_MIN, FAILED, FINISHED, NCTL, SAFE,
-                            RodasDense, RodasStepper, _comb, pin_model)
+from .elastic_rodas import (C_AUTO, C_H, C_HACC, C_HFAIL, C_NFEV, C_NJEV, C_NLU, C_NPIV, C_STATUS, C_T, C_TB,
+                            C_TOL, C_TOLD, FINISHED, NCTL, RodasDense, RodasStepper, _comb, attempt_step, control_step,
+                            pin_model)
 from .rosenbrock import A_ST, C_NODE, C_ST, D2, D3, D_TIME, GAMMA
 
 __all__ = ["LinksStepper", "links_step", "links_accept"]
@@ -114,13 +114,8 @@ def links_accept(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h,
     tol = ctl[C_TOL]
     reject = False
     while True:
-        hs = ctl[C_H]
-        last = t + hs >= tb or t + 1.01 * hs >= tb
-        if last:
-            hs = tb - t
-        if hs <= 1e-14 * max(1.0, abs(t)):
-            ctl[C_STATUS] = FAILED
-            ctl[C_HFAIL] = hs
+        hs, last, failed = attempt_step(ctl, t, tb)
+        if failed:
             return 1
         for s in range(6):
             EL.pin6_at(t + C_NODE[s] * hs if not auto else t, pinpar, pintab, pins[s])
@@ -136,41 +131,24 @@ def links_accept(N, y, yn, St, B, gW, gD, dsp, ab, piv, pins, pinpar, pintab, h,
         ctl[C_NFEV] += 5.0
         err = links_step(N, hs, y, yn, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B, gW, gD, int(dsp[0]),
                          int(dsp[1]), ab, piv, St, ytmp, btmp, w, z1, zn1, c23, tol, T, E, ED, FV, gx, gy, ctl)
-        if not (err - err == 0.0):
-            ctl[C_NREJ] += 1.0
-            ctl[C_H] = 0.1 * hs
+        if not control_step(ctl, hs, err, reject):
             reject = True
             continue
-        fac = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, err ** 0.25 / SAFE))
-        hnew = hs / fac
-        if err <= 1.0:
-            if ctl[C_HACC] > 0.0:
-                facg = (ctl[C_HACC] / hs) * (err * err / ctl[C_ERRACC]) ** 0.25 / SAFE
-                facg = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, facg))
-                hnew = hs / max(fac, facg)
-            ctl[C_HACC] = hs
-            ctl[C_ERRACC] = max(1e-2, err)
-            if reject:
-                hnew = min(hnew, hs)
-            tn = tb if last else t + hs
-            for i in range(n):
-                y0d[i] = y[i]
-                y[i] = z1[i]
-                yn0d[i] = yn[i]
-                yn[i] = zn1[i]
-            ctl[C_TOLD] = t
-            ctl[C_T] = tn
-            f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
-                           dsp, T, E, ED, FV, gx, gy, cw)
-            ctl[C_NFEV] += 1.0
-            ctl[C_NJEV] += 1.0
-            ctl[C_H] = hnew
-            if last:
-                ctl[C_STATUS] = FINISHED
-            return 0
-        ctl[C_NREJ] += 1.0
-        reject = True
-        ctl[C_H] = hnew
+        tn = tb if last else t + hs
+        for i in range(n):
+            y0d[i] = y[i]
+            y[i] = z1[i]
+            yn0d[i] = yn[i]
+            yn[i] = zn1[i]
+        ctl[C_TOLD] = t
+        ctl[C_T] = tn
+        f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
+                       dsp, T, E, ED, FV, gx, gy, cw)
+        ctl[C_NFEV] += 1.0
+        ctl[C_NJEV] += 1.0
+        if last:
+            ctl[C_STATUS] = FINISHED
+        return 0
 
 
 class LinksDense:

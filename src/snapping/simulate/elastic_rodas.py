@@ -178,6 +178,52 @@ def f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, 
 
 
 @njit(cache=True, error_model="numpy")
+def attempt_step(ctl, t, tb):
+    """``(hs, last, failed)`` of the next attempt from ``t``: the step ``ctl[C_H]``, cut to reach
+    ``tb`` exactly when it (nearly) passes it (``last``); ``failed`` (and ``ctl[C_STATUS] = FAILED``,
+    the step in ``ctl[C_HFAIL]``) when it fell below 1e-14 |t|. Shared by RODAS4's loops in node
+    and link coordinates."""
+    hs = ctl[C_H]
+    last = t + hs >= tb or t + 1.01 * hs >= tb
+    if last:
+        hs = tb - t
+    if hs <= 1e-14 * max(1.0, abs(t)):
+        ctl[C_STATUS] = FAILED
+        ctl[C_HFAIL] = hs
+        return hs, last, True
+    return hs, last, False
+
+
+@njit(cache=True, error_model="numpy")
+def control_step(ctl, hs, err, reject):
+    """The step rule of ``rodas.f`` with Gustafsson's predictive controller, after an attempt of
+    step ``hs`` with scaled error ``err``: True when accepted (err <= 1; ``ctl[C_H]`` the next
+    step, ``C_HACC``, ``C_ERRACC`` updated), False when rejected (``C_NREJ`` counted, ``ctl[C_H]``
+    the retry's step: a tenth of ``hs`` for a non-finite error). ``reject``: an attempt of this
+    step was rejected before (the next step then does not grow)."""
+    if not (err - err == 0.0):
+        ctl[C_NREJ] += 1.0
+        ctl[C_H] = 0.1 * hs
+        return False
+    fac = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, err ** 0.25 / SAFE))
+    hnew = hs / fac
+    if err <= 1.0:
+        if ctl[C_HACC] > 0.0:  # Gustafsson's predictive controller (rodas.f, PRED)
+            facg = (ctl[C_HACC] / hs) * (err * err / ctl[C_ERRACC]) ** 0.25 / SAFE
+            facg = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, facg))
+            hnew = hs / max(fac, facg)
+        ctl[C_HACC] = hs
+        ctl[C_ERRACC] = max(1e-2, err)
+        if reject:
+            hnew = min(hnew, hs)
+        ctl[C_H] = hnew
+        return True
+    ctl[C_NREJ] += 1.0
+    ctl[C_H] = hnew
+    return False
+
+
+@njit(cache=True, error_model="numpy")
 def rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, invm, ea, damp, tabe, tabt, g,
                  ytmp, btmp, w, ft, z1, y0d, c23, ctl, T, E, ED, FV):
     """Attempt RODAS4 steps from ``(ctl[C_T], y)`` (``St[0] = f`` and the Jacobian there) with
@@ -194,13 +240,8 @@ def rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, 
     tol = ctl[C_TOL]
     reject = False
     while True:
-        hs = ctl[C_H]
-        last = t + hs >= tb or t + 1.01 * hs >= tb
-        if last:
-            hs = tb - t
-        if hs <= 1e-14 * max(1.0, abs(t)):
-            ctl[C_STATUS] = FAILED
-            ctl[C_HFAIL] = hs
+        hs, last, failed = attempt_step(ctl, t, tb)
+        if failed:
             return 1
         if auto:
             for s in range(6):
@@ -218,39 +259,22 @@ def rodas_accept(N, y, St, B, gW, gD, dsp, F, ab, piv, pins, pinpar, pintab, h, 
         ctl[C_NFEV] += 5.0
         err = rodas_step(N, t, hs, y, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B, gW, gD, int(dsp[0]),
                          int(dsp[1]), F, ab, piv, pivoted, St, ytmp, btmp, w, z1, c23, tol, T, E, ED, FV, ctl)
-        if not (err - err == 0.0):
-            ctl[C_NREJ] += 1.0
-            ctl[C_H] = 0.1 * hs
+        if not control_step(ctl, hs, err, reject):
             reject = True
             continue
-        fac = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, err ** 0.25 / SAFE))
-        hnew = hs / fac
-        if err <= 1.0:
-            if ctl[C_HACC] > 0.0:  # Gustafsson's predictive controller (rodas.f, PRED)
-                facg = (ctl[C_HACC] / hs) * (err * err / ctl[C_ERRACC]) ** 0.25 / SAFE
-                facg = min(1.0 / FAC_MIN, max(1.0 / FAC_MAX, facg))
-                hnew = hs / max(fac, facg)
-            ctl[C_HACC] = hs
-            ctl[C_ERRACC] = max(1e-2, err)
-            if reject:
-                hnew = min(hnew, hs)
-            tn = tb if last else t + hs
-            for i in range(n):
-                y0d[i] = y[i]
-                y[i] = z1[i]
-            ctl[C_TOLD] = t
-            ctl[C_T] = tn
-            f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
-                           dsp, T, E, ED, FV)
-            ctl[C_NFEV] += 1.0
-            ctl[C_NJEV] += 1.0
-            ctl[C_H] = hnew
-            if last:
-                ctl[C_STATUS] = FINISHED
-            return 0
-        ctl[C_NREJ] += 1.0
-        reject = True
-        ctl[C_H] = hnew
+        tn = tb if last else t + hs
+        for i in range(n):
+            y0d[i] = y[i]
+            y[i] = z1[i]
+        ctl[C_TOLD] = t
+        ctl[C_T] = tn
+        f_and_jacobian(N, tn, y, pinpar, pintab, pins[6], h, invm, ea, damp, tabe, tabt, g, St[0], B, gW, gD,
+                       dsp, T, E, ED, FV)
+        ctl[C_NFEV] += 1.0
+        ctl[C_NJEV] += 1.0
+        if last:
+            ctl[C_STATUS] = FINISHED
+        return 0
 
 
 class RodasDense:
