@@ -13,19 +13,20 @@ from __future__ import annotations
 
 import os
 
-#: the slowest files of a cold run, slowest first (seconds of one cold run, 2 cores, load ~4)
+#: the slowest files, roughly slowest first: the sums of their tests' ``--durations`` in one cold run on
+#: one process (numba caches empty, 2 cores shared, load ~4; CHANGELOG.md, `fastsuite`)
 SLOWEST_FIRST = (
-    "test_caps.py",          # 160 s: the stretching levels' elastic runs, the design rows
-    "test_reproduce.py",     # 140 s: the tiny reproduction and its rerun
-    "test_regimes.py",       # 100 s: the tiny study and its continuum reference
-    "test_sweep.py",         # 100 s: sweeps on worker processes, SIGINT/SIGKILL of sweeps
-    "test_docs.py",          # 70 s: the sphinx build
-    "test_animation.py",     # 75 s: a run with dense snapshots, GIF frames
-    "test_checkpoint.py",    # 70 s: interrupted runs resumed bit for bit
-    "test_animation3d.py",   # 50 s
-    "test_highorder.py",     # 50 s: the DOP853 ensemble against single runs
-    "test_notebooks.py",     # 45 s: three notebooks in kernels
-    "test_peers_scripts.py", # 60 s: the peers' quick runs
+    "test_caps.py",           # ~155 s: the stretching levels' elastic runs, the design rows
+    "test_reproduce.py",      # ~140 s: the tiny reproduction and its rerun
+    "test_regimes.py",        # ~95 s: the tiny study and its continuum reference
+    "test_sweep.py",          # ~120 s: sweeps on worker processes, SIGINT/SIGKILL of sweeps
+    "test_docs.py",           # ~70 s: the sphinx build
+    "test_animation.py",      # ~75 s: a run with dense snapshots, GIF frames
+    "test_checkpoint.py",     # ~70 s: interrupted runs resumed bit for bit
+    "test_animation3d.py",    # ~50 s
+    "test_highorder.py",      # ~45 s: the DOP853 ensemble against single runs
+    "test_notebooks.py",      # ~45 s: three notebooks in kernels
+    "test_peers_scripts.py",  # ~65 s: the peers' quick runs
     "test_caps_levels.py",
     "test_elastic_links.py",
     "test_checkpoint_dop853.py",
