@@ -76,6 +76,7 @@ snapping._validate.SnappingInputError: ei=-1.0 is out of range: must be finite a
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from dataclasses import dataclass, replace
 
@@ -151,6 +152,33 @@ def _pos(name: str, v, unit: str) -> float:
     return x
 
 
+#: the keywords of :func:`spec` (what ``**params`` of :func:`cap` and :func:`design` may hold)
+SPEC_KEYS = ("length", "mass", "g", "ei", "ea", "diameter", "cd_normal", "cd_tangential", "air_density",
+             "end_mass", "tip_drag_area")
+#: the units of each keyword of :func:`spec`
+SPEC_UNITS = {"length": "m", "mass": "kg", "g": "m s-2", "ei": "N m2", "ea": "N", "diameter": "m", "cd_normal": "1",
+              "cd_tangential": "1", "air_density": "kg m-3", "end_mass": "kg", "tip_drag_area": "m2"}
+_NONNEG = ("ei", "end_mass", "tip_drag_area", "cd_normal", "cd_tangential")
+
+
+def _check_params(params: dict) -> None:
+    """Refuse a keyword that :func:`spec` does not take, and check each value given (None: not
+    given) against its range, naming it: a bad keyword is a SnappingInputError, not a TypeError."""
+    bad = sorted(k for k in params if k not in SPEC_KEYS)
+    if bad:
+        raise V.SnappingInputError(f"{bad[0]}={params[bad[0]]!r} is not a parameter of a line; valid: "
+                                   f"{', '.join(SPEC_KEYS)}")
+    for k, v in params.items():
+        if v is None:
+            continue
+        (_nonneg if k in _NONNEG else _pos)(k, v, SPEC_UNITS[k])
+        if k in ("length", "mass", "g"):  # (the SI scales: beyond, the SI values leave the doubles)
+            lo, hi = V.SI_SCALE_RANGE
+            if not lo <= float(v) <= hi:
+                raise V.SnappingInputError(f"{k}={float(v)!r} {SPEC_UNITS[k]} is out of range: must lie in "
+                                           f"[{lo:g}, {hi:g}] (beyond, the SI values leave the doubles)")
+
+
 def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None, diameter=None, cd_normal=None,
          cd_tangential=None, air_density=None, end_mass=None, tip_drag_area=None) -> LineSpec:
     """The :class:`LineSpec` of ``line`` (a catalogue name, a :class:`snapping.lines.Line`, or
@@ -160,23 +188,22 @@ def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None
     kg/m^3, ``end_mass`` kg, ``tip_drag_area`` m^2. A bad value is refused naming it."""
     from . import lines
 
-    g = _pos("g", g, "m s-2")
-    for k, v, u in (("ei", ei, "N m2"), ("end_mass", end_mass, "kg"), ("tip_drag_area", tip_drag_area, "m2"),
-                    ("cd_normal", cd_normal, "1"), ("cd_tangential", cd_tangential, "1")):
-        if v is not None:
-            _nonneg(k, v, u)
-    for k, v, u in (("length", length, "m"), ("mass", mass, "kg"), ("ea", ea, "N"), ("diameter", diameter, "m"),
-                    ("air_density", air_density, "kg m-3")):
-        if v is not None:
-            _pos(k, v, u)
+    _check_params({"g": g, "ei": ei, "end_mass": end_mass, "tip_drag_area": tip_drag_area, "cd_normal": cd_normal,
+                   "cd_tangential": cd_tangential, "length": length, "mass": mass, "ea": ea, "diameter": diameter,
+                   "air_density": air_density})
+    g = float(g)
     if line is None:
         if length is None or mass is None:
             missing = "length" if length is None else "mass"
             raise V.SnappingInputError(f"{missing}=None: without a catalogue line both length (m) and mass (kg) "
                                        f"are needed")
         if (cd_normal is not None or cd_tangential is not None) and diameter is None:
-            raise V.SnappingInputError("cd_normal/cd_tangential need diameter (m): the drag per length is "
-                                       "0.5 rho C d |v| v")
+            k, v = ("cd_normal", cd_normal) if cd_normal is not None else ("cd_tangential", cd_tangential)
+            raise V.SnappingInputError(f"{k}={v!r} needs a diameter (m): the drag per length is "
+                                       f"0.5 rho C d |v| v")
+        if air_density is not None and diameter is None and not tip_drag_area:
+            raise V.SnappingInputError(f"air_density={air_density!r} (kg m-3) acts on nothing: give a diameter (m) "
+                                       f"or a tip body's drag area (m2) with it (the drag is 0.5 rho C d |v| v)")
         return LineSpec("custom", float(length), float(mass), g, float(ei or 0.0), None if ea is None else float(ea),
                         None if diameter is None else float(diameter), cd_normal, cd_tangential, air_density,
                         float(end_mass or 0.0), float(tip_drag_area or 0.0))
@@ -204,7 +231,14 @@ END_MASS_MAX = 1e4
 
 
 def _as_spec(line_or_spec, params: dict) -> LineSpec:
+    _check_params(params)  # (a keyword spec does not take: named, with the valid ones)
     if isinstance(line_or_spec, LineSpec):
+        fixed = sorted(k for k in ("length", "mass") if params.get(k) is not None)
+        if fixed:
+            raise V.SnappingInputError(f"{fixed[0]}={params[fixed[0]]!r} cannot override a LineSpec (its mass and "
+                                       f"profiles follow from its length): give the line's name or Line with "
+                                       f"{fixed[0]}=..., or build it again with caps.spec")
+        params = {k: float(v) for k, v in params.items() if v is not None}
         sp = replace(line_or_spec, **params) if params else line_or_spec
     else:
         sp = spec(line_or_spec, **params)
@@ -452,6 +486,13 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``graded`` (:func:`cap`'s: the real peaks from graded links, extrapolated, with their error),
     ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it."""
     sp = _as_spec(line, params)
+    chis = _check_chis(chis)
+    if isinstance(N, str) and N == "auto":
+        raise V.SnappingInputError("N='auto' is cap's (one separation): design runs every chi on the same links: "
+                                   "give N an integer in [2, 20000]")
+    N = V.integer("N", N, 2, 20000)
+    if quantity not in QUANTITIES:
+        raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
     limits = {}
     for k, q, v in (("max_tension", "sigma_peak", max_tension), ("max_speed", "v_peak", max_speed),
                     ("max_acceleration", "a_peak", max_acceleration)):
@@ -460,8 +501,6 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     if not limits:
         raise V.SnappingInputError("give at least one limit: max_tension (N), max_speed (m/s) or max_acceleration "
                                    "(m/s^2)")
-    if isinstance(chis, (int, float)):
-        chis = [chis]
     t0, c0 = time.perf_counter(), time.process_time()
     rows, n_rhs = [], 0
     for chi in sorted(chis):
@@ -477,6 +516,26 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     return {"line": sp.name, "N": N, "limits": limits, "quantity": quantity, "rows": rows, "admissible_chi": ok,
             "numbers": sp.numbers(N), "n_rhs": n_rhs, "wall": time.perf_counter() - t0,
             "cpu": time.process_time() - c0}
+
+
+def _check_chis(chis) -> list:
+    """``chis`` of :func:`design` as a sorted list of distinct separations, each in [CHI_MIN, 1),
+    every one checked before any run (a bad one is named with its place: ``chis[2]=1.5``)."""
+    from .estimates import check_chi
+
+    if isinstance(chis, numbers.Real) and not isinstance(chis, bool):
+        chis = [chis]
+    if isinstance(chis, (str, bytes, dict)) or chis is None or not hasattr(chis, "__iter__"):
+        raise V.SnappingInputError(f"chis={chis!r} is not a sequence of end separations (each in (0, 1), "
+                                   f"e.g. (0.2, 0.3, 0.5))")
+    out = [check_chi(c, f"chis[{i}]") for i, c in enumerate(list(chis))]
+    if not out:
+        raise V.SnappingInputError("chis=[] holds no end separation: give at least one, each in (0, 1)")
+    twice = sorted({c for c in out if out.count(c) > 1})
+    if twice:
+        raise V.SnappingInputError(f"chis={[float(c) for c in chis]!r} gives chi={twice[0]!r} more than once: "
+                                   f"each separation is run once")
+    return sorted(out)
 
 
 def format_answer(r: dict) -> list[str]:

@@ -64,6 +64,8 @@ __all__ = ["Line", "CATALOGUE", "get", "names"]
 #: the units of each SI field of a Line
 UNITS = {"mass_per_length": "kg m-1", "diameter": "m", "ei": "N m2", "ea": "N", "cd_normal": "1",
          "cd_tangential": "1", "tip_drag_area": "m2", "tip_mass": "kg", "length": "m"}
+#: the profiles of :meth:`Line.profile` (the diameter ratio's powers 1, 2, 4)
+PROFILES = ("diameter", "mass_per_length", "ei")
 #: the keywords of :meth:`snapping.simulate.Body.from_si` that :meth:`Line.body` passes on as overrides
 BODY_KEYS = ("ei", "bending_damping", "curvature", "diameter", "air_density", "cd_normal", "cd_tangential",
              "tip_drag_area", "wind", "drag_linear_normal", "drag_linear_tangential", "clamp")
@@ -119,6 +121,9 @@ class Line:
     estimates: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        for k in ("name", "title"):
+            if not isinstance(getattr(self, k), str):
+                raise V.SnappingInputError(f"{k}={getattr(self, k)!r} is not a string")
         for k in ("mass_per_length", "diameter", "length"):
             V.positive(k, getattr(self, k))
         for k in ("ei", "cd_normal", "cd_tangential", "tip_mass", "tip_drag_area"):
@@ -130,7 +135,11 @@ class Line:
         if self.taper_units not in ("m", "fraction"):
             raise V.SnappingInputError(f"taper_units={self.taper_units!r} is not one of ('m', 'fraction')")
         if self.taper is not None:
-            x, r = (np.asarray(c, dtype=float) for c in zip(*self.taper))
+            try:
+                x, r = (np.asarray(c, dtype=float) for c in zip(*self.taper))
+            except (TypeError, ValueError):
+                raise V.SnappingInputError(f"taper={self.taper!r} must be stations (x, ratio) with x increasing "
+                                           f"from >= 0 and ratios > 0") from None
             if x.size < 2 or not (np.all(np.diff(x) > 0) and x[0] >= 0 and np.all(np.isfinite(r)) and np.all(r > 0)):
                 raise V.SnappingInputError(f"taper={self.taper!r} must be stations (x, ratio) with x increasing "
                                            f"from >= 0 and ratios > 0")
@@ -164,11 +173,13 @@ class Line:
     def profile(self, name: str, length: float | None = None):
         """``"ei"``, ``"diameter"`` or ``"mass_per_length"`` as a function of the arclength s (m)
         from the held end of a line of ``length`` m (a number when the line has no taper)."""
+        if not isinstance(name, str) or name not in PROFILES:
+            raise V.SnappingInputError(f"name={name!r} is not a profile of a line; valid: {', '.join(PROFILES)}")
         power = {"diameter": 1, "mass_per_length": 2, "ei": 4}[name]
+        L = self.length if length is None else V.positive("length", length)
         v0 = getattr(self, name)
         if self.taper is None:
             return v0
-        L = self.length if length is None else float(length)
 
         def f(s):
             return v0 * self.ratio(L - s, L) ** power
@@ -241,6 +252,10 @@ class Line:
 
     def replace(self, **changes) -> "Line":
         """This line with catalogue values changed (``mass_per_length=``, ``ea=``, ...)."""
+        fields = [f for f in self.__dataclass_fields__]
+        bad = sorted(set(changes) - set(fields))
+        if bad:
+            raise V.SnappingInputError(f"{bad[0]}= is not a field of a Line; valid: {', '.join(fields)}")
         return replace(self, **changes)
 
 

@@ -66,7 +66,8 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_METHODS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TOL_C, stretch_tol)
+                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
+                           STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
            "GRID_DAMPING"]
@@ -98,8 +99,10 @@ def _drag_ratio() -> float:
     return math.pi * units.CD_TANGENTIAL / units.CD_NORMAL
 
 
-def cell_links(chi: float, mechanism: str, number: float, level: dict) -> np.ndarray:
-    """The link lengths of one run (:func:`cell_problem`'s), free end first."""
+def cell_links(chi: float, mechanism: str, number: float, level: dict, method: str | None = None) -> np.ndarray:
+    """The link lengths of one run (:func:`cell_problem`'s), free end first. ``method``: the
+    stretching run's elastic method (``"rodas4-links"``: the free end's links floored at
+    ``STRETCH_TIP_TIME * c``, :func:`snapping.regimes_spec.stretch_tip_floor`)."""
     from .simulate import grading
 
     if "n_links" in level:
@@ -107,6 +110,8 @@ def cell_links(chi: float, mechanism: str, number: float, level: dict) -> np.nda
     h_min = level["h_min"]
     if mechanism == "bending" and number > 0:
         h_min = max(h_min, BEND_FLOOR * level["frac"] * math.sqrt(number))
+    elif mechanism == "stretching" and number > 0:
+        h_min = max(h_min, stretch_tip_floor(1.0 / number, method))
     return grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
 
 
@@ -144,15 +149,16 @@ def _mark(ds: xr.Dataset) -> None:
 
 
 def cell_problem(chi: float, mechanism: str, number: float, level: dict, lumping: str = "shared",
-                 damping: float = GRID_DAMPING):
+                 damping: float = GRID_DAMPING, method: str | None = None):
     """The problem of one run: the catenary of separation ``chi`` with the mechanism at
     ``number`` (0 or ``mechanism=None``: the ideal chain, fold-graded) at the resolution
     ``level`` (``n_links``: a uniform chain; else the fold-following grading; bending: its
     free end's links floored at ``BEND_FLOOR frac sqrt(beta)``, grid damping ratio ``damping``).
-    Stretching: the (inextensible) problem whose links the elastic line takes."""
+    Stretching: the (inextensible) problem whose links the elastic line takes (``method``
+    ``"rodas4-links"``: its free end's links floored at ``STRETCH_TIP_TIME * c``)."""
     from .simulate import Body, Links, Problem
 
-    h = cell_links(chi, mechanism, number, level)
+    h = cell_links(chi, mechanism, number, level, method)
     body, tip = None, 0.0
     if mechanism == "bending" and number > 0:
         body = Body(bending=number, damping=eta_grid(h, number, damping) if damping > 0 else 0.0)
@@ -172,14 +178,14 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     ``start``, ``method``: the elastic line's (stretching only)."""
     from .simulate import run
 
-    problem = cell_problem(chi, mechanism, number, level, damping=damping)
+    problem = cell_problem(chi, mechanism, number, level, damping=damping, method=method)
     cpu = time.process_time()
     if mechanism == "stretching" and number > 0:
         from .simulate.elastic import Elastic, solve
 
         ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
                    tol=stretch_tol(tol, 1.0 / number), method=method, stop_floor=STRETCH_STOP_FLOOR,
-                   start=start, max_rhs=STRETCH_MAX_RHS).dataset
+                   start=start, max_rhs=STRETCH_MAX_RHS_LINKS if method == "rodas4-links" else STRETCH_MAX_RHS).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
         ds = run(problem, method=method, tol=tol, progress=False).dataset
@@ -403,6 +409,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             raise V.SnappingInputError(f"method={method!r} is not one of {STRETCH_METHODS} (a stretching study's "
                                        f"elastic methods)")
         acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR)
+        if method == "rodas4-links":  # its tip links floored (regimes_spec.stretch_tip_floor)
+            acc["tip_time"] = STRETCH_TIP_TIME
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
             acc["elastic_start"] = start
             acc["tol_c"] = STRETCH_TOL_C  # stiffer lines' runs at tol (tol_c/c)^2 (regimes_spec.stretch_tol)
@@ -466,7 +474,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start,
                         acc.get("elastic_method", STRETCH_METHOD))
     for args in calls.values():  # every run's problem is checked before any starts
-        cell_problem(*args[:4], damping=damping)
+        cell_problem(*args[:4], damping=damping, method=args[7] if len(args) > 7 else None)
 
     bar = tqdm(total=len(ds.chi) * (len(numbers) + 1) * len(levels_p), initial=0, desc=f"regimes {mechanism}",
                unit="run", disable=not progress)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 __all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_METHODS", "STRETCH_STOP_FLOOR", "STRETCH_START",
            "STRETCH_DAMPING", "STRETCH_MAX_RHS",
-           "STRETCH_TOL_C", "stretch_tol"]
+           "STRETCH_TOL_C", "stretch_tol", "STRETCH_TIP_TIME", "STRETCH_MAX_RHS_LINKS", "stretch_tip_floor"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -88,3 +88,40 @@ def stretch_tol(tol: float, c: float) -> float:
     (1e-06, 2.5e-07)
     """
     return tol if c <= STRETCH_TOL_C else tol * (STRETCH_TOL_C / c) ** 2
+
+
+#: stretching, ``method="rodas4-links"``: the free end's links are at least ``STRETCH_TIP_TIME * c`` long
+#: (units L, c in sqrt(g L)): a tip link's longitudinal wave crossing time h/c is at least this. Why: the
+#: fold-graded tip links carry a tension of the order of their own weight (strain ~ g h / c^2), far
+#: below what the step's error resolves, so they sit at the slack/taut kink of the tension law, where
+#: the grid damping's force jumps by zeta c lambda l' as a link turns taut. Where h/c is short the
+#: integrator follows that chatter (steps ~ zeta h / c, 1e-9 to 1e-7) from the start and never leaves it:
+#: at tol 1e-6, grid damping 4, every run measured that stalled (chi = 0.5, c = 442, h_min 2.1e-6 and
+#: 4.2e-6 on level 1; c = 87 and 196 on level 2; chi = 0.1, c = 442 on level 1) or was flagged slack
+#: (chi = 0.1, c = 1000 on levels -1 and 0, c = 442 on level 2) had h_min/c <= 1.2e-8 (not every run
+#: there failed), and every run with h_min/c >= 1.8e-8 ran (a few hundred to 2,100 steps); 3e-8 leaves
+#: a margin of 2.5 over the longest that failed (benchmarks/stretch_tip_floor.py). The tip links resolve
+#: nothing the peaks need at that length: flooring moves v_peak by 1.3e-6 to 1.3e-5 relative at
+#: chi = 0.5 (c = 442, levels -1 ... 1), 1.8e-5 (chi = 0.1, c = 196, level 0) and 2.6e-4 (chi = 0.1,
+#: c = 442, level 0). Two physical scales were tried first and fail: the arm length where
+#: the ideal fold's speed reaches c does not exist for the stiff lines (v_peak of the ideal, 4.5 to 33,
+#: stays below c >= 87), and the tip zone whose tension ~ lambda g s is below the grid damping's
+#: response to the tolerance's velocity error (s < zeta c tol, 1.8e-3 at c = 442, tol 1e-6), used as a
+#: floor, lowers chi = 0.1's level-0 peak from 31.4 to 20.1 (docs/guide/regimes.md)
+STRETCH_TIP_TIME = 3e-8
+#: stretching, ``method="rodas4-links"``: a run stops (failed) after this many evaluations. Its runs
+#: took at most 77,436 in the full 4 x 8 scan at levels -1 ... 2 (chi = 0.3, c = 442, level 2, its
+#: evaluations doubling with each level), at most 13,343 elsewhere; a stalled run (tip-link chatter,
+#: 1e-8 steps) would otherwise run to STRETCH_MAX_RHS, 2.5 million evaluations, an hour at 7000 links
+STRETCH_MAX_RHS_LINKS = 200_000
+
+
+def stretch_tip_floor(c: float, method: str) -> float:
+    """The shortest free-end link of a stretching run of wave speed ``c`` by ``method``:
+    ``STRETCH_TIP_TIME * c`` for ``"rodas4-links"``, 0 (no floor: the shipped node-method study's
+    links) otherwise.
+
+    >>> round(stretch_tip_floor(442.0, "rodas4-links"), 12), stretch_tip_floor(442.0, "rodas4")
+    (1.326e-05, 0.0)
+    """
+    return STRETCH_TIP_TIME * c if method == "rodas4-links" else 0.0

@@ -112,6 +112,10 @@ def build_parser() -> argparse.ArgumentParser:
 _SI_COMMANDS = ("simulate", "fit", "sweep", "converge")
 _SI_DESTS = ("length", "mass", "g")
 
+#: library parameters named otherwise than the option that gives them (``chis=[]`` of --chi)
+_RENAMED = {"regimes": {"chis": "--chi", "numbers": "--numbers", "out": "--output", "path": "--load",
+                        "method": "--elastic-method"}}
+
 #: library parameters that come from inside an option's value (named after the option)
 _PART_OF = {"simulate": {"ratio": "--taper", "power": "--taper", "accel": "--pin-motion", "period": "--pin-motion",
                          "duration": "--pin-motion", "t0": "--pin-motion", "dx": "--supports", "dy": "--supports"}}
@@ -135,6 +139,8 @@ def _as_typed(parser, command: str, msg: str) -> str:
     after = r"(?=[=\[]| contains| grid)"
     for dest, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
         msg = re.sub(rf"(?<![\w.\-]){re.escape(dest)}{after}", opt, msg)
+    for name, opt in _RENAMED.get(command, {}).items():
+        msg = re.sub(rf"(?<![\w.\-]){re.escape(name)}(?=[=\[:])", opt, msg)
     for name, opt in _PART_OF.get(command, {}).items():
         if opt not in msg:
             msg = re.sub(rf"(?<![\w.\-]){re.escape(name)}{after}", f"{opt} {name}", msg, count=1)
@@ -226,6 +232,11 @@ def _outside_run(args) -> str:
     import os
 
     out = getattr(args, "output", None)
+    if getattr(args, "_elastic_running", False):  # (the extensible line's solve: no checkpoint, no resume)
+        kept = (f"{out} is unchanged" if out and os.path.exists(out) else
+                f"nothing was written{f' ({out} does not exist)' if out else ''}")
+        return (f"during the extensible line's run, which keeps no checkpoint and cannot be resumed: {kept}; "
+                f"run the command again")
     if args.command == "simulate" and out and not os.path.exists(out):
         return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
     return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"

@@ -11,10 +11,10 @@ import math
 #: the dests of the elastic options (any of them given: the elastic model)
 ELASTIC_DESTS = ("ea", "stretching", "axial_damping_si", "axial_damping", "grid_damping", "strain_table")
 #: simulate options the elastic model does not take (dest: why)
-NOT_ELASTIC = {"resume": "--resume continues a rigid-link checkpoint",
-               "record_thin": "--record-thin thins the rigid-link record",
-               "dt0": "--dt0 sets the rigid-link methods' first step",
-               "max_link_error": "--max-link-error checks rigid links", "chords": "--chords",
+NOT_ELASTIC = {"resume": "--resume (it continues a rigid-link checkpoint)",
+               "record_thin": "--record-thin (it thins the rigid-link record)",
+               "dt0": "--dt0 (it sets the rigid-link methods' first step)",
+               "max_link_error": "--max-link-error (it checks rigid links)", "chords": "--chords",
                "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections",
                "start": "--start (the bending line's start; the extensible line's is --elastic-start)"}
 #: the extensible line's starts (--elastic-start; snapping.simulate.elastic_model.STARTS)
@@ -158,11 +158,19 @@ def elastic_from_args(args, scales):
     zeta = 0.0 if args.grid_damping is None else args.grid_damping
     if not (math.isfinite(zeta) and zeta >= 0.0):
         raise SnappingInputError(f"--grid-damping={zeta!r} is out of range: the damping ratio must be finite and >= 0")
-    if args.ea is not None:
+    from ..simulate.elastic_model import EA_MAX
+
+    if args.ea is not None:  # (the bound in the option's own unit: EA <= EA_MAX M g)
         ea = _finite_positive("--ea", args.ea, "the axial stiffness EA (N)")
+        if not ea / force <= EA_MAX:
+            raise SnappingInputError(f"--ea={ea!r} is out of range: the axial stiffness EA must lie in "
+                                     f"(0, {EA_MAX * force:.4g}] N ({EA_MAX:g} times the line's weight M g)")
         return Elastic(ea=ea / force, damping=damping, grid_damping=zeta)
     if args.stretching is not None:
         c = _finite_positive("--stretching", args.stretching, "the wave speed c/sqrt(g L)")
+        if not c * c <= EA_MAX:
+            raise SnappingInputError(f"--stretching={c!r} is out of range: the wave speed c/sqrt(g L) must lie in "
+                                     f"(0, {math.sqrt(EA_MAX):g}] (EA = c^2 M g at most {EA_MAX:g} M g)")
         return Elastic.from_wave_speed(c, damping=damping, grid_damping=zeta)
     e, t = _read_table(args.strain_table)
     try:
@@ -184,6 +192,7 @@ def run_elastic(args, problem, elastic, times):
     out = None
     if args.output is not None:
         out = _files.check_output(args.output, overwrite=args.overwrite)
+    args._elastic_running = True  # (an interruption now is inside a run that keeps no checkpoint: main says so)
     r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
               method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
               snapshot_times=times, start=elastic_start(args))

@@ -3,7 +3,7 @@ the peaks of a chain's snap (computed and estimated) and the inverse design."""
 
 from __future__ import annotations
 
-from ._caps import add_real_options, cmd_real_design, cmd_real_estimate, wants_real
+from ._caps import add_real_options, cmd_real_design, cmd_real_estimate, refuse_real_only, wants_real
 from ._common import PLOT_BYTES, _floats, _add_g_option, _dimensionless, _formatter, _print_dimensionless, print_json
 
 
@@ -117,6 +117,7 @@ def _cmd_estimate(args) -> int:
 
     if wants_real(args):
         return cmd_real_estimate(args)
+    refuse_real_only(args)
     chain = _chain_of(args)
     where = {k: getattr(args, k) for k in ("chi", "separation", "curvature") if getattr(args, k) is not None}
     if args.simulate and args.links is None:
@@ -189,13 +190,14 @@ def _add_design(sub) -> None:
                                                                            "--line)")
     _add_g_option(p)
     p.add_argument("--links", type=int, default=None, metavar="N",
-                   help="the chain's number of links (10 to 10000; required, but for a real line: default 200)")
+                   help="the chain's number of links (10 to 10000; required, but for a real line: 2 to 20000, "
+                        "default 200)")
     p.add_argument("--tip-mass", type=float, default=None, metavar="RATIO",
                    help="tip mass / chain mass (default: scan the table's tip masses, 0 to 1)")
     p.add_argument("--plot", default=None, metavar="PNG", help="save the peaks against the separation here")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    add_real_options(p)
+    add_real_options(p, resolve=False)
     p.add_argument("--chis", type=_floats, default=None, metavar="C1,C2,...",
                    help="a real line's end separations to run (default 0.05,0.1,0.15,0.2,0.25,0.3,0.4,0.5)")
     p.set_defaults(func=_cmd_design)
@@ -209,8 +211,7 @@ def _cmd_design(args) -> int:
 
     if wants_real(args):
         return cmd_real_design(args)
-    if args.chis is not None:
-        raise SnappingInputError("--chis is a real line's option (--line or the physical parameters)")
+    refuse_real_only(args)
     for opt, v in (("--length", args.length), ("--mass", args.mass), ("--links", args.links)):
         if v is None:
             raise SnappingInputError(f"the following arguments are required: {opt} (or --line NAME: a real line)")

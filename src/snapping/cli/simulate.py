@@ -78,6 +78,8 @@ def _add_simulate(sub) -> None:
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
+            "The extensible line's run (--ea/--stretching/--strain-table) keeps no checkpoint: it\n"
+            "writes -o when it ends, and an interrupted one writes nothing (exit status 130 or 143).\n"
             "\n"
             "Output files: -o must be a new path or, with --overwrite, an existing regular file (a\n"
             "device, FIFO or directory is never replaced; a symbolic link is written through, to its\n"
@@ -308,10 +310,22 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
         _print_dimensionless(numbers)
     if summary["status"] != "completed":
-        print(f"snapping simulate: error: the extensible line's run failed: {summary['stop_reason']}"
-              + (f" (peak guard: {summary['peak_note']})" if summary.get("peak_note") else ""), file=sys.stderr)
+        print(f"snapping simulate: error: {elastic_failure_words(summary, args.output)}", file=sys.stderr)
         return 1
     return 0
+
+
+def elastic_failure_words(summary: dict, output) -> str:
+    """What a failed extensible-line run says: why (its stop reason, or, when it reached the snap,
+    the peak guard's rules broken: its peaks are not resolved) and where the run was kept."""
+    note, why = summary.get("peak_note") or "", summary.get("stop_reason") or "unknown"
+    if why == "snap" and note:
+        head = f"the extensible line's run reached the snap, but its peaks are not resolved (peak guard: {note})"
+    else:
+        head = f"the extensible line's run failed: {why}" + (f" (peak guard: {note})" if note else "")
+    kept = (f"; the run is written to {output} with status 'failed'" if output
+            else "; the summary above is the failed run's")
+    return head + kept
 
 
 def _print_body(summary) -> None:

@@ -119,7 +119,7 @@ def peak_guard(t, rec: dict, *, wave_speed: float, length: float, start: str, t_
     if matched:
         share = slack_share(t, rec["dt"], rec["n_slack"], t_snap_sigma)
         if np.isfinite(share) and share > SLACK_MAX:
-            notes.append(f"slack: a link slack {share:.3g} of the fall from the matched start (limit {SLACK_MAX:g})")
+            notes.append(f"slack: a link slack during {share:.3g} of the fall from the matched start (limit {SLACK_MAX:g})")
     if np.isfinite(energy_drift) and energy_drift > ENERGY_FLAG * energy_scale:
         notes.append(f"energy: drift {energy_drift:.3g} above {ENERGY_FLAG:g} of the energy scale {energy_scale:.3g}")
     return ring, not notes, "; ".join(notes)

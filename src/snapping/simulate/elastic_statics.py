@@ -182,6 +182,9 @@ def statics(line, z0: np.ndarray, *, hold_free_end: bool = False, tol: float = 1
     free = np.ones(N, bool)
     if hold_free_end:
         free[0] = False
+    if not free.any():  # one link held at both ends: nothing is free, the start is the equilibrium
+        line.statics_iterations = 0
+        return z
     idx = np.sort(np.concatenate([4 * np.flatnonzero(free), 4 * np.flatnonzero(free) + 1]))
     mrow = np.repeat(line.m[free], 2)
     mdiag = sp.diags(np.concatenate([np.repeat(line.m, 4), [1.0, 1.0]]))
