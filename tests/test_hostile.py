@@ -80,7 +80,15 @@ def untouched(files):
 
 
 # ------------------------------------------------------------------ Python API
-BAD_REALS = [NAN, INF, -INF, "0.3", None, [0.3], True, object()]
+class _Opaque:
+    """A value of no number type (like ``object()``), with a fixed repr: the test ids it makes
+    are the same in every process, as pytest-xdist needs of its workers' collections."""
+
+    def __repr__(self) -> str:
+        return "object()"
+
+
+BAD_REALS = [NAN, INF, -INF, "0.3", None, [0.3], True, _Opaque()]
 BAD_FRACTIONS = BAD_REALS + [-0.3, 0.0, 1.0, 1e300]
 
 

@@ -123,6 +123,13 @@ def F(tmp_path_factory) -> dict:
     d = tmp_path_factory.mktemp("hostile_gen")
     run = simulate.run(0.5, 40, tol=1e-6, method="euler-richardson", chords="arclength",
                        output=d / "run.nc")  # to the snap: fit works on it (the paper's run, as designed)
+    # compile the kernels of the runs below before any case's clock starts: TIME_LIMIT catches a
+    # hang on bad input, not a cold numba cache (which file compiles a kernel first depends on the
+    # order the files run in: on two processes, pytest-xdist, this file may be the first)
+    for key in ("Problem.run", "simulate.run", "simulate.run(fixed)", "simulate.run(fast)", "simulate.run_ensemble",
+                "simulate.integrate_fixed"):
+        call, base = SPECS[key][:2]
+        call(None, **base)
     return {"ds": run.dataset, "run_nc": str(run.path), "root": str(d)}
 
 
