@@ -40,8 +40,30 @@ def test_study_runs_its_cells_by_the_chosen_method():
         assert int(ds.n_rhs_level.sel(chi=CHI, number=1.0 / C).values[k]) == int(links["n_rhs"])
 
 
+def test_cell_passes_the_node_method_when_asked(monkeypatch):
+    """The default is the links method (branch shipstretch): a cell asked for the node method runs it."""
+    import snapping.simulate.elastic as E
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def spy(problem, elastic, **kw):
+        seen.append(kw["method"])
+        raise Stop
+
+    monkeypatch.setattr(E, "solve", spy)
+    for method in ("rodas4", "rodas4-links"):
+        with pytest.raises(Stop):
+            R._run_task(CHI, "stretching", 1.0 / C, {"n_links": 4, "frac": 0.25}, TOL, method=method)
+    assert seen == ["rodas4", "rodas4-links"]
+
+
 def test_default_method_and_the_study_key():
-    assert S.STRETCH_METHOD == "rodas4" and "rodas4-links" in S.STRETCH_METHODS
+    # the regime study's default is the links method (the shipped study, branch shipstretch); the
+    # caps' stretch factor keeps its own default, the node method (the design answers unchanged)
+    assert S.STRETCH_METHOD == "rodas4-links" and "rodas4" in S.STRETCH_METHODS and caps.STRETCH_METHOD == "rodas4"
     seen = []
 
     def fake(chi, mech, number, level, tol, damping=None, start=None, method=None):
@@ -51,11 +73,11 @@ def test_default_method_and_the_study_key():
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(R, "_run_task", fake)
-        d = R.regimes("stretching", [CHI], [0.1], levels=2, first=-4, progress=False)
-        assert set(m for m in seen if m is not None) == {"rodas4"} and d.attrs["elastic_method"] == "rodas4"
+        lk = R.regimes("stretching", [CHI], [0.1], levels=2, first=-4, progress=False)
+        assert set(m for m in seen if m is not None) == {"rodas4-links"} and lk.attrs["elastic_method"] == "rodas4-links"
         seen.clear()
-        lk = R.regimes("stretching", [CHI], [0.1], levels=2, first=-4, method="rodas4-links", progress=False)
-        assert set(m for m in seen if m is not None) == {"rodas4-links"}
+        d = R.regimes("stretching", [CHI], [0.1], levels=2, first=-4, method="rodas4", progress=False)
+        assert set(m for m in seen if m is not None) == {"rodas4"} and d.attrs["elastic_method"] == "rodas4"
     assert d.attrs["regimes_study"] != lk.attrs["regimes_study"]  # a file of one method is not resumed by the other
     for bad in ("radau", "links", 4):
         with pytest.raises(SnappingInputError, match="method"):

@@ -75,7 +75,9 @@ def test_floor_is_in_the_links_study_key(monkeypatch):
 
     monkeypatch.setattr(R, "_run_task", fake)
     lk = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, method="rodas4-links", progress=False)
-    nd = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, progress=False)
+    nd = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, method="rodas4", progress=False)
+    dflt = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, progress=False)  # the links method
+    assert dflt.attrs["regimes_study"] == lk.attrs["regimes_study"]
     assert '"tip_time": 3e-08' in lk.attrs["regimes_study"] and "tip_time" not in nd.attrs["regimes_study"]
 
 

@@ -33,7 +33,8 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   hanging equilibrium let go, was the study of stop 29) of wave speed c; the number scanned is the
   *inverse* stretching number ``sqrt(g L)/c`` (so that number -> 0 is the inextensible
   ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4
-  (``STRETCH_METHOD``) and the elastic grid damping ``damping`` (the shortest longitudinal
+  (``STRETCH_METHOD``: in link coordinates by default, the shipped study's; ``method="rodas4"``
+  in node coordinates) and the elastic grid damping ``damping`` (the shortest longitudinal
   mode's damping ratio, a link damping ``zeta h sqrt(EA lambda)`` vanishing with h, so the
   continuum extrapolation removes it), the stop rule armed at ``STRETCH_STOP_FLOOR``
   (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links
@@ -350,8 +351,9 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         stored as the attribute ``elastic_start`` (and, other than ``"stretched"``, in the
         study's key: a stop-29 file, run from ``"stretched"``, is resumed by that value).
     method : {"rodas4", "rodas4-links"}, optional
-        Stretching only: the elastic line's method (default ``STRETCH_METHOD``, ``"rodas4"``, the shipped
-        study's; ``"rodas4-links"``: RODAS4 in link coordinates, steps not capped by c). Stored as the
+        Stretching only: the elastic line's method (default ``STRETCH_METHOD``, ``"rodas4-links"``, the
+        shipped study's: RODAS4 in link coordinates, steps not capped by c; ``"rodas4"``: node coordinates,
+        the study shipped before). Stored as the
         attribute ``elastic_method`` and in the study's key (a file of the other method is refused).
     workers : int
         Local worker processes (the sweep's, :mod:`snapping._workers`).

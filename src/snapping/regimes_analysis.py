@@ -362,17 +362,19 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
 
 
 #: level_ratios: an extrapolated same-links ratio whose error bar (its last Richardson correction) exceeds
-#: this fraction of it is no limit and is left out (the stretching study at chi = 0.1: orders 0.2-0.3, bars
-#: 56-114% of the ratio, the ideal's own peak still growing 17.2, 22.0, 26.7 over the levels)
+#: this fraction of it is no limit and is left out (the node-method stretching study shipped before branch
+#: shipstretch, at chi = 0.1: orders 0.2-0.3, bars 56-114% of the ratio, the ideal's own peak still growing
+#: 17.2, 22.0, 26.7 over its levels -4 ... -2)
 RATIO_MAX_ERROR = 0.5
 
 
 def level_ratios(ds, quantity: str = "v_peak") -> dict:
     """The peak over the ideal's *on the same links*, level by level, extrapolated across the levels
     (:func:`snapping.continuum.extrapolate`) -- for a study whose levels are too coarse for each
-    limit apart (the stretching study's: its ideal limits carry 3-40% error bars, their observed
-    orders 0.2-0.3) while the ratio, its discretisation errors shared, moves by 1-2% from level to
-    level. Per chi: ``ratio``, ``error`` and ``order`` per number (nan where the extrapolated ratio
+    limit apart (the node-method stretching study shipped before branch shipstretch: its ideal limits
+    carried 3-40% error bars, observed orders 0.2-0.3) while the ratio, its discretisation errors shared,
+    moves by 1-2% from level to level; for the shipped links study, whose limits are resolved (bars
+    <= 0.36%), a second estimate of its crossovers (the same within 1% at chi = 0.1-0.3). Per chi: ``ratio``, ``error`` and ``order`` per number (nan where the extrapolated ratio
     leaves (0, 2) or its error bar exceeds :data:`RATIO_MAX_ERROR` of it: an order near 0, a failed
     extrapolation), and :func:`crossover` on them.
 

@@ -34,12 +34,15 @@ ACCURACY = {
 #: the largest number a cell takes (every mechanism's number is a ratio to the chain's scales)
 NUMBER_MAX = 1e4
 
-#: stretching: the elastic line's method in a study (the compiled RODAS4 of
-#: :mod:`snapping.simulate.elastic_rodas`; its grid damping is the study's ``damping``)
-STRETCH_METHOD = "rodas4"
-#: stretching: the elastic methods a study may take (``regimes(method=)``): the default node-coordinate
-#: RODAS4, or RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`), whose steps
-#: are not capped by the wave speed c (``benchmarks/stretch_links.py``, docs/guide/regimes.md)
+#: stretching: the elastic line's method in a study: RODAS4 in link coordinates
+#: (:mod:`snapping.simulate.elastic_links_rodas`; its grid damping is the study's ``damping``), the
+#: shipped study's (``benchmarks/stretch_scan.py``: v_peak within 1% in 32/32 cells). The regime study's
+#: only: the caps' stretch factor keeps its own default (:data:`snapping.caps_runs.STRETCH_METHOD`, "rodas4")
+STRETCH_METHOD = "rodas4-links"
+#: stretching: the elastic methods a study may take (``regimes(method=)``): the node-coordinate
+#: RODAS4 of :mod:`snapping.simulate.elastic_rodas` (the study shipped before branch shipstretch), or the
+#: default, RODAS4 in link coordinates, whose steps are not capped by the wave speed c
+#: (``benchmarks/stretch_links.py``, docs/guide/regimes.md)
 STRETCH_METHODS = ("rodas4", "rodas4-links")
 #: stretching: the running peak of v_max (units sqrt(g L)) above which the elastic run's stop rule
 #: judges the snap (:func:`snapping.simulate.elastic.solve`'s ``stop_floor``). Its default bound,
@@ -118,8 +121,8 @@ STRETCH_MAX_RHS_LINKS = 200_000
 
 def stretch_tip_floor(c: float, method: str) -> float:
     """The shortest free-end link of a stretching run of wave speed ``c`` by ``method``:
-    ``STRETCH_TIP_TIME * c`` for ``"rodas4-links"``, 0 (no floor: the shipped node-method study's
-    links) otherwise.
+    ``STRETCH_TIP_TIME * c`` for ``"rodas4-links"``, 0 (no floor: the node-method study's
+    links, shipped before branch shipstretch) otherwise.
 
     >>> round(stretch_tip_floor(442.0, "rodas4-links"), 12), stretch_tip_floor(442.0, "rodas4")
     (1.326e-05, 0.0)

@@ -49,8 +49,8 @@ def _add_regimes(sub) -> None:
     p.add_argument("--start", default=None, choices=["matched", "stretched", "unstretched"],
                    help="stretching: the elastic line's start (default matched: no release wave)")
     p.add_argument("--elastic-method", default=None, choices=["rodas4", "rodas4-links"],
-                   help="stretching: the elastic line's method (default rodas4, node coordinates, the shipped study's; "
-                        "rodas4-links: link coordinates, steps not capped by the wave speed)")
+                   help="stretching: the elastic line's method (default rodas4-links, link coordinates, steps not "
+                        "capped by the wave speed, the shipped study's; rodas4: node coordinates)")
     p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
     p.add_argument("-o", "--output", default=None, metavar="FILE", help="the study file (netCDF), resumable")
