@@ -348,11 +348,12 @@ def regime_map(ds, path=None, quantity: str = "v_peak"):
     ax.set_xscale("log")
     ax.set_xlabel(f"{ds.attrs['number_name']} ({ds.attrs['mechanism']})")
     ax.set_ylabel("chi")
-    title = f"what caps the snap: {ds.attrs['mechanism']} ({quantity} / ideal; contour {LEVEL:g})"
+    head, tail = f"what caps the snap: {ds.attrs['mechanism']}", f"({quantity} / ideal; contour {LEVEL:g})"
+    title = f"{head} {tail}" if len(head) + len(tail) < 60 else f"{head}\n{tail}"  # (a long one in two lines)
     if "converged" in ds and not ds["converged"].values.all():
         ax.set_title(title + "\n?: not converged (left out of the fits)", fontsize=10)
     else:
-        ax.set_title(title)
+        ax.set_title(title, fontsize=10 if "\n" in title else None)
     fig.tight_layout()
     if path is not None:
         from ._files import save_figure
