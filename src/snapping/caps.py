@@ -328,12 +328,19 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
     if not (graded == "auto" or graded is True or graded is False):
         raise V.SnappingInputError(f"graded={graded!r} is not one of 'auto', True, False")
-    runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method)
-    if isinstance(N, str) and N == "auto":
-        r = _auto(runs, quantity, alone, graded)
-    else:
+    if not (isinstance(N, str) and N == "auto"):
         N = V.integer("N", N, 2, 20000)
-        r = _answer(runs, N, quantity, check and N >= 4, alone, graded)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(desc=f"{sp.name or 'line'}, chi={chi:g}", unit="run", leave=False, disable=None)  # (off without a terminal)
+    try:
+        runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method, bar=bar)
+        if N == "auto":
+            r = _auto(runs, quantity, alone, graded)
+        else:
+            r = _answer(runs, N, quantity, check and N >= 4, alone, graded)
+    finally:
+        bar.close()
     r.update({"runs": runs.log, "n_rhs": sum(x["n_rhs"] for x in runs.log), "wall": time.perf_counter() - t0,
               "cpu": time.process_time() - c0})
     return r
@@ -503,7 +510,9 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
                                    "(m/s^2)")
     t0, c0 = time.perf_counter(), time.process_time()
     rows, n_rhs = [], 0
-    for chi in sorted(chis):
+    from tqdm.auto import tqdm
+
+    for chi in tqdm(sorted(chis), desc=f"design {sp.name or 'line'}", unit="chi", leave=False, disable=None):
         r = cap(sp, chi, N=N, tol=tol, check=False, alone=alone, quantity=quantity, damping=damping,
                 stiff_tol=stiff_tol, graded=graded)
         n_rhs += r["n_rhs"]

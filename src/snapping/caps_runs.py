@@ -311,10 +311,17 @@ class Runs:
     """The runs of one answer of :func:`snapping.caps.cap`, each made once: ``get(on, N)`` (``on``
     the mechanisms, () the ideal) runs it or returns it; ``log`` says what each cost."""
 
-    def __init__(self, sp, chi, tol, stiff_tol, damping, stretch_method=STRETCH_METHOD):
+    def __init__(self, sp, chi, tol, stiff_tol, damping, stretch_method=STRETCH_METHOD, bar=None):
         self.sp, self.chi, self.tol, self.stiff_tol, self.damping = sp, chi, tol, stiff_tol, damping
         self.stretch_method = stretch_method  # the stretching factor's elastic method (:func:`stretch_factor`)
         self.done, self.log = {}, []
+        self.bar = bar  # a progress bar (tqdm): one step per run made, the last run in its postfix
+
+    def _logged(self, entry: dict) -> None:
+        self.log.append(entry)
+        if self.bar is not None:
+            self.bar.set_postfix_str(f"{entry['run']}: {entry['N']} links, {entry['cpu']:.1f} s", refresh=False)
+            self.bar.update(1)
 
     def get(self, on, N: int) -> dict:
         key = (tuple(on), int(N))
@@ -326,7 +333,7 @@ class Runs:
                 p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min)
             r = _run(p, method, tol)
             self.done[key] = r
-            self.log.append({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
+            self._logged({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
                              "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
 
@@ -343,7 +350,7 @@ class Runs:
             r = _run(p, "rodas4", GRADED_TOL)
             r["links"] = int(h.size)
             self.done[key] = r
-            self.log.append({"run": ("+".join(on) or "ideal") + f" (graded {level})", "N": int(h.size),
+            self._logged({"run": ("+".join(on) or "ideal") + f" (graded {level})", "N": int(h.size),
                              "method": r["method"], "tol": r["tol"], "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
 
