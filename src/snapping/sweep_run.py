@@ -95,7 +95,11 @@ def _run_task(task: list) -> list:
     if len(task) == 1:
         params, path = task[0]
         try:
-            _run_one(params, path)
+            if "elastic" in params:
+                _run_one(params, path)
+            else:  # (a sweep interrupted while the run is still starting does not wait for it to start)
+                with _workers.until_first_step():
+                    _run_one(params, path)
         except Exception as exc:  # numerical failures and run-time refusals are reported, not raised
             return [_failure_of(exc, path)]
         return [None]
@@ -263,6 +267,8 @@ def _run_sweep(grid: Grid, out_dir, *, workers, scheduler, progress, size, log, 
             outcomes = result()
         except Exception as exc:  # the task itself could not run (its worker died, ...): all its runs
             outcomes = [_failure_of(exc, path) for _, path in task]
+        if any(o is not None and o["kind"] == "cancelled" for o in outcomes):
+            raise KeyboardInterrupt  # a worker got SIGINT between its runs: the sweep was interrupted
         for (params, _), outcome in zip(task, outcomes):
             if outcome is not None:
                 failures.append(RunFailure(chi=params["chi"], N=params["N"], options=dict(grid.options), **outcome))

@@ -118,6 +118,11 @@ class RunInterrupted(KeyboardInterrupt):
         """128 + the signal number (130 for SIGINT, 143 for SIGTERM)."""
         return 128 + int(self.signum)
 
+    def __reduce__(self):
+        # (picklable, e.g. from a sweep's worker process: the default rebuilds it from the
+        # message alone, which fails for want of ``signum``, and breaks the worker pool)
+        return type(self), (str(self), self.signum, self.dataset, self.path), self.__dict__
+
 
 #: the exception of each failure code of the compiled loops
 FAILURES = {
