@@ -374,51 +374,128 @@ def test_combined_runs_that_ended_before_the_snap_say_so(tmp_path, capsys):
     assert (comb["v_peak"] > 0).all()  # the maxima over the run are kept
 
 
-@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
-@pytest.mark.parametrize("to_group", [True, False], ids=["ctrl-c", "sigint-to-the-sweep-alone"])
-def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_path, to_group):
-    """SIGINT to the process group (Ctrl-C) or to the sweep alone: exit 130 with one line, no
-    traceback, the queued runs not started, the runs in progress saved resumable, no worker left."""
-    import signal
+def _cli_sweep(tmp_path, env, options: str):
+    """A ``snapping sweep`` of 4 runs on 2 workers in its own process group, the grid's options
+    updated with ``options`` (a dict's source)."""
     import subprocess
     import sys
-    import time
 
-    pid_file, out = tmp_path / "pids", tmp_path / "out"
-    env = _worker_env(pid_file)
-    # the CLI's sweep, with runs that checkpoint every 0.5 s (to see them under way) and last ~1 min
+    out = tmp_path / "out"
     script = ("import sys\nfrom snapping import sweep as S\nfrom snapping.cli import main\nG = S.Grid\n"
-              "S.Grid = lambda chi, N, options: G(chi, N, {**options, 't_end': 60.0, 'checkpoint_every': 0.5})\n"
+              f"S.Grid = lambda chi, N, options: G(chi, N, {{**options, **{options}}})\n"
               f"sys.exit(main(['sweep', '--chi', '0.3,0.4,0.5,0.6', '--N', '200', '--method', 'fast', '--workers', "
               f"'2', '-o', {str(out)!r}]))\n")
-    cmd = [sys.executable, "-c", script]
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
-    pids = []
+    return subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True), out
+
+
+def _interrupt(proc, pids, to_group, timeout=60.0):
+    """SIGINT to the sweep's process group (Ctrl-C) or to the sweep alone; its stderr once it
+    ended (within ``timeout`` s: what "promptly" means under load), and no worker left."""
+    import signal
+    import subprocess
+
     try:
-        deadline = time.monotonic() + 120
-        pids = _wait_for_workers(proc, pid_file, deadline)
-        assert len(pids) == 2, f"the workers did not start ({pids})"
-        while len(list(out.glob("run_*.nc"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)  # until both runs are under way (their first checkpoints)
-        assert proc.poll() is None, "the sweep ended before it could be interrupted"
-        t0 = time.monotonic()
         (os.killpg if to_group else os.kill)(proc.pid, signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
-        elapsed = time.monotonic() - t0
+        try:
+            _, err = proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"the sweep did not end within {timeout:g} s of the SIGINT")
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-        for p in pids:
-            if _alive(p):
-                os.kill(p, signal.SIGKILL)
+        left = [p for p in pids if _alive(p)]
+        for p in left:
+            os.kill(p, signal.SIGKILL)
+    assert not left, f"workers {left} outlived the interrupted sweep"
     assert proc.returncode == 130, err
     assert "Traceback" not in err and err.strip().count("\n") == 0 and "interrupted" in err
-    assert elapsed < 20.0  # the runs take a minute each: the queued ones were not run
-    statuses = [str(simulate.load_run(p).attrs["status"]) for p in sorted(out.glob("run_*.nc"))]
-    assert statuses == ["interrupted", "interrupted"]  # the two in progress, resumable; the others not started
-    assert not [p for p in pids if _alive(p)]
+    return err
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+@pytest.mark.parametrize("to_group", [True, False], ids=["ctrl-c", "sigint-to-the-sweep-alone"])
+def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_path, to_group):
+    """SIGINT to the process group (Ctrl-C) or to the sweep alone, once the first two runs are
+    under way: exit 130 with one line, no traceback, the two runs saved resumable, the queued
+    runs not started, no worker left. The runs cannot end (t_end 1e4: hours), so that a third
+    run file can only come from a queued run started after the interrupt."""
+    import time
+
+    pid_file = tmp_path / "pids"
+    # runs that checkpoint every 0.5 s (to see them under way) and last hours (t_end 1e4; a thin record)
+    proc, out = _cli_sweep(tmp_path, _worker_env(pid_file), "{'t_end': 1e4, 'record_thin': 1e-2, 'checkpoint_every': 0.5}")
+    pids, under_way = [], {}
+    try:
+        deadline = time.monotonic() + 300  # (a cold numba cache under load: minutes; idle: ~10 s)
+        pids = _wait_for_workers(proc, pid_file, deadline)
+        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
+        while len(under_way) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # until both runs are under way: a checkpoint of each saved
+            for p in out.glob("run_*.nc"):
+                if p.name not in under_way:
+                    under_way[p.name] = str(simulate.load_run(p).attrs["status"])
+        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
+        assert sorted(under_way.values()) == ["checkpoint", "checkpoint"], f"the runs are not under way: {under_way}"
+    except BaseException:
+        proc.kill()
+        proc.wait()
+        for p in pids:
+            if _alive(p):
+                os.kill(p, 9)
+        raise
+    _interrupt(proc, pids, to_group)
+    statuses = {p.name: str(simulate.load_run(p).attrs["status"]) for p in out.glob("run_*.nc")}
+    assert statuses == dict.fromkeys(under_way, "interrupted")  # the two in progress, resumable; the others not started
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+def test_cli_sweep_sigint_while_its_runs_are_starting_ends_at_once(tmp_path):
+    """SIGINT to the sweep alone while its workers' runs are still starting (a slow start, as a
+    cold numba compilation under load: here a sleep of 10 min before the first steps, in the
+    workers only): the sweep ends promptly (nothing of those runs to save), exit 130, no file."""
+    import time
+
+    pid_file, site = tmp_path / "pids", tmp_path / "site"
+    site.mkdir()
+    # in the sweep's worker processes only: each run's first chunk of steps starts after 600 s
+    (site / "sitecustomize.py").write_text(
+        "import sys\n"
+        "if '--multiprocessing-fork' in sys.orig_argv:\n"
+        "    import os, time\n"
+        "    from snapping.simulate import driver\n"
+        "    drive = driver._drive_locked\n"
+        "    def slow(eng, *a, **k):\n"
+        "        loop = eng.loop\n"
+        "        def slow_loop(*la, **lk):\n"
+        f"            open(os.path.join({str(tmp_path)!r}, f'starting.{{os.getpid()}}'), 'w').close()\n"
+        "            time.sleep(600)\n"
+        "            return loop(*la, **lk)\n"
+        "        eng.loop = slow_loop\n"
+        "        return drive(eng, *a, **k)\n"
+        "    driver._drive_locked = slow\n")
+    env = _worker_env(pid_file)
+    env["PYTHONPATH"] = os.pathsep.join([str(site), env["PYTHONPATH"]])
+    proc, out = _cli_sweep(tmp_path, env, "{'t_end': 1e4, 'record_thin': 1e-2}")
+    pids = []
+    try:
+        deadline = time.monotonic() + 300
+        pids = _wait_for_workers(proc, pid_file, deadline)
+        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
+        while len(list(tmp_path.glob("starting.*"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # until both workers are in their runs' (slow) start
+        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
+        assert len(list(tmp_path.glob("starting.*"))) == 2, "the runs did not start"
+    except BaseException:
+        proc.kill()
+        proc.wait()
+        for p in pids:
+            if _alive(p):
+                os.kill(p, 9)
+        raise
+    _interrupt(proc, pids, to_group=False)
+    assert list(out.glob("run_*.nc")) == []  # nothing was computed, nothing saved; nothing started after
 
 
 def test_cli_reproduce_with_failed_runs_prints_the_table_and_exits_1(tmp_path, capsys, monkeypatch):
