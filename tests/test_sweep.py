@@ -376,8 +376,19 @@ def test_combined_runs_that_ended_before_the_snap_say_so(tmp_path, capsys):
 
 def _interrupted_or_stopped(what):
     """A task for a local worker: a run interrupted there (a big Dataset with it), or whether
-    the worker was told to stop."""
-    if what == "interrupt":
+    the worker was told to stop (after a SIGINT to itself, or after clearing the flag)."""
+    import time
+
+    if what == "sigint":  # (between runs: the worker's own handler)
+        import signal
+
+        os.kill(os.getpid(), signal.SIGINT)
+        t0 = time.monotonic()
+        while not S._workers.stopped() and time.monotonic() - t0 < 2.0:
+            time.sleep(0.01)
+    elif what == "clear":
+        S._workers._STOP._value.value = 0
+    elif what == "interrupt":
         import xarray as xr
 
         from snapping.simulate.errors import RunInterrupted
@@ -388,9 +399,10 @@ def _interrupted_or_stopped(what):
 
 
 def test_a_run_interrupted_in_a_worker_reaches_the_sweep_and_no_queued_task_starts():
-    """A run interrupted in a worker (SIGINT or SIGTERM reached it) comes back as such (not as a
-    broken pool: it unpickles, and without its 400 kB Dataset, which is in its file), and the
-    worker starts no queued task even before the sweep itself acts on it (here it never does)."""
+    """A SIGINT to a worker between its runs stops the sweep (no traceback). A run interrupted in
+    a worker (SIGINT or SIGTERM reached it) comes back as such (not as a broken pool: it
+    unpickles, and without its 400 kB Dataset, which is in its file), and the worker starts no
+    queued task even before the sweep itself acts on it (here it never does)."""
     from snapping.simulate.errors import RunInterrupted
 
     got = {}
@@ -401,7 +413,9 @@ def test_a_run_interrupted_in_a_worker_reaches_the_sweep_and_no_queued_task_star
         except KeyboardInterrupt as exc:
             got[args[0]] = exc
 
-    S._workers.run_all(1, _interrupted_or_stopped, [("interrupt",), ("next",)], collect)  # one worker: in order
+    calls = [("sigint",), ("clear",), ("interrupt",), ("next",)]
+    S._workers.run_all(1, _interrupted_or_stopped, calls, collect)  # one worker: in order
+    assert got["sigint"] is True and got["clear"] is False  # a SIGINT to a worker stops the sweep, no traceback
     exc = got["interrupt"]
     assert type(exc) is RunInterrupted and exc.signum == 2 and exc.exit_status == 130
     assert exc.path == "run.nc" and exc.dataset is None and "interrupted by SIGINT" in str(exc)
