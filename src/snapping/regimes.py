@@ -67,7 +67,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
+                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_SNAP_PEAKS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
@@ -195,6 +195,8 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
                            f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
     row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
+    if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
+        row.update({q: float(a[f"{q}_snap"]) for q in STRETCH_SNAP_PEAKS if f"{q}_snap" in a})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -410,7 +412,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         if not isinstance(method, str) or method not in STRETCH_METHODS:
             raise V.SnappingInputError(f"method={method!r} is not one of {STRETCH_METHODS} (a stretching study's "
                                        f"elastic methods)")
-        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR)
+        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR, peaks="snap")
         if method == "rodas4-links":  # its tip links floored (regimes_spec.stretch_tip_floor)
             acc["tip_time"] = STRETCH_TIP_TIME
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
