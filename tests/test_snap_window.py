@@ -57,11 +57,12 @@ def test_post_snap_spike_is_excluded():
     assert snap_peaks(T, V, {"a": a}, {"a": (1e4, T[j])}, 1.0)["a"] == pytest.approx(100.0, rel=1e-12)
 
 
-@pytest.mark.parametrize("where", ["before", "after"])
+@pytest.mark.parametrize("where", ["before", "after", "last"])
 def test_spike_inside_the_snap_is_included(where):
     a = _a()
-    j = 900 if where == "before" else I_END - 1  # before the speed peak / after it with v >= 0.9
-    assert V[j] >= 0.9 or T[j] < 1.0
+    # before the speed peak / after it with v >= 0.9 / the window's last step (the first below 0.9)
+    j = {"before": 900, "after": I_END - 1, "last": I_END}[where]
+    assert V[j] >= 0.9 or T[j] < 1.0 or j == I_END
     a[j] = 5e3
     a[I_END + 300] = 1e4  # and a bigger one after the snap, which is the run's peak
     out = snap_peaks(T, V, {"a": a}, {"a": (1e4, T[I_END + 300])}, 1.0)
