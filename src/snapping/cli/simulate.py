@@ -131,7 +131,8 @@ def _add_simulate(sub) -> None:
     from ._elastic import add_elastic_options
 
     add_elastic_options(p)
-    p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file: .nc, .nc4 or .netcdf (a new path, or --overwrite)")
+    p.add_argument("-o", "--output", default=None,
+                   help="write the run to this netCDF4 file: .nc, .nc4 or .netcdf (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
                    help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
