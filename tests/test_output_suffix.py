@@ -60,6 +60,19 @@ def test_commands_refuse_a_netcdf_output_under_another_suffix(argv, tmp_path, ca
     assert list(tmp_path.iterdir()) == []  # nothing written, nothing started
 
 
+@pytest.mark.parametrize("kind", ["device", "directory"])
+def test_a_path_that_is_not_a_file_is_named_as_such_first(kind, tmp_path, capsys):
+    """A directory or device given to -o is refused as what it is (check_output's words), the
+    suffix aside: it is never replaced whatever its name."""
+    p = "/dev/null" if kind == "device" else str(tmp_path / "adir")
+    if kind == "directory":
+        os.mkdir(p)
+    assert netcdf_suffix(p) == p
+    status, err = _cli(["simulate", "--chi", "0.3", "--N", "4", "-o", p, "--overwrite"], capsys)
+    assert status == 2 and len(err) == 1 and ("regular file" in err[0] or "directory" in err[0]), err
+    assert "suffix" not in err[0]
+
+
 def test_table_build_refuses_before_any_run(tmp_path, capsys):
     from snapping.table.build import main as build_main
 

@@ -473,7 +473,9 @@ NETCDF_SUFFIXES = (".nc", ".nc4", ".netcdf")
 def netcdf_suffix(path, *, name: str = "output") -> str:
     """``path`` of a netCDF output, refused (naming ``name``, the path and
     :data:`NETCDF_SUFFIXES`) when its suffix is not a netCDF file's: a command never writes
-    netCDF under a name that says another format (``-o run.txt``). Checked before the work.
+    netCDF under a name that says another format (``-o run.txt``). Checked before the work; a
+    path that is there and is not a regular file is left to :func:`check_output`, which refuses
+    it naming what it is (a directory, a device, a FIFO).
 
     >>> netcdf_suffix("run.nc")
     'run.nc'
@@ -483,6 +485,11 @@ def netcdf_suffix(path, *, name: str = "output") -> str:
     snapping._validate.SnappingInputError: --output='run.txt' has the suffix .txt, which is not a netCDF file's: the file is written as netCDF4; give a name ending in .nc, .nc4 or .netcdf
     """
     p = os.fspath(V.file_path(name, path))
+    try:
+        if not stat.S_ISREG(os.stat(p).st_mode):  # a directory, device, FIFO: check_output names what it is
+            return p
+    except OSError:  # (nothing there yet, or not reachable: check_output says why)
+        pass
     suffix = os.path.splitext(p)[1]
     if suffix.lower() not in NETCDF_SUFFIXES:
         what = "has no suffix" if not suffix else f"has the suffix {suffix}, which is not a netCDF file's"
