@@ -35,8 +35,9 @@ def _add_regimes(sub) -> None:
     )
     p.add_argument("--mechanism", choices=sorted(MECHANISMS), default=None, help="the mechanism scanned")
     p.add_argument("--chi", type=_floats, default=None, help="comma-separated end separations in (0, 1)")
-    p.add_argument("--numbers", type=_floats, default=None, help="comma-separated values of the mechanism's number (nondimensional: Numbers above), each in "
-                        "(0, 1e4]")
+    p.add_argument("--numbers", type=_floats, default=None,
+                   help="comma-separated values of the mechanism's number (nondimensional: Numbers above), each "
+                        "in (0, 1e4]")
     p.add_argument("--accuracy", choices=sorted(ACCURACY), default="coarse",
                    help="levels preset (default coarse: 3 levels; medium: 4 levels, ~1e-3 in the ideal's peaks)")
     p.add_argument("--levels", type=int, default=None, help="override the preset's refinement levels")
