@@ -36,7 +36,9 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   (``STRETCH_METHOD``: in link coordinates by default, the shipped study's; ``method="rodas4"``
   in node coordinates) and the elastic grid damping ``damping`` (the shortest longitudinal
   mode's damping ratio, a link damping ``zeta h sqrt(EA lambda)`` vanishing with h, so the
-  continuum extrapolation removes it), the stop rule armed at ``STRETCH_STOP_FLOOR``
+  continuum extrapolation removes it), its acceleration and tension peaks the snap's
+  (``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`; the key says
+  ``"peaks": "snap"``), the stop rule armed at ``STRETCH_STOP_FLOOR``
   (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links
   costs 6.8 M evaluations for one coarse cell (chi = 0.3, c = 30, 108 links) and puts the
   acceleration peak at 2.9e6.
