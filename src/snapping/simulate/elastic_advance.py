@@ -229,14 +229,17 @@ class RodasRun:
         ln = st.line
         self.model = (ln.m, ln.tabw, ln.snode, np.concatenate([ln.snode, [0.0]]), ln.snode - 0.5 * ln.h)
 
-    def advance(self, t_snapshot=np.inf) -> int:
-        """Steps until the next return code (``R_*``), the next snapshot time ``t_snapshot``."""
+    def advance(self, t_snapshot=np.inf, rows=None) -> int:
+        """Steps until the next return code (``R_*``), the next snapshot time ``t_snapshot``;
+        ``rows``: the record buffer's rows this call may fill (default all: R_BUFFER once full;
+        fewer return sooner, the same steps: :class:`snapping.simulate.elastic_progress.Chunks`)."""
         st = self.st
         self.sctl[S_TSNAP] = t_snapshot
+        rec = self.rec if rows is None else self.rec[:rows]
         return advance(st.N, st.y, st.St, st.B, st.gW, st.gD, st.dsp, st.F, st.ab, st.piv, st.pins, st.pinpar,
                        st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.ctl, *st.work, *self.model, self.mm,
                        self.PY0, self.PY1, self.PC, self.PT, self.ref, self.keep, self.nkeep, self.after, self.best,
-                       self.sctl, self.rec, self.peak_z)
+                       self.sctl, rec, self.peak_z)
 
     def drain(self) -> np.ndarray:
         """The record rows since the last drain (t first, then STEP_NAMES)."""
@@ -275,13 +278,14 @@ class LinksRun(RodasRun):
         super().__init__(stepper, mm0, **kw)
         self.PN0 = np.zeros_like(self.PY0)
 
-    def advance(self, t_snapshot=np.inf) -> int:
+    def advance(self, t_snapshot=np.inf, rows=None) -> int:
         st = self.st
         self.sctl[S_TSNAP] = t_snapshot
+        rec = self.rec if rows is None else self.rec[:rows]
         return advance_links(st.N, st.zl, st.yn, st.St, st.B, st.gW, st.gD, st.dsp, st.ab, st.piv, st.pins,
                              st.pinpar, st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.zn1, st.ctl,
                              *st.work, st.cw, *self.model, self.mm, self.PY0, self.PY1, self.PC, self.PT, self.PN0,
-                             self.ref, self.keep, self.nkeep, self.after, self.best, self.sctl, self.rec, self.peak_z)
+                             self.ref, self.keep, self.nkeep, self.after, self.best, self.sctl, rec, self.peak_z)
 
     def dense(self, s):
         return ELR.LinksDense(self.st.links, self.PT[s, 0], self.PT[s, 1], self.PY0[s].copy(), self.PY1[s].copy(),
