@@ -262,6 +262,38 @@ class RodasRun:
     def last_start(self):
         return self.start(int(self.sctl[S_PREV]))
 
+    #: the stepper's arrays that carry a run from one step to the next (the rest is scratch that
+    #: every attempt sets anew): the state, the controls and counts (the step-size controller's
+    #: step and last error among them), f (``St[0]``) and the Jacobian at the state
+    STEPPER_STATE = ("y", "ctl", "St0", "B", "gW", "gD", "dsp")
+    #: the run's: the step slots (the peaks' kept steps, the last step), the peaks, the run's
+    #: controls and the running peak's state (the record is drained at every return)
+    RUN_STATE = ("PY0", "PY1", "PC", "PT", "ref", "keep", "nkeep", "after", "best", "sctl", "peak_z")
+
+    def state(self) -> dict:
+        """{name: copy} of the arrays from which :meth:`restore` continues the run, bit for bit:
+        taken at a return of the compiled loop, after :meth:`drain` (what a checkpoint of the
+        run must hold besides its record, snapshots and inputs;
+        ``benchmarks/probe_elastic_restore.py``)."""
+        st = self.st
+        out = {f"stepper_{k}": (st.St[0] if k == "St0" else getattr(st, k)).copy() for k in self.STEPPER_STATE}
+        out.update({k: getattr(self, k).copy() for k in self.RUN_STATE})
+        return out
+
+    def restore(self, state: dict) -> None:
+        """Put :meth:`state`'s arrays back, in place, into this run and its stepper (built for the
+        same line); a missing name or a shape that differs is a ValueError."""
+        st = self.st
+        want = {f"stepper_{k}" for k in self.STEPPER_STATE} | set(self.RUN_STATE)
+        if set(state) != want:
+            raise ValueError(f"run state: expected the arrays {sorted(want)}, got {sorted(state)}")
+        for k, v in state.items():
+            dst = (st.St[0] if k == "stepper_St0" else getattr(st, k[8:])) if k.startswith("stepper_") \
+                else getattr(self, k)
+            if np.shape(v) != dst.shape:
+                raise ValueError(f"run state: {k} has shape {np.shape(v)}, the run's is {dst.shape}")
+            dst[...] = v
+
     def segments(self):
         """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
         (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
@@ -273,6 +305,9 @@ class RodasRun:
 class LinksRun(RodasRun):
     """:class:`RodasRun` for a :class:`~snapping.simulate.elastic_links_rodas.LinksStepper`
     (:func:`advance_links`): the slots hold link states, and ``PN0`` the steps' node starts."""
+
+    STEPPER_STATE = ("zl", "yn", "ctl", "St0", "B", "gW", "gD", "dsp")
+    RUN_STATE = RodasRun.RUN_STATE + ("PN0",)
 
     def __init__(self, stepper, mm0, **kw):
         super().__init__(stepper, mm0, **kw)
