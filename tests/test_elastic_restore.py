@@ -45,6 +45,14 @@ def _to_end(run, rows, calls=None):
     return np.concatenate(out), None
 
 
+def _steps(run, k):
+    """Take exactly ``k`` steps (not the last)."""
+    while k > 0:
+        rows = min(k, run.rec.shape[0])
+        assert run.advance(np.inf, rows) == EA.R_BUFFER
+        k -= len(run.drain())
+
+
 @pytest.mark.parametrize("method,pin", [("rodas4", None), ("rodas4-links", None),
                                         ("rodas4", PinMotion.flick((0.5, 0.0), 0.4))])
 def test_restored_run_continues_bit_for_bit(method, pin):
@@ -62,6 +70,23 @@ def test_restored_run_continues_bit_for_bit(method, pin):
     assert np.array_equal(a.sctl, b.sctl, equal_nan=True) and np.array_equal(a.peak_z, b.peak_z)
     ra, rb = ERF.refine(a, S.PEAK_SAMPLES, S.PEAK_RESTEP), ERF.refine(b, S.PEAK_SAMPLES, S.PEAK_RESTEP)
     assert ra == rb
+
+
+@pytest.mark.parametrize("method", ["rodas4", "rodas4-links"])
+def test_restored_after_the_peaks_refines_them_bit_for_bit(method):
+    """Stopped 3 steps before the stop rule ends the run: the peaks' kept steps (their dense
+    output guides the refinement) were all taken before the stop, and come from the state."""
+    ref = _make(method)
+    total = len(_to_end(ref, None)[0])
+    a = _make(method)
+    _steps(a, total - 3)
+    b = _make(method)
+    b.restore(a.state())
+    tail_a, tail_b = _to_end(a, None), _to_end(b, None)
+    assert tail_a[1] == tail_b[1] == EA.R_SNAP and len(tail_a[0]) == 3 and np.array_equal(tail_a[0], tail_b[0])
+    assert a.best[0, 1] < tail_a[0][0, 0]  # (the v peak was before the stop)
+    peaks = [ERF.refine(r, S.PEAK_SAMPLES, S.PEAK_RESTEP) for r in (ref, a, b)]
+    assert peaks[0] == peaks[1] == peaks[2]
 
 
 def test_a_fresh_run_is_not_the_stopped_one():
