@@ -14,7 +14,7 @@ def drain(self):
     calls[0] += 1
     return orig(self)
 EA.RodasRun.drain = drain
-for rep in range(2):
+for rep in range(1):
     for prog in (False, True):
         calls[0] = 0
         t0, w0 = time.process_time(), time.perf_counter()
