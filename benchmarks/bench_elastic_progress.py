@@ -1,6 +1,5 @@
 """CPU time of one elastic run (chi 0.25, to the snap) with and without the progress bar (stderr to /dev/null) and the calls into the compiled loop. usage: PYTHONPATH=src python benchmarks/bench_elastic_progress.py METHOD N C"""
 import contextlib, os, sys, time
-import numpy as np
 from snapping.simulate.problem import Links, Problem
 from snapping.simulate.elastic import Elastic, solve
 from snapping.simulate import elastic_advance as EA
