@@ -5,7 +5,8 @@ method="rodas4-links")``: fold levels -1 ... 2 (the other mechanisms' 1% levels)
 (1e-6, tighter above c = 450: ``stretch_tol``), grid damping 4, matched start, the tip links floored at
 ``STRETCH_TIP_TIME * c`` (``regimes_spec.stretch_tip_floor``). Measures the process's CPU time
 (``time.process_time``: one process, no workers) and samples the load; writes the study to ``--out``
-(resumable: a rerun computes only the runs missing) and a JSON summary beside it (``.json``), with
+(resumable: a rerun computes only the runs missing; its a_peak, sigma_peak are the runs' snap peaks,
+``a_peak_snap``/``sigma_peak_snap``, since branch snappeaks: ``results/stretch_scan_snap.json``) and a JSON summary beside it (``.json``), with
 per-run CPU split by c, chi and level (what dominates) and the cells not converged / not within 1%.
 
 Usage::

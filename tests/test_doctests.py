@@ -10,7 +10,7 @@ MODULES = ["snapping.schema", "snapping.estimates", "snapping.estimates.catenary
            "snapping.table", "snapping.design", "snapping.shape_estimates", "snapping.ideal", "snapping._validate",
            "snapping._files", "snapping.units", "snapping.unit_scales", "snapping.cli", "snapping.lines",
            "snapping.dimensionless", "snapping.simulate.compression", "snapping.spatial", "snapping.regimes_analysis",
-           "snapping.caps", "snapping.reproduce_verdicts"]
+           "snapping.caps", "snapping.caps_inputs", "snapping.reproduce_verdicts"]
 
 
 def _with_submodules(module):

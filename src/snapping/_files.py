@@ -55,7 +55,7 @@ from . import _validate as V
 
 __all__ = ["check_output", "check_output_dir", "output_dir", "check_own_files", "is_foreign_netcdf",
            "check_input", "locked", "write_atomic", "save_figure", "OutputWriteError",
-           "OutputBusyError", "lock_path", "describe_kind", "figure_format"]
+           "OutputBusyError", "lock_path", "describe_kind", "figure_format", "netcdf_suffix", "NETCDF_SUFFIXES"]
 
 #: bytes a write may leave free on the filesystem before it counts as full
 FULL_MARGIN = 1 << 20
@@ -464,6 +464,38 @@ def figure_format(path, *, name: str = "plot") -> str:
         raise V.SnappingInputError(f"{name}={os.fspath(path)!r} {what}: give a file name ending in one of "
                                    f"{', '.join('.' + f for f in sorted(formats))}")
     return fmt
+
+
+#: the suffixes a netCDF file that a command writes may end in (a run, a regime study, the table)
+NETCDF_SUFFIXES = (".nc", ".nc4", ".netcdf")
+
+
+def netcdf_suffix(path, *, name: str = "output") -> str:
+    """``path`` of a netCDF output, refused (naming ``name``, the path and
+    :data:`NETCDF_SUFFIXES`) when its suffix is not a netCDF file's: a command never writes
+    netCDF under a name that says another format (``-o run.txt``). Checked before the work; a
+    path that is there and is not a regular file is left to :func:`check_output`, which refuses
+    it naming what it is (a directory, a device, a FIFO).
+
+    >>> netcdf_suffix("run.nc")
+    'run.nc'
+    >>> netcdf_suffix("run.txt", name="--output")
+    Traceback (most recent call last):
+    ...
+    snapping._validate.SnappingInputError: --output='run.txt' has the suffix .txt, which is not a netCDF file's: the file is written as netCDF4; give a name ending in .nc, .nc4 or .netcdf
+    """
+    p = os.fspath(V.file_path(name, path))
+    try:
+        if not stat.S_ISREG(os.stat(p).st_mode):  # a directory, device, FIFO: check_output names what it is
+            return p
+    except OSError:  # (nothing there yet, or not reachable: check_output says why)
+        pass
+    suffix = os.path.splitext(p)[1]
+    if suffix.lower() not in NETCDF_SUFFIXES:
+        what = "has no suffix" if not suffix else f"has the suffix {suffix}, which is not a netCDF file's"
+        raise V.SnappingInputError(f"{name}={p!r} {what}: the file is written as netCDF4; give a name ending in "
+                                   f"{', '.join(NETCDF_SUFFIXES[:-1])} or {NETCDF_SUFFIXES[-1]}")
+    return p
 
 
 def save_figure(fig, path, *, overwrite: bool = True, **savefig_kw) -> str:

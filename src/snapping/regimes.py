@@ -36,7 +36,9 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   (``STRETCH_METHOD``: in link coordinates by default, the shipped study's; ``method="rodas4"``
   in node coordinates) and the elastic grid damping ``damping`` (the shortest longitudinal
   mode's damping ratio, a link damping ``zeta h sqrt(EA lambda)`` vanishing with h, so the
-  continuum extrapolation removes it), the stop rule armed at ``STRETCH_STOP_FLOOR``
+  continuum extrapolation removes it), its acceleration and tension peaks the snap's
+  (``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`; the key says
+  ``"peaks": "snap"``), the stop rule armed at ``STRETCH_STOP_FLOOR``
   (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links
   costs 6.8 M evaluations for one coarse cell (chi = 0.3, c = 30, 108 links) and puts the
   acceleration peak at 2.9e6.
@@ -67,7 +69,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
+                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_SNAP_PEAKS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
@@ -195,6 +197,8 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
                            f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
     row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
+    if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
+        row.update({q: float(a[f"{q}_snap"]) for q in STRETCH_SNAP_PEAKS if f"{q}_snap" in a})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -410,7 +414,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         if not isinstance(method, str) or method not in STRETCH_METHODS:
             raise V.SnappingInputError(f"method={method!r} is not one of {STRETCH_METHODS} (a stretching study's "
                                        f"elastic methods)")
-        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR)
+        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR, peaks="snap")
         if method == "rodas4-links":  # its tip links floored (regimes_spec.stretch_tip_floor)
             acc["tip_time"] = STRETCH_TIP_TIME
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)

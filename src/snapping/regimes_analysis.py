@@ -288,6 +288,9 @@ def report(ds, quantities=("v_peak", "a_peak", "sigma_peak")) -> list[str]:
     name = ds.attrs["number_name"]
     lines = [f"regime study: {ds.attrs['mechanism']} ({ds.attrs['mechanism_description']}), number {name}; "
              f"{ds.attrs['grading']} levels x{ds.sizes['level']}, status {ds.attrs['status']}"]
+    if ds.attrs.get("peaks") == "snap":
+        lines.append("a_peak, sigma_peak of the cells: the snap's (each run's a_peak_snap, sigma_peak_snap: up to v_max "
+                     "below 0.9 of its peak after it, snapping.simulate.snap_window), not the run's")
     for q in quantities:
         lines.append(f"{q}: limit +- error (ratio to the ideal)")
         lines.append(f"{'chi':>6} {'ideal':>18} " + " ".join(f"{name + '=' + format(n, 'g'):>28}"

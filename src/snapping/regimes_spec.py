@@ -8,7 +8,8 @@ from __future__ import annotations
 
 __all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_METHODS", "STRETCH_STOP_FLOOR", "STRETCH_START",
            "STRETCH_DAMPING", "STRETCH_MAX_RHS",
-           "STRETCH_TOL_C", "stretch_tol", "STRETCH_TIP_TIME", "STRETCH_MAX_RHS_LINKS", "stretch_tip_floor"]
+           "STRETCH_TOL_C", "stretch_tol", "STRETCH_TIP_TIME", "STRETCH_MAX_RHS_LINKS", "stretch_tip_floor",
+           "STRETCH_SNAP_PEAKS"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -128,3 +129,9 @@ def stretch_tip_floor(c: float, method: str) -> float:
     (1.326e-05, 0.0)
     """
     return STRETCH_TIP_TIME * c if method == "rodas4-links" else 0.0
+
+
+#: stretching: the peaks a study keeps from each elastic run's snap, not its whole run (the run's
+#: ``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`); the study's key
+#: says ``"peaks": "snap"`` (a file of the run's peaks is not resumed)
+STRETCH_SNAP_PEAKS = ("a_peak", "sigma_peak")

@@ -255,6 +255,12 @@ ELASTIC_LINK_VARS: dict[str, dict[str, str]] = {
 ELASTIC_RESULT_ATTRS: dict[str, str] = {
     "strain_peak": "largest link strain over the recorded steps",
     "t_first_slack": "time of the first recorded step with a slack link (NaN: none)",
+    "a_peak_snap": ("peak of the maximum acceleration over the snap: from the start until v_max, after its peak, "
+                    "falls below 0.9 of it (t_snap_end); a_peak itself where it lies in that window, else the "
+                    "largest recorded step (snapping.simulate.snap_window)"),
+    "sigma_peak_snap": ("peak of the maximum tension over the snap (as a_peak_snap): excludes the slack fold and "
+                        "recoil after the snap, which the run's sigma_peak may hold"),
+    "t_snap_end": "end of the snap's window: the first recorded step after the speed peak with v_max < 0.9 v_peak",
     "n_slack_steps": "number of recorded steps with a slack link",
     "dissipated_total": "energy dissipated by the axial damping over the run",
     "wave_speed": "smallest longitudinal wave speed sqrt(EA/lambda) of the links",

@@ -28,7 +28,8 @@ def add_body_options(p) -> None:
     g.add_argument("--bending", type=float, default=0.0, metavar="B",
                    help="bending stiffness EI in units of lambda g L^3 (default 0: a chain)")
     g.add_argument("--bending-damping", dest="damping", type=float, default=0.0, metavar="ETA",
-                   help="Kelvin-Voigt bending damping (moment per curvature rate; default 0)")
+                   help="Kelvin-Voigt bending damping (moment per curvature rate), units of lambda g L^3 sqrt(L/g) "
+                        "(default 0)")
     g.add_argument("--drag-normal", type=float, default=0.0, metavar="CN",
                    help="quadratic normal air drag per length, units of lambda/L (terminal speed 1/sqrt(CN))")
     g.add_argument("--drag-tangential", type=float, default=0.0, metavar="CT",
@@ -56,9 +57,11 @@ def add_body_options(p) -> None:
     si.add_argument("--air-density", type=float, default=None, metavar="KG_M3",
                     help="air density in kg/m^3 (default 1.2)")
     si.add_argument("--cd-normal", type=float, default=None, metavar="CN",
-                    help="cross-flow drag coefficient of the line, on d per length (default 1.2, a cylinder)")
+                    help="cross-flow drag coefficient of the line, on d per length (default: the --line's, else 1.2, "
+                         "a cylinder)")
     si.add_argument("--cd-tangential", type=float, default=None, metavar="CT",
-                    help="skin-friction coefficient, on pi d per length (default 0.01, an estimate)")
+                    help="skin-friction coefficient, on pi d per length (default: the --line's, else 0.01, an "
+                         "estimate)")
     si.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",
                     help="drag area C_d A of the free end's tip body in m^2 (a fly, a popper)")
     si.add_argument("--wind-si", default=None, metavar="WX,WY", help="uniform wind in m/s (y downward)")

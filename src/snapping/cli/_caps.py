@@ -23,8 +23,10 @@ def add_real_options(p, resolve: bool = True) -> None:
     g.add_argument("--ei", type=float, default=None, metavar="N_M2", help="bending stiffness EI in N m^2")
     g.add_argument("--ea", type=float, default=None, metavar="NEWTONS", help="axial stiffness EA in N (stretching)")
     g.add_argument("--diameter", type=float, default=None, metavar="METERS", help="diameter in m (air drag)")
-    g.add_argument("--cd-normal", type=float, default=None, metavar="CN", help="cross-flow drag coefficient (1.2)")
-    g.add_argument("--cd-tangential", type=float, default=None, metavar="CT", help="skin-friction coefficient (0.01)")
+    g.add_argument("--cd-normal", type=float, default=None, metavar="CN",
+                   help="cross-flow drag coefficient, on d per length (default: the --line's, else 1.2)")
+    g.add_argument("--cd-tangential", type=float, default=None, metavar="CT",
+                   help="skin-friction coefficient, on pi d per length (default: the --line's, else 0.01)")
     g.add_argument("--air-density", type=float, default=None, metavar="KG_M3", help="air density in kg/m^3 (1.2)")
     g.add_argument("--end-mass", type=float, default=None, metavar="KG", help="a point mass at the free end, kg")
     g.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",

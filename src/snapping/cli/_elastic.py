@@ -195,7 +195,8 @@ def run_elastic(args, problem, elastic, times):
     args._elastic_running = True  # (an interruption now is inside a run that keeps no checkpoint: main says so)
     r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
               method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
-              snapshot_times=times, start=elastic_start(args))
+              snapshot_times=times, start=elastic_start(args),
+              progress=False if getattr(args, "no_progress", False) else None)
     if out is not None:
         ds = r.dataset
         _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)

@@ -35,7 +35,9 @@ def _add_regimes(sub) -> None:
     )
     p.add_argument("--mechanism", choices=sorted(MECHANISMS), default=None, help="the mechanism scanned")
     p.add_argument("--chi", type=_floats, default=None, help="comma-separated end separations in (0, 1)")
-    p.add_argument("--numbers", type=_floats, default=None, help="comma-separated values of the mechanism's number")
+    p.add_argument("--numbers", type=_floats, default=None,
+                   help="comma-separated values of the mechanism's number (nondimensional: Numbers above), each "
+                        "in (0, 1e4]")
     p.add_argument("--accuracy", choices=sorted(ACCURACY), default="coarse",
                    help="levels preset (default coarse: 3 levels; medium: 4 levels, ~1e-3 in the ideal's peaks)")
     p.add_argument("--levels", type=int, default=None, help="override the preset's refinement levels")
@@ -53,7 +55,8 @@ def _add_regimes(sub) -> None:
                         "capped by the wave speed, the shipped study's; rodas4: node coordinates)")
     p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
     p.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
-    p.add_argument("-o", "--output", default=None, metavar="FILE", help="the study file (netCDF), resumable")
+    p.add_argument("-o", "--output", default=None, metavar="FILE",
+                   help="the study file (netCDF: .nc, .nc4 or .netcdf), resumable")
     p.add_argument("--load", default=None, metavar="FILE", help="report (and --plot) a study file, running nothing")
     p.add_argument("--plot", default=None, metavar="PATH", help="draw the regime map (.png, .pdf, .svg)")
     p.add_argument("--quantity", default="v_peak", choices=["v_peak", "a_peak", "sigma_peak", "kappa_peak"],
@@ -72,6 +75,10 @@ def _cmd_regimes(args) -> int:
     from .._validate import SnappingInputError
 
     _refuse_unused(args)
+    if args.output is not None:  # (the study is netCDF: never under a name that says another format)
+        from .._files import netcdf_suffix
+
+        netcdf_suffix(args.output, name="--output")
     if args.plot is not None:
         figure_format(args.plot, name="--plot")
         check_output(args.plot, name="--plot", overwrite=args.overwrite, need_bytes=PLOT_BYTES)

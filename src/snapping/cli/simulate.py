@@ -131,7 +131,8 @@ def _add_simulate(sub) -> None:
     from ._elastic import add_elastic_options
 
     add_elastic_options(p)
-    p.add_argument("-o", "--output", default=None, help="write the run to this netCDF4 file (a new path, or --overwrite)")
+    p.add_argument("-o", "--output", default=None,
+                   help="write the run to this netCDF4 file: .nc, .nc4 or .netcdf (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
     p.add_argument("--resume", metavar="RUN.nc", default=None,
                    help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
@@ -158,6 +159,10 @@ def _cmd_simulate(args) -> int:
     from .._validate import SnappingInputError
 
     scales = _si_scales(args)
+    if args.output is not None:  # (a run file is netCDF4: never under a name that says another format)
+        from .._files import netcdf_suffix
+
+        netcdf_suffix(args.output, name="--output")
     try:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:

@@ -113,6 +113,49 @@ def _catenary_xy(s, chi: float, a: float):
     return x, y
 
 
+#: chains of at most this many links start, with ``chords="exact"``, held at both ends (:func:`few_links_start`)
+FEW_LINKS = 3
+
+
+def few_links_start(X: float, h) -> tuple[np.ndarray, np.ndarray] | None:
+    """The catenary start of a chain of at most :data:`FEW_LINKS` links, chords exact: the
+    chain at rest held at the pin (the origin) and at its free end at horizontal distance ``X``
+    (chi L), at the pin's level when the links reach it; None for longer chains (and three
+    unequal links), which walk the catenary (:func:`initial_state`, ``chords="exact"``).
+
+    A walk along the catenary with chords of a link's length overshoots the curve's free end
+    by about a link when the links are as long as its sag (one link: its node 0.96 L above
+    the pin at chi 0.25). Held at both ends the few links have their static equilibrium,
+    which their lengths alone fix: two links meet below the middle, at the intersection of
+    the circles of their lengths about the two ends; three equal links hang symmetric, the
+    middle one level (their nodes lie on a level catenary through both ends). One link
+    cannot span the catenary's ends (chi < 1): it hangs from the pin with its end at
+    horizontal distance X below the pin's level (a pendulum released at that angle).
+    ``h`` in the project's order (``h[0]`` at the free end); ``y`` grows downward; index 0
+    of the result is the free end.
+
+    >>> x, y = few_links_start(0.25, [0.5, 0.5])
+    >>> [round(float(v), 6) for v in (*x, *y)]
+    [0.25, 0.125, 0.0, 0.0, 0.484123, 0.0]
+    """
+    h = np.asarray(h, dtype=float)
+    N = h.size
+    if N > FEW_LINKS or (N == 3 and not (h[0] == h[1] == h[2])):
+        return None
+    x, y = np.zeros(N + 1), np.zeros(N + 1)
+    x[0] = X
+    if N == 1:
+        y[0] = math.sqrt(max(h[0] * h[0] - X * X, 0.0))
+    elif N == 2:  # the free node: |r| = h[1] from the pin, |r - (X, 0)| = h[0] from the free end
+        x[1] = (X * X + h[1] * h[1] - h[0] * h[0]) / (2.0 * X)
+        y[1] = math.sqrt(max(h[1] * h[1] - x[1] * x[1], 0.0))
+    else:  # three equal links: the middle one level, the outer ones symmetric
+        x[2] = 0.5 * (X - h[1])
+        x[1] = X - x[2]
+        y[1] = y[2] = math.sqrt(max(h[0] * h[0] - x[2] * x[2], 0.0))
+    return x, y
+
+
 def initial_state(chi: float, N: int, chords: str = "arclength") -> ChainState:
     """The paper's initial condition: the catenary of end separation ``chi`` at rest.
 
@@ -122,7 +165,10 @@ def initial_state(chi: float, N: int, chords: str = "arclength") -> ChainState:
     kappa^2/(24 N^2), reported by the run as ``link_error_initial``) and the free
     end is exactly at (chi, 0). With ``chords="exact"`` the nodes are placed on the
     same curve, walking from the pin, at chord distance exactly 1/N (the free end
-    then lies a little beyond s = 1).
+    then lies a little beyond s = 1); a chain of at most :data:`FEW_LINKS` links, whose
+    walk would overshoot the curve by about a link, is held at both ends instead
+    (:func:`few_links_start`: its static equilibrium, the free end at (chi, 0); one link
+    at (chi, sqrt(1 - chi^2))).
 
     Parameters
     ----------
@@ -159,6 +205,8 @@ def initial_state(chi: float, N: int, chords: str = "arclength") -> ChainState:
         y[-1] = 0.0
         x[0] = chi  # the formula's rounding: the free end is exactly at (chi, 0)
         y[0] = 0.0
+    elif N <= FEW_LINKS:
+        x, y = few_links_start(chi, np.full(N, 1.0 / N))
     else:
         a = estimates.catenary_parameter(chi)
         h = 1.0 / N

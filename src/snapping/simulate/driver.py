@@ -16,7 +16,6 @@ signals and due checkpoints; at the end it builds the Dataset
 from __future__ import annotations
 
 import signal
-import sys
 import threading
 import time
 
@@ -431,13 +430,6 @@ def expected_snap_time(inputs: dict) -> float | None:
     return float(max(T_STAR - 0.25 * chi ** 2, 0.5 * T_STAR))
 
 
-def _isatty(stream) -> bool:
-    try:
-        return bool(stream.isatty())
-    except (AttributeError, ValueError, OSError):
-        return False
-
-
 def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall_before: float) -> Run:
     """:func:`_drive` once the output (if any) is locked and checked.
 
@@ -448,34 +440,12 @@ def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall
     ``final_state()`` and ``link_error_initial``."""
     t_end = inputs["t_end"] or None
     N = eng.N
-    bar = None
-    if progress is None and not _isatty(sys.stderr):  # a log or a pipe: lines every ~10 s, not a bar
-        from .progress_lines import LineProgress
+    from .progress_lines import open_bar
 
-        expected = None if t_end else expected_snap_time(inputs)
-        bar = LineProgress(f"chain N={N} ({inputs['method']})", total=t_end or expected, initial=eng.t,
-                           estimated=not t_end)
-    elif progress or progress is None:
-        from tqdm.auto import tqdm
-
-        desc = f"chain N={N}" if M.method(inputs["method"]) is M.euler_richardson else \
-            f"chain N={N} ({inputs['method']})"
-        expected = None if t_end else expected_snap_time(inputs)
-        if t_end:
-            fmt = "{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}"
-        elif expected:
-            fmt = "{desc}: t={n:.5f}/~{total:.4f} (estimated snap) {bar} [{elapsed}<{remaining}]{postfix}"
-        else:
-            fmt = "{desc}: t={n:.5f} [{elapsed}]{postfix}"
-        class _Bar(tqdm):  # an estimated total is raised when t passes it (no bar beyond 100%)
-            def update(self, n=1):
-                if expected and self.total is not None and self.n + n > self.total:
-                    self.total = self.n + n
-                return super().update(n)
-
-        bar = _Bar(total=t_end or expected, initial=eng.t, file=sys.stderr,
-                   disable=None if progress is None else False, unit="t", desc=desc, dynamic_ncols=True,
-                   bar_format=fmt)
+    expected = None if t_end else expected_snap_time(inputs)
+    desc = f"chain N={N}" if M.method(inputs["method"]) is M.euler_richardson else f"chain N={N} ({inputs['method']})"
+    bar = open_bar(desc, progress=progress, t_end=t_end, expected=expected, initial=eng.t,
+                   line_desc=f"chain N={N} ({inputs['method']})")
     got = {"signum": None, "last": time.monotonic()}
     wall0 = time.perf_counter()
 

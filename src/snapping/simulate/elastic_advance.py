@@ -229,14 +229,17 @@ class RodasRun:
         ln = st.line
         self.model = (ln.m, ln.tabw, ln.snode, np.concatenate([ln.snode, [0.0]]), ln.snode - 0.5 * ln.h)
 
-    def advance(self, t_snapshot=np.inf) -> int:
-        """Steps until the next return code (``R_*``), the next snapshot time ``t_snapshot``."""
+    def advance(self, t_snapshot=np.inf, rows=None) -> int:
+        """Steps until the next return code (``R_*``), the next snapshot time ``t_snapshot``;
+        ``rows``: the record buffer's rows this call may fill (default all: R_BUFFER once full;
+        fewer return sooner, the same steps: :class:`snapping.simulate.elastic_progress.Chunks`)."""
         st = self.st
         self.sctl[S_TSNAP] = t_snapshot
+        rec = self.rec if rows is None else self.rec[:rows]
         return advance(st.N, st.y, st.St, st.B, st.gW, st.gD, st.dsp, st.F, st.ab, st.piv, st.pins, st.pinpar,
                        st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.ctl, *st.work, *self.model, self.mm,
                        self.PY0, self.PY1, self.PC, self.PT, self.ref, self.keep, self.nkeep, self.after, self.best,
-                       self.sctl, self.rec, self.peak_z)
+                       self.sctl, rec, self.peak_z)
 
     def drain(self) -> np.ndarray:
         """The record rows since the last drain (t first, then STEP_NAMES)."""
@@ -259,6 +262,38 @@ class RodasRun:
     def last_start(self):
         return self.start(int(self.sctl[S_PREV]))
 
+    #: the stepper's arrays that carry a run from one step to the next (the rest is scratch that
+    #: every attempt sets anew): the state, the controls and counts (the step-size controller's
+    #: step and last error among them), f (``St[0]``) and the Jacobian at the state
+    STEPPER_STATE = ("y", "ctl", "St0", "B", "gW", "gD", "dsp")
+    #: the run's: the step slots (the peaks' kept steps, the last step), the peaks, the run's
+    #: controls and the running peak's state (the record is drained at every return)
+    RUN_STATE = ("PY0", "PY1", "PC", "PT", "ref", "keep", "nkeep", "after", "best", "sctl", "peak_z")
+
+    def state(self) -> dict:
+        """{name: copy} of the arrays from which :meth:`restore` continues the run, bit for bit:
+        taken at a return of the compiled loop, after :meth:`drain` (what a checkpoint of the
+        run must hold besides its record, snapshots and inputs;
+        ``benchmarks/probe_elastic_restore.py``)."""
+        st = self.st
+        out = {f"stepper_{k}": (st.St[0] if k == "St0" else getattr(st, k)).copy() for k in self.STEPPER_STATE}
+        out.update({k: getattr(self, k).copy() for k in self.RUN_STATE})
+        return out
+
+    def restore(self, state: dict) -> None:
+        """Put :meth:`state`'s arrays back, in place, into this run and its stepper (built for the
+        same line); a missing name or a shape that differs is a ValueError."""
+        st = self.st
+        want = {f"stepper_{k}" for k in self.STEPPER_STATE} | set(self.RUN_STATE)
+        if set(state) != want:
+            raise ValueError(f"run state: expected the arrays {sorted(want)}, got {sorted(state)}")
+        for k, v in state.items():
+            dst = (st.St[0] if k == "stepper_St0" else getattr(st, k[8:])) if k.startswith("stepper_") \
+                else getattr(self, k)
+            if np.shape(v) != dst.shape:
+                raise ValueError(f"run state: {k} has shape {np.shape(v)}, the run's is {dst.shape}")
+            dst[...] = v
+
     def segments(self):
         """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
         (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
@@ -271,17 +306,21 @@ class LinksRun(RodasRun):
     """:class:`RodasRun` for a :class:`~snapping.simulate.elastic_links_rodas.LinksStepper`
     (:func:`advance_links`): the slots hold link states, and ``PN0`` the steps' node starts."""
 
+    STEPPER_STATE = ("zl", "yn", "ctl", "St0", "B", "gW", "gD", "dsp")
+    RUN_STATE = RodasRun.RUN_STATE + ("PN0",)
+
     def __init__(self, stepper, mm0, **kw):
         super().__init__(stepper, mm0, **kw)
         self.PN0 = np.zeros_like(self.PY0)
 
-    def advance(self, t_snapshot=np.inf) -> int:
+    def advance(self, t_snapshot=np.inf, rows=None) -> int:
         st = self.st
         self.sctl[S_TSNAP] = t_snapshot
+        rec = self.rec if rows is None else self.rec[:rows]
         return advance_links(st.N, st.zl, st.yn, st.St, st.B, st.gW, st.gD, st.dsp, st.ab, st.piv, st.pins,
                              st.pinpar, st.pintab, *st.args(), st.ytmp, st.btmp, st.w, st.ft, st.zn1, st.ctl,
                              *st.work, st.cw, *self.model, self.mm, self.PY0, self.PY1, self.PC, self.PT, self.PN0,
-                             self.ref, self.keep, self.nkeep, self.after, self.best, self.sctl, self.rec, self.peak_z)
+                             self.ref, self.keep, self.nkeep, self.after, self.best, self.sctl, rec, self.peak_z)
 
     def dense(self, s):
         return ELR.LinksDense(self.st.links, self.PT[s, 0], self.PT[s, 1], self.PY0[s].copy(), self.PY1[s].copy(),

@@ -48,10 +48,13 @@ from scipy.integrate import DOP853, Radau
 from .. import _validate as V
 from . import elastic_advance as EA
 from . import elastic_checks as EC
+from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
+from .snap_window import snap_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
+from .options import check_progress
 from .elastic_rodas import RodasStepper
 from .elastic_links_rodas import LinksStepper
 
@@ -225,17 +228,26 @@ def _snapshot(ts, t_old, y_old, t, y, restep, dense):
     return zs if zs is not None else dense()(ts)
 
 
-def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep, **kw):
+def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep, bar=None,
+               **kw):
     """The step loop of :func:`solve` for RODAS4, compiled (:func:`elastic_advance.advance`:
-    the same bookkeeping, many steps a call). Returns the record rows (t first), the running
-    peak's state, the first slack time, when the stop rule was armed, status and reason; the
-    snapshots and the peaks' kept steps (refined by :meth:`_Peaks.refine`) are filled in."""
+    the same bookkeeping, many steps a call; with a progress ``bar``, calls of about
+    :data:`elastic_progress.CHUNK_SECONDS`, the bar moved after each). Returns the record rows
+    (t first), the running peak's state, the first slack time, when the stop rule was armed,
+    status and reason; the snapshots and the peaks' kept steps (refined by
+    :meth:`_Peaks.refine`) are filled in."""
     run = (EA.LinksRun if isinstance(solver, LinksStepper) else EA.RodasRun)(solver, mm0, energy_fail=ENERGY_ERROR_FAIL,
                                                                             **kw)
     chunks, status = [], "completed"
+    sizes, nsteps = EP.Chunks(bar, run.rec.shape[0]), 0
     while True:
-        code = run.advance(snaps[0] if snaps else np.inf)
+        code = run.advance(snaps[0] if snaps else np.inf, sizes.start())
         chunks.append(run.drain())
+        sizes.done(len(chunks[-1]))
+        if bar is not None and len(chunks[-1]):
+            nsteps += len(chunks[-1])
+            last = chunks[-1][-1]
+            EP.show(bar, float(last[0]), nsteps, solver.nrej, float(last[2]), float(last[1]))
         if code == EA.R_STEP_FAILED:
             status, stop_reason = "failed", f"step failed: step size {solver.ctl[ER.C_HFAIL]:.3g} too small at " \
                 f"t = {solver.t:.9g}"
@@ -272,7 +284,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
 
 def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float = 1e-8, method: str = "radau",
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
-          snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None) -> ElasticRun:
+          snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None,
+          progress: bool | None = False) -> ElasticRun:
     """Integrate the elastic line of ``problem`` made of ``elastic`` links.
 
     Parameters
@@ -311,6 +324,11 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         The running peak of v_max above which the stop rule judges the snap, instead of
         :func:`speed_floor`'s bound (which, from the lightest node's mass, can exceed the snap
         itself on fold-graded links: the run then goes on to ``t_end_max``).
+    progress : bool or None
+        A progress bar on stderr, as :func:`snapping.simulate.run`'s (None: the bar on a
+        terminal, else a plain line every ~10 s; :mod:`snapping.simulate.elastic_progress`):
+        ``t`` out of ``t_end`` or of the estimated snap, the steps and rejected steps taken.
+        The run's numbers are the same with or without it.
 
     Returns
     -------
@@ -335,6 +353,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     max_rhs = V.integer("max_rhs", max_rhs, 1)
     if stop_floor is not None:
         stop_floor = V.positive("stop_floor", stop_floor)
+    progress = check_progress(progress)
 
     wall0 = time.perf_counter()
     z0 = _initial(line, start, initial)
@@ -382,50 +401,57 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         n_restep[0] += st.nfev
         return st.y if st.status == "finished" else None
 
-    if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
-        rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
-            solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
-            t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs)
-        rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
-        times = np.concatenate([times, rec_steps[:, 0]])
-    else:
-        while solver.status == "running":
-            msg = solver.step()
-            if solver.status == "failed":
-                status, stop_reason = "failed", f"step failed: {msg}"
-                break
-            t, z = float(solver.t), solver.y
-            while snaps and snaps[0] <= t:
-                ts = snaps.pop(0)
-                if ts >= 0.0:
-                    snap_t.append(ts)
-                    snap_z.append(_snapshot(ts, t_prev, z_prev, t, z, restep, solver.dense_output))
-                    snap_kind.append("requested")
-            mm = line.measure(t, z)
-            rows.append(_record(line, t, z, t - solver.t_old, mm))
-            times.append(t)
-            peaks.update(t, mm, (t_prev, z_prev, t, solver.dense_output()))
-            t_prev, z_prev = t, z.copy()
-            if mm[16] > 0 and np.isnan(first_slack):
-                first_slack = t
-            if mm[0] > running:
-                running, peak_state = mm[0], (t, z.copy())
-            if not np.all(np.isfinite(z)):
-                status, stop_reason = "failed", "non-finite state"
-                break
-            if max(count[0], solver.nfev) > max_rhs:
-                status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
-                break
-            row = rows[-1]
-            err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
-            if np.isnan(t_armed) and running >= floor:
-                t_armed = t
-            if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
-                stop_reason = "snap"
-                break
-            if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
-                status, stop_reason = "failed", _ENERGY_MSG
-                break
+    bar = EP.open_run_bar(problem, method, t_end, progress)
+    try:
+        if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
+            rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
+                solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
+                t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs,
+                bar=bar)
+            rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
+            times = np.concatenate([times, rec_steps[:, 0]])
+        else:
+            while solver.status == "running":
+                msg = solver.step()
+                if solver.status == "failed":
+                    status, stop_reason = "failed", f"step failed: {msg}"
+                    break
+                t, z = float(solver.t), solver.y
+                while snaps and snaps[0] <= t:
+                    ts = snaps.pop(0)
+                    if ts >= 0.0:
+                        snap_t.append(ts)
+                        snap_z.append(_snapshot(ts, t_prev, z_prev, t, z, restep, solver.dense_output))
+                        snap_kind.append("requested")
+                mm = line.measure(t, z)
+                rows.append(_record(line, t, z, t - solver.t_old, mm))
+                times.append(t)
+                EP.show(bar, t, len(times) - 1, getattr(solver, "nrej", None), mm[0], t - solver.t_old)
+                peaks.update(t, mm, (t_prev, z_prev, t, solver.dense_output()))
+                t_prev, z_prev = t, z.copy()
+                if mm[16] > 0 and np.isnan(first_slack):
+                    first_slack = t
+                if mm[0] > running:
+                    running, peak_state = mm[0], (t, z.copy())
+                if not np.all(np.isfinite(z)):
+                    status, stop_reason = "failed", "non-finite state"
+                    break
+                if max(count[0], solver.nfev) > max_rhs:
+                    status, stop_reason = "failed", f"more than max_rhs={max_rhs} right-hand-side evaluations"
+                    break
+                row = rows[-1]
+                err = max(err, abs(row[i_en] - row[i_w] + row[i_d] - E0))
+                if np.isnan(t_armed) and running >= floor:
+                    t_armed = t
+                if t_end is None and not np.isnan(t_armed) and mm[0] < stop_fraction * running:
+                    stop_reason = "snap"
+                    break
+                if t_end is None and err > ENERGY_ERROR_FAIL * (abs(E0) + abs(row[i_w]) + U0):
+                    status, stop_reason = "failed", _ENERGY_MSG
+                    break
+    finally:
+        if bar is not None:
+            bar.close()
     t_final = float(times[-1])
     zf = solver.y.copy()
     snap_t += [peak_state[0], t_final]
@@ -462,6 +488,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
         "t_stop_armed": float(t_armed),
     }
+    snap = snap_peaks(times, rec[:, STEP_NAMES.index("v_max")],
+                      {k: rec[:, STEP_NAMES.index(f"{k}_max")] for k in ("a", "sigma")}, ref, ref["v"][1])
+    results.update(a_peak_snap=snap["a"], sigma_peak_snap=snap["sigma"], t_snap_end=snap["t_snap_end"])
     cols = {k: rec[:, STEP_NAMES.index(k)] for k in ("sigma_max", "dt", "n_slack", "sigma_min")}
     ring, ok, note = EC.peak_guard(np.asarray(times), cols, wave_speed=line.wave_speed, length=float(np.sum(line.h)),
                                    start=start if initial is None else "initial", t_snap_sigma=ref["sigma"][1],

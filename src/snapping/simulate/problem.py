@@ -139,7 +139,9 @@ class Problem:
         """The paper's start: the level catenary of end separation ``chi``, at rest. With the
         paper's links (default: ``Links.uniform(N)``) the nodes are those of
         :func:`snapping.simulate.initial_state` (``chords`` as there); other links are placed
-        on the same curve with chords exactly ``h_j`` (walking from the held end).
+        on the same curve with chords exactly ``h_j`` (walking from the held end), except a chain
+        of at most three links (two, or three equal), held at both ends at rest instead
+        (:func:`snapping.simulate.chain.few_links_start`).
 
         ``start``: the shape the line is released from, held at both ends at rest before:
         ``"catenary"`` (the nodes above), or ``"equilibrium"``: the discrete static equilibrium
@@ -163,7 +165,7 @@ class Problem:
         else:
             from .. import estimates
             from . import shapes
-            from .chain import CHORDS, _catenary_xy
+            from .chain import CHORDS, _catenary_xy, few_links_start
 
             if chords not in CHORDS:
                 raise V.SnappingInputError(f"chords={chords!r} is not one of {CHORDS}")
@@ -175,7 +177,8 @@ class Problem:
                     cx, cy = _catenary_xy(np.asarray(s, dtype=float) / L, chi, a)
                     return L * cx, L * cy
 
-                x, y = shapes.place_on_curve(cat, links.h)
+                few = few_links_start(chi * L, links.h)  # (at most FEW_LINKS links: held at both ends)
+                x, y = shapes.place_on_curve(cat, links.h) if few is None else few
             else:  # nodes at their arclength on the curve (chords a little shorter than h_j)
                 s = np.clip(np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]]) / L, 0.0, 1.0)
                 xs, ys = estimates.catenary_shape(s, chi)

@@ -55,3 +55,40 @@ class LineProgress:
     def close(self) -> None:
         if self.printed:
             self._print(f"stopped at {self._line()}")
+
+
+def _isatty(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
+def open_bar(desc: str, *, progress, t_end=None, expected=None, initial: float = 0.0, line_desc=None):
+    """The progress display of one run in simulated time, the same for every method (the rigid
+    chain's driver and the extensible line's :func:`snapping.simulate.elastic.solve`): None when
+    ``progress`` is False; with ``progress=None`` and stderr not a terminal, a
+    :class:`LineProgress` (``line_desc``, default ``desc``); else a tqdm bar on stderr (shown on a
+    terminal only when ``progress`` is None) of ``t`` out of ``t_end``, or out of the ``expected``
+    snap time (an estimate, raised when ``t`` passes it), or of ``t`` alone."""
+    if progress is False:
+        return None
+    if progress is None and not _isatty(sys.stderr):  # a log or a pipe: lines every ~10 s, not a bar
+        return LineProgress(line_desc or desc, total=t_end or expected, initial=initial, estimated=not t_end)
+    from tqdm.auto import tqdm
+
+    if t_end:
+        fmt = "{desc}: t={n:.5f}/{total:.5f} {bar} [{elapsed}<{remaining}]{postfix}"
+    elif expected:
+        fmt = "{desc}: t={n:.5f}/~{total:.4f} (estimated snap) {bar} [{elapsed}<{remaining}]{postfix}"
+    else:
+        fmt = "{desc}: t={n:.5f} [{elapsed}]{postfix}"
+
+    class _Bar(tqdm):  # an estimated total is raised when t passes it (no bar beyond 100%)
+        def update(self, n=1):
+            if expected and self.total is not None and self.n + n > self.total:
+                self.total = self.n + n
+            return super().update(n)
+
+    return _Bar(total=t_end or expected, initial=initial, file=sys.stderr, disable=None if progress is None else False,
+                unit="t", desc=desc, dynamic_ncols=True, bar_format=fmt)

@@ -218,10 +218,18 @@ def assemble(runs: dict[str, dict], *, command: str = "", wall_s: float | None =
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m snapping.table.build", description=__doc__.split("\n\n")[0])
     p.add_argument("--ledger", default="build/table/runs.jsonl", help="the ledger of finished runs (resumable)")
-    p.add_argument("-o", "--output", default=None, help="write the assembled table here (netCDF)")
+    p.add_argument("-o", "--output", default=None, help="write the assembled table here (netCDF: .nc, .nc4 or .netcdf)")
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     p.add_argument("--assemble-only", action="store_true", help="do not run: assemble the ledger as it is")
     args = p.parse_args(argv)
+    if args.output:  # (refused before the runs: the table is netCDF)
+        from .._files import netcdf_suffix
+        from .._validate import SnappingInputError
+
+        try:
+            netcdf_suffix(args.output, name="--output")
+        except SnappingInputError as exc:
+            p.error(str(exc))
     t0 = time.perf_counter()
     runs = read_ledger(args.ledger) if args.assemble_only else build(
         args.ledger, workers=args.workers, log=lambda s: print(s, file=sys.stderr, flush=True))

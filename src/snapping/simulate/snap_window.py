@@ -1,0 +1,78 @@
+"""The snap's own peaks of an extensible line's run (issue 24): acceleration and tension taken
+over the snap, not over the whole run.
+
+An elastic run (:func:`snapping.simulate.elastic.solve`) stops when v_max has fallen to
+``stop_fraction`` (1/2) of its peak. Between the snap and that stop the line goes on: the fold
+runs out, links go slack and the line recoils, and in soft lines (c a few to a few hundred
+sqrt(g L)) the largest acceleration or tension of the run can come from that phase, at the
+run's last steps (chi 0.3, c 442.7, fold level 1: v_max peaks at step 253 of 4702, a_max and
+sigma_max at step 4685, ``benchmarks/stretch_peak_phase.py``). Such maxima depend on where the
+run is stopped and are not the snap's.
+
+**The snap** is the tip's whip: from the start until the speed has fallen back to
+``SNAP_FRACTION`` (0.9) of its peak after the peak, i.e. while the fastest node moves within
+10% of its peak speed. Why this window (measured, docs/guide/regimes.md "The snap's peaks"):
+
+* the ideal (inextensible) chain's acceleration peak comes at or just before its speed peak
+  and its tension peak just after it (chi 0.1/0.3/0.5 at the coarse study level: +1e-5,
+  +1.2e-4, +7.9e-4 in t sqrt(g/L)), while its speed is still above 0.99 of the peak: a
+  window that ended at the speed peak would cut the ideal's tension peak; one that ends at
+  0.9 holds all three, so in the stiff limit the snap's peaks are the run's;
+* the slack/recoil phase starts later: the first slack link of chi 0.3 c 442.7 (level -1)
+  comes 5.8e-3 after the speed peak, when v_max is below 0.8 of its peak; the window ends
+  at +1.2e-3.
+
+In soft lines the tension keeps rising through the window (the line is still being pulled
+straight when the tip has slowed by 10%), so ``sigma_peak_snap`` is then the largest tension
+while the tip is within 10% of its peak speed: a value at the window's end, not a turning
+point (documented, with its level convergence, in the guide).
+
+The snap's peaks are computed from the run's per-step records: where the run's refined peak
+(``a_peak``, ``sigma_peak``) falls inside the window it is taken as is (so the snap's peaks
+equal the run's whenever the run's peaks belong to the snap, bit for bit); otherwise the
+largest recorded step value inside the window (step ends, not refined).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["SNAP_FRACTION", "snap_end", "snap_peaks"]
+
+#: the snap lasts, after the speed peak, until v_max has fallen below this fraction of its peak
+SNAP_FRACTION = 0.9
+
+
+def snap_end(t, v, t_peak, fraction: float = SNAP_FRACTION) -> int:
+    """Index of the last recorded step of the snap: the first step after the speed peak (the
+    first recorded time >= ``t_peak``) whose speed ``v`` is below ``fraction`` times the peak
+    (the largest of ``v``); the last step if the speed never falls that far (the run's end)."""
+    t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    if t.size == 0:
+        raise ValueError("no recorded steps")
+    if not np.isfinite(t_peak):
+        return t.size - 1
+    ip = int(np.searchsorted(t, t_peak, side="left"))
+    if ip >= t.size:
+        return t.size - 1
+    vp = max(float(np.max(v)), 0.0)
+    below = np.flatnonzero(v[ip:] < fraction * vp)
+    return t.size - 1 if below.size == 0 else ip + int(below[0])
+
+
+def snap_peaks(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP_FRACTION) -> dict:
+    """The snap's peaks of the per-step records ``cols`` ({name: values per step}) given the
+    run's refined peaks ``run_peaks`` ({name: (value, time)}) and the speed's peak time
+    ``t_peak``: ``{name: value}`` plus ``"t_snap_end"`` (the window's last time). A run peak
+    whose time lies in the window is returned as is; else the window's largest record."""
+    t = np.asarray(t, dtype=float)
+    je = snap_end(t, v, t_peak, fraction)
+    t_end = float(t[je])
+    out = {"t_snap_end": t_end}
+    for name, col in cols.items():
+        val, tp = run_peaks[name]
+        if np.isfinite(tp) and tp <= t_end:
+            out[name] = float(val)
+        else:
+            out[name] = float(np.max(np.asarray(col, dtype=float)[:je + 1]))
+    return out
