@@ -13,23 +13,28 @@ from __future__ import annotations
 
 import os
 
-#: the slowest files, roughly slowest first: the sums of their tests' ``--durations`` in one cold run on
-#: one process (numba caches empty, 2 cores shared, load ~4; CHANGELOG.md, `fastsuite`)
+#: the slowest files, slowest first: the sums of their tests' ``--durations`` in one cold run on one
+#: process (numba caches empty, 2 cores shared, load 3-9, 2026-12-03; compiling numba kernels is much of it)
 SLOWEST_FIRST = (
-    "test_caps.py",           # ~155 s: the stretching levels' elastic runs, the design rows
-    "test_reproduce.py",      # ~140 s: the tiny reproduction and its rerun
-    "test_regimes.py",        # ~95 s: the tiny study and its continuum reference
-    "test_sweep.py",          # ~120 s: sweeps on worker processes, SIGINT/SIGKILL of sweeps
-    "test_docs.py",           # ~70 s: the sphinx build
-    "test_animation.py",      # ~75 s: a run with dense snapshots, GIF frames
-    "test_checkpoint.py",     # ~70 s: interrupted runs resumed bit for bit
-    "test_animation3d.py",    # ~50 s
-    "test_highorder.py",      # ~45 s: the DOP853 ensemble against single runs
-    "test_notebooks.py",      # ~45 s: three notebooks in kernels
-    "test_peers_scripts.py",  # ~65 s: the peers' quick runs
+    "test_caps.py",             # ~245 s: the stretching levels' elastic runs (their compile), the design rows
+    "test_sweep.py",            # ~200 s: sweeps on worker processes, SIGINT/SIGKILL of sweeps
+    "test_reproduce.py",        # ~180 s: the tiny reproduction and its rerun
+    "test_peers_scripts.py",    # ~115 s: the peers' quick runs
+    "test_regimes.py",          # ~115 s: the tiny study and its continuum reference
+    "test_docs.py",             # ~110 s: the sphinx build
+    "test_highorder.py",        # ~110 s: the DOP853 ensemble kernel's compile
+    "test_notebooks.py",        # ~105 s: three notebooks in kernels
+    "test_regimes_stretch.py",  # ~75 s: the shipped stretching study's checks
+    "test_animation3d.py",      # ~70 s
+    "test_elastic.py",          # ~65 s
+    "test_checkpoint.py",       # ~60 s: interrupted runs resumed bit for bit
+    "test_elastic_damping.py",  # ~60 s
+    "test_animation.py",        # ~55 s: a run with dense snapshots, GIF frames
+    "test_checkpoint_dop853.py",
+    "test_snap_window.py",
+    "test_body_figures.py",
     "test_caps_levels.py",
     "test_elastic_links.py",
-    "test_checkpoint_dop853.py",
 )
 
 
