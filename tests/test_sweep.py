@@ -452,6 +452,15 @@ def _cli_sweep(tmp_path, env, options: str):
                             text=True, start_new_session=True), out
 
 
+def _kill_all(proc, pids):
+    """SIGKILL the sweep and any of its workers still alive (a failed test leaves no process)."""
+    proc.kill()
+    proc.wait()
+    for p in pids:
+        if _alive(p):
+            os.kill(p, 9)
+
+
 def _interrupt(proc, pids, to_group, timeout=60.0):
     """SIGINT to the sweep's process group (Ctrl-C) or to the sweep alone; its stderr once it
     ended (within ``timeout`` s: what "promptly" means under load), and no worker left."""
@@ -502,11 +511,7 @@ def test_cli_sweep_sigint_with_workers_stops_promptly_and_saves_the_runs(tmp_pat
         assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
         assert sorted(under_way.values()) == ["checkpoint", "checkpoint"], f"the runs are not under way: {under_way}"
     except BaseException:
-        proc.kill()
-        proc.wait()
-        for p in pids:
-            if _alive(p):
-                os.kill(p, 9)
+        _kill_all(proc, pids)
         raise
     _interrupt(proc, pids, to_group)
     statuses = {p.name: str(simulate.load_run(p).attrs["status"]) for p in out.glob("run_*.nc")}
@@ -551,11 +556,7 @@ def test_cli_sweep_sigint_while_its_runs_are_starting_ends_at_once(tmp_path):
         assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
         assert len(list(tmp_path.glob("starting.*"))) == 2, "the runs did not start"
     except BaseException:
-        proc.kill()
-        proc.wait()
-        for p in pids:
-            if _alive(p):
-                os.kill(p, 9)
+        _kill_all(proc, pids)
         raise
     _interrupt(proc, pids, to_group=False)
     assert list(out.glob("run_*.nc")) == []  # nothing was computed, nothing saved; nothing started after
