@@ -562,6 +562,49 @@ def test_cli_sweep_sigint_while_its_runs_are_starting_ends_at_once(tmp_path):
     assert list(out.glob("run_*.nc")) == []  # nothing was computed, nothing saved; nothing started after
 
 
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc (Linux)")
+def test_cli_elastic_sweep_sigint_ends_at_once_without_waiting_for_its_runs(tmp_path):
+    """An extensible line's runs keep no checkpoint: SIGINT to the sweep alone while they are
+    under way (here each worker's solve takes 10 min) ends it promptly, exit 130, no run file
+    and no worker left (the runs would be run again: nothing of them to save)."""
+    import subprocess
+    import sys
+    import time
+
+    pid_file, site = tmp_path / "pids", tmp_path / "site"
+    site.mkdir()
+    # in the sweep's worker processes only: each elastic run takes 600 s after saying it started
+    (site / "sitecustomize.py").write_text(
+        "import sys\n"
+        "if '--multiprocessing-fork' in sys.orig_argv:\n"
+        "    import os, time\n"
+        "    import snapping.simulate.elastic as E\n"
+        "    def slow(*a, **k):\n"
+        f"        open(os.path.join({str(tmp_path)!r}, f'solving.{{os.getpid()}}'), 'w').close()\n"
+        "        time.sleep(600)\n"
+        "    E.solve = slow\n")
+    env = _worker_env(pid_file)
+    env["PYTHONPATH"] = os.pathsep.join([str(site), env["PYTHONPATH"]])
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "snapping", "sweep", "--chi", "0.3,0.4,0.5,0.6", "--N", "4",
+                             "--stretching", "30", "--workers", "2", "-o", str(out)], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    pids = []
+    try:
+        deadline = time.monotonic() + 300
+        pids = _wait_for_workers(proc, pid_file, deadline)
+        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
+        while len(list(tmp_path.glob("solving.*"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)  # until both workers are in their runs
+        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
+        assert len(list(tmp_path.glob("solving.*"))) == 2, "the runs did not start"
+    except BaseException:
+        _kill_all(proc, pids)
+        raise
+    _interrupt(proc, pids, to_group=False)
+    assert list(out.glob("run_*.nc")) == []  # nothing saved; no queued run started
+
+
 def test_cli_reproduce_with_failed_runs_prints_the_table_and_exits_1(tmp_path, capsys, monkeypatch):
     import snapping.reproduce as R
     from snapping.cli import main

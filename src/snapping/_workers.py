@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ProcessPoolExecutor
 
-__all__ = ["local_pool", "stop_pool", "run_all", "worker_init", "stopped", "until_first_step", "StopFlag",
+__all__ = ["local_pool", "stop_pool", "run_all", "worker_init", "stopped", "until_first_step", "nothing_to_save", "StopFlag",
            "WORKER_PID_FILE_ENV", "EXIT_ABANDONED"]
 
 #: test hook: a path to which each local worker process appends its pid when it starts
@@ -141,6 +141,15 @@ def until_first_step():
                 _PHASE = "idle"
 
     return phase()
+
+
+def nothing_to_save():
+    """Context of a run that keeps no checkpoint (an extensible line's run: :mod:`snapping.simulate.elastic`)
+    in a local worker task: it has nothing to save at any step (an interrupted one is run again), so a
+    stopped sweep ends the worker at once (:func:`worker_init`) instead of waiting for the run to end.
+    Such a run never reaches the driver's chunk hook, so it stays "starting" (:func:`until_first_step`)
+    to its end. Around the run only, not its file's write. (Nothing outside a local worker.)"""
+    return until_first_step()
 
 
 def _call(fn, *args):

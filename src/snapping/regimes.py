@@ -186,9 +186,13 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     if mechanism == "stretching" and number > 0:
         from .simulate.elastic import Elastic, solve
 
-        ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
-                   tol=stretch_tol(tol, 1.0 / number), method=method, stop_floor=STRETCH_STOP_FLOOR,
-                   start=start, max_rhs=STRETCH_MAX_RHS_LINKS if method == "rodas4-links" else STRETCH_MAX_RHS).dataset
+        from . import _workers
+
+        with _workers.nothing_to_save():  # (an interrupted study does not wait for it: the study keeps no part of it)
+            ds = solve(problem, Elastic.from_wave_speed(1.0 / number, grid_damping=damping),
+                       tol=stretch_tol(tol, 1.0 / number), method=method, stop_floor=STRETCH_STOP_FLOOR,
+                       start=start, max_rhs=STRETCH_MAX_RHS_LINKS if method == "rodas4-links" else STRETCH_MAX_RHS
+                       ).dataset
     else:
         method = "rodas4" if (mechanism == "bending" and number > 0 and damping > 0) else "fast"
         ds = run(problem, method=method, tol=tol, progress=False).dataset

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _validate as V
+from . import _validate as V, _workers
 
 __all__ = ["OPTIONS", "description", "problem_of", "solve_kwargs", "run_point"]
 
@@ -94,7 +94,8 @@ def run_point(params: dict, path) -> str:
     from .simulate.elastic import solve
     from .sweep_files import atomic_to_netcdf
 
-    r = solve(**solve_kwargs(params))
+    with _workers.nothing_to_save():  # (an interrupted sweep does not wait for it: it would be run again)
+        r = solve(**solve_kwargs(params))
     atomic_to_netcdf(r.dataset, path, overwrite=True)  # the sweep owns its run files
     return str(path)
 
@@ -134,7 +135,8 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "str
             pass
     if ds is None:
         cpu0 = time.process_time()
-        ds = solve(problem, elastic, tol=tol, start=start).dataset
+        with _workers.nothing_to_save():
+            ds = solve(problem, elastic, tol=tol, start=start).dataset
         cpu = time.process_time() - cpu0
         if path is not None:
             from .sweep_files import atomic_to_netcdf
