@@ -437,6 +437,16 @@ def test_an_interrupted_run_pickles_with_its_signal_and_path():
     assert (back.signum, back.exit_status, back.path, back.dataset, back.note) == (15, 143, "run.nc", None, "kept")
 
 
+def _sigint_default():
+    """``preexec_fn`` of a sweep subprocess that the test interrupts: SIGINT at its default, as in a
+    command typed at a terminal. (A process started in the background by a non-interactive shell,
+    e.g. a CI script's ``cmd &``, inherits SIGINT ignored, and Python then keeps it ignored: such a
+    sweep, as any program there, does not react to SIGINT sent to it alone.)"""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _cli_sweep(tmp_path, env, options: str):
     """A ``snapping sweep`` of 4 runs on 2 workers in its own process group, the grid's options
     updated with ``options`` (a dict's source)."""
@@ -449,7 +459,7 @@ def _cli_sweep(tmp_path, env, options: str):
               f"sys.exit(main(['sweep', '--chi', '0.3,0.4,0.5,0.6', '--N', '200', '--method', 'fast', '--workers', "
               f"'2', '-o', {str(out)!r}]))\n")
     return subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True), out
+                            text=True, start_new_session=True, preexec_fn=_sigint_default), out
 
 
 def _kill_all(proc, pids):
@@ -588,7 +598,8 @@ def test_cli_elastic_sweep_sigint_ends_at_once_without_waiting_for_its_runs(tmp_
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "snapping", "sweep", "--chi", "0.3,0.4,0.5,0.6", "--N", "4",
                              "--stretching", "30", "--workers", "2", "-o", str(out)], env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_sigint_default)
     pids = []
     try:
         deadline = time.monotonic() + 300
