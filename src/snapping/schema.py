@@ -359,6 +359,44 @@ CHECKPOINT_VARS_RODAS4: dict[str, dict[str, str]] = {
                                        "checkpoint_snapshot_t", "checkpoint_requested",
                                        "checkpoint_after_fractions")},
 }
+#: The state of an unfinished extensible-line run (``snapping.simulate.elastic.solve``,
+#: methods ``rodas4`` and ``rodas4-links``; :mod:`snapping.simulate.elastic_checkpoint`):
+#: the arrays of ``RodasRun.state()`` (``ckpt_`` + their names; dimensions ``ckpt_<name>_<axis>``)
+#: and the snapshots so far, next to the record so far. Continued by
+#: ``solve(..., resume=path)`` to the same numbers, bit for bit.
+ELASTIC_CHECKPOINT_VARS: dict[str, dict[str, str]] = {
+    "ckpt_stepper_y": _v("node state of the RODAS4 stepper (positions, velocities, held end's work, dissipation)"),
+    "ckpt_stepper_zl": _v("link state of the rodas4-links stepper (lengths, angles, their rates, W, D)"),
+    "ckpt_stepper_yn": _v("node state of the rodas4-links stepper"),
+    "ckpt_stepper_ctl": _v("the stepper's controls and counts (t, step size, last error, evaluations)"),
+    "ckpt_stepper_St0": _v("f at the current state (the next step's first stage)"),
+    "ckpt_stepper_B": _v("banded Jacobian at the current state"),
+    "ckpt_stepper_gW": _v("gradient of the held end's work rate at the current state"),
+    "ckpt_stepper_gD": _v("gradient of the dissipation rate at the current state"),
+    "ckpt_stepper_dsp": _v("the Jacobian's dependence on the held end at the current state"),
+    "ckpt_PY0": _v("start states of the step slots"),
+    "ckpt_PY1": _v("end states of the step slots"),
+    "ckpt_PC": _v("continuous-extension coefficients of the step slots"),
+    "ckpt_PT": _v("start and end times of the step slots"),
+    "ckpt_PN0": _v("node start states of the step slots (rodas4-links)"),
+    "ckpt_ref": _v("users of each step slot"),
+    "ckpt_keep": _v("step slots kept around each peak (v, a, sigma)"),
+    "ckpt_nkeep": _v("number of kept step slots per peak"),
+    "ckpt_after": _v("1 where a peak keeps the next step"),
+    "ckpt_best": _v("running peaks of v_max, a_max, sigma_max and their times"),
+    "ckpt_sctl": _v("the run's controls (stop rule, energy error, first slack, running peak)"),
+    "ckpt_peak_z": _v("state at the running peak of v_max"),
+    "ckpt_snap_t": _v("times of the snapshots so far"),
+    "ckpt_snap_z": _v("states of the snapshots so far"),
+    "ckpt_snap_kind": _v("kinds of the snapshots so far"),
+}
+#: Global attributes of an extensible-line checkpoint (besides the run's inputs).
+ELASTIC_CHECKPOINT_ATTRS: dict[str, str] = {
+    "checkpoint_version": "layout version of the ckpt_ variables",
+    "checkpoint_wall_time": "wall-clock seconds spent on the run before this checkpoint",
+    "checkpoint_n_restep": "right-hand-side evaluations of the snapshots' integrations so far",
+    "checkpoint_inputs": "JSON of every input of solve that the run's numbers depend on (resume checks them)",
+}
 #: String variable (no units) holding the kinds of the snapshots so far.
 CHECKPOINT_KIND_VAR = "checkpoint_snapshot_kind"
 

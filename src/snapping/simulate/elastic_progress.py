@@ -66,10 +66,10 @@ class Chunks:
     (``rows``) without a bar; with one, :data:`FIRST_CHUNK`, then as many as take about
     :data:`CHUNK_SECONDS` at the measured wall time per step."""
 
-    def __init__(self, bar, rows: int):
+    def __init__(self, bar, rows: int, short: bool = False):
         self.max = int(rows)
-        self.rows = self.max if bar is None else min(FIRST_CHUNK, self.max)
-        self.adapt = bar is not None
+        self.adapt = bar is not None or bool(short)  # (short: a checkpointed run, its chunks as a bar's)
+        self.rows = min(FIRST_CHUNK, self.max) if self.adapt else self.max
         self.t0 = time.perf_counter()
 
     def start(self) -> int:

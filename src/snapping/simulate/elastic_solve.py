@@ -40,6 +40,7 @@ Example
 from __future__ import annotations
 
 import json
+import os
 import time
 
 import numpy as np
@@ -47,6 +48,7 @@ from scipy.integrate import DOP853, Radau
 
 from .. import _validate as V
 from . import elastic_advance as EA
+from . import elastic_checkpoint as ECK
 from . import elastic_checks as EC
 from . import elastic_progress as EP
 from . import elastic_refine as ERF
@@ -54,7 +56,8 @@ from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .snap_window import snap_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
-from .options import check_progress
+from .errors import RunInterrupted
+from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
 from .elastic_links_rodas import LinksStepper
 
@@ -229,7 +232,7 @@ def _snapshot(ts, t_old, y_old, t, y, restep, dense):
 
 
 def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep, bar=None,
-               **kw):
+               state=None, poll=None, **kw):
     """The step loop of :func:`solve` for RODAS4, compiled (:func:`elastic_advance.advance`:
     the same bookkeeping, many steps a call; with a progress ``bar``, calls of about
     :data:`elastic_progress.CHUNK_SECONDS`, the bar moved after each). Returns the record rows
@@ -238,8 +241,10 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
     :meth:`_Peaks.refine`) are filled in."""
     run = (EA.LinksRun if isinstance(solver, LinksStepper) else EA.RodasRun)(solver, mm0, energy_fail=ENERGY_ERROR_FAIL,
                                                                             **kw)
+    if state is not None:  # (a resumed run: elastic_checkpoint)
+        run.restore(state)
     chunks, status = [], "completed"
-    sizes, nsteps = EP.Chunks(bar, run.rec.shape[0]), 0
+    sizes, nsteps = EP.Chunks(bar, run.rec.shape[0], short=poll is not None), 0
     while True:
         code = run.advance(snaps[0] if snaps else np.inf, sizes.start())
         chunks.append(run.drain())
@@ -261,6 +266,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
                 snap_z.append(_snapshot(ts, dense.t_old, run.last_start(), t, solver.y, restep, lambda: dense))
                 snap_kind.append("requested")
         if code in (EA.R_SNAPSHOT, EA.R_BUFFER):
+            if poll is not None:  # checkpoints and signals, at a step boundary (may raise RunInterrupted)
+                poll(run, chunks)
             continue
         if code == EA.R_SNAP:
             stop_reason = "snap"
@@ -285,7 +292,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
 def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float = 1e-8, method: str = "radau",
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
           snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None,
-          progress: bool | None = False) -> ElasticRun:
+          progress: bool | None = False, checkpoint=None, checkpoint_every: float | None = None,
+          resume=None) -> ElasticRun:
     """Integrate the elastic line of ``problem`` made of ``elastic`` links.
 
     Parameters
@@ -329,6 +337,18 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         terminal, else a plain line every ~10 s; :mod:`snapping.simulate.elastic_progress`):
         ``t`` out of ``t_end`` or of the estimated snap, the steps and rejected steps taken.
         The run's numbers are the same with or without it.
+    checkpoint : path, optional
+        ``"rodas4"`` and ``"rodas4-links"`` only: the file (:mod:`snapping.simulate.elastic_checkpoint`)
+        written on SIGINT or SIGTERM (status 'interrupted', then :class:`RunInterrupted` is
+        raised, as by :func:`snapping.simulate.run`) and every ``checkpoint_every`` seconds of
+        wall time (status 'checkpoint'; 0: at every return of the compiled loop, None: only
+        when stopped). An existing file is refused unless it is ``resume``'s. The run's numbers
+        are the same with or without it.
+    resume : path, optional
+        A checkpoint of this run to continue (the same ``problem``, ``elastic`` and options:
+        others are refused by name, as is a file whose digest fails); the result equals the
+        uninterrupted run's, bit for bit (``wall_time`` aside: it adds up the sessions).
+        Further checkpoints go to ``checkpoint``, by default this file.
 
     Returns
     -------
@@ -354,8 +374,26 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     if stop_floor is not None:
         stop_floor = V.positive("stop_floor", stop_floor)
     progress = check_progress(progress)
+    checkpoint_every = check_checkpoint_every(checkpoint_every)
+    if (checkpoint is not None or resume is not None or checkpoint_every is not None) and \
+            (method not in ("rodas4", "rodas4-links") or not COMPILED_LOOP):
+        raise V.SnappingInputError(f"checkpoint/checkpoint_every/resume with method={method!r}: only 'rodas4' and "
+                                   "'rodas4-links' (compiled loop) keep checkpoints")
+    if checkpoint is None:
+        checkpoint = resume
+    if checkpoint_every is not None and checkpoint is None:
+        raise V.SnappingInputError(f"checkpoint_every={checkpoint_every!r} needs a checkpoint file (checkpoint=PATH)")
+    if checkpoint is not None:
+        from .dataset import check_writable
+        own = resume is not None and os.path.realpath(os.fspath(checkpoint)) == os.path.realpath(os.fspath(resume))
+        checkpoint = check_writable(checkpoint, name="checkpoint", overwrite=own)
+    inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
+              "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
+              "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
+              "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
+              "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
 
-    wall0 = time.perf_counter()
+    wall0, wall_before = time.perf_counter(), 0.0
     z0 = _initial(line, start, initial)
     t_bound = t_end if t_end is not None else t_end_max
     count = [0]
@@ -401,13 +439,58 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         n_restep[0] += st.nfev
         return st.y if st.status == "finished" else None
 
+    state = poll = sigs = None
+    if checkpoint is not None:
+        key = {**{k: repr(v) if isinstance(v, float) else v for k, v in inputs.items()}, "max_rhs": max_rhs,
+               "snapshot_times": repr(snaps), "stop_floor": repr(floor), "initial": repr(z0.tolist())}
+        if resume is not None:
+            RunCls = EA.LinksRun if method == "rodas4-links" else EA.RodasRun
+            got = ECK.read(resume, key, [f"stepper_{k}" for k in RunCls.STEPPER_STATE] + list(RunCls.RUN_STATE))
+            if not np.array_equal(got["rows"][0], np.asarray(rows[0], float), equal_nan=True):
+                raise V.SnappingInputError(f"resume={str(resume)!r}: its first recorded step is not the start its "
+                                           "inputs give (the file was changed after it was written)")
+            state, rows, times, wall_before = got["state"], got["rows"], got["times"], got["wall"]
+            snap_t, snap_z, snap_kind = got["snap_t"], got["snap_z"], got["snap_kind"]
+            snaps = [x for x in snaps if x > times[-1]]
+            n_restep[0] = got["n_restep"]
+        sigs, last = ECK.Signals(), [time.monotonic()]
+
+        def poll(run, chunks):  # between chunks: a due checkpoint, or a signal (save, raise RunInterrupted)
+            signum = sigs.poll(run)
+            if signum is None and (checkpoint_every is None or time.monotonic() - last[0] < checkpoint_every):
+                return
+            t = float(solver.t)
+            rec = np.concatenate([np.asarray(rows, dtype=float)] + [c[:, 1:] for c in chunks])
+            tt = np.concatenate([np.asarray(times, dtype=float)] + [c[:, 0] for c in chunks])
+            sc = run.sctl
+            pk = (float(sc[EA.S_PEAKT]), run.peak_z.copy()) if sc[EA.S_RUN] > 0.0 else peak_state
+            wall = wall_before + time.perf_counter() - wall0
+            how = f"continue with solve(..., resume={checkpoint!r})"
+            status = "checkpoint" if signum is None else "interrupted"
+            reason = f"running; checkpoint at t={t:.9g}, step {len(tt) - 1}; if the run was killed, {how}" \
+                if signum is None else f"interrupted by {ECK.signal_name(signum)} at t={t:.9g}, step {len(tt) - 1}; {how}"
+            base = _dataset(line, tt, rec, snap_t + [pk[0], t], snap_z + [pk[1], solver.y.copy()],
+                            snap_kind + ["peak", "final"], {**inputs, "status": status, "stop_reason": reason,
+                                                            "t_final": t, "n_steps": len(tt) - 1, "wall_time": wall})
+            ds, path = ECK.write(checkpoint, base, run.state(), snap_t, snap_z, snap_kind, key, wall,
+                                 n_restep[0])
+            last[0] = time.monotonic()
+            if signum is not None:
+                raise RunInterrupted(f"{reason} (saved in {path})", int(signum), dataset=ds, path=path)
+
     bar = EP.open_run_bar(problem, method, t_end, progress)
     try:
         if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
-            rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
-                solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
-                t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0, max_rhs=max_rhs,
-                bar=bar)
+            if sigs is not None:
+                sigs.__enter__()
+            try:
+                rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
+                    solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
+                    t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0,
+                    max_rhs=max_rhs, bar=bar, state=state, poll=poll)
+            finally:
+                if sigs is not None:
+                    sigs.__exit__()
             rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
             times = np.concatenate([times, rec_steps[:, 0]])
         else:
@@ -466,7 +549,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         n_restep[0] += nf
     else:
         ref = peaks.refine(line, restep)
-    wall = time.perf_counter() - wall0
+    wall = wall_before + time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
         rec[:, STEP_NAMES.index("dissipated")]
@@ -499,10 +582,5 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     results.update(peak_ringing=ring, peaks_resolved=int(ok), peak_note=note)
     if not ok:
         results["status"] = "failed"  # stop_reason unchanged: peak_note says why
-    inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
-              "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
-              "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
-              "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
-              "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
     ds = _dataset(line, np.asarray(times), rec, snap_t, snap_z, snap_kind, {**inputs, **results})
     return ElasticRun(ds, {k: {"value": v[0], "t": v[1]} for k, v in ref.items()}, zf, line)
