@@ -447,6 +447,38 @@ def _sigint_default():
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+def _env_with_worker_hook(tmp_path, pid_file, body: str) -> dict:
+    """The environment of a sweep subprocess (:func:`_worker_env`) whose worker processes only run
+    ``body`` (source lines indented by 4, ``os`` and ``time`` imported) at start: a ``sitecustomize``."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text("import sys\nif '--multiprocessing-fork' in sys.orig_argv:\n"
+                                           "    import os, time\n" + body)
+    env = _worker_env(pid_file)
+    env["PYTHONPATH"] = os.pathsep.join([str(site), env["PYTHONPATH"]])
+    return env
+
+
+def _until_both_workers_marked(proc, pid_file, tmp_path, marker: str) -> list[int]:
+    """The pids of the sweep's two workers once each has left a file ``marker.PID`` in ``tmp_path``
+    (its run under way: a ``sitecustomize`` hook of the test's); the sweep killed if they do not."""
+    import time
+
+    pids = []
+    try:
+        deadline = time.monotonic() + 300
+        pids = _wait_for_workers(proc, pid_file, deadline)
+        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
+        while len(list(tmp_path.glob(f"{marker}.*"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.1)
+        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
+        assert len(list(tmp_path.glob(f"{marker}.*"))) == 2, "the runs did not start"
+    except BaseException:
+        _kill_all(proc, pids)
+        raise
+    return pids
+
+
 def _cli_sweep(tmp_path, env, options: str):
     """A ``snapping sweep`` of 4 runs on 2 workers in its own process group, the grid's options
     updated with ``options`` (a dict's source)."""
@@ -533,15 +565,9 @@ def test_cli_sweep_sigint_while_its_runs_are_starting_ends_at_once(tmp_path):
     """SIGINT to the sweep alone while its workers' runs are still starting (a slow start, as a
     cold numba compilation under load: here a sleep of 10 min before the first steps, in the
     workers only): the sweep ends promptly (nothing of those runs to save), exit 130, no file."""
-    import time
-
-    pid_file, site = tmp_path / "pids", tmp_path / "site"
-    site.mkdir()
+    pid_file = tmp_path / "pids"
     # in the sweep's worker processes only: each run's first chunk of steps starts after 600 s
-    (site / "sitecustomize.py").write_text(
-        "import sys\n"
-        "if '--multiprocessing-fork' in sys.orig_argv:\n"
-        "    import os, time\n"
+    env = _env_with_worker_hook(tmp_path, pid_file,
         "    from snapping.simulate import driver\n"
         "    drive = driver._drive_locked\n"
         "    def slow(eng, *a, **k):\n"
@@ -553,21 +579,8 @@ def test_cli_sweep_sigint_while_its_runs_are_starting_ends_at_once(tmp_path):
         "        eng.loop = slow_loop\n"
         "        return drive(eng, *a, **k)\n"
         "    driver._drive_locked = slow\n")
-    env = _worker_env(pid_file)
-    env["PYTHONPATH"] = os.pathsep.join([str(site), env["PYTHONPATH"]])
     proc, out = _cli_sweep(tmp_path, env, "{'t_end': 1e4, 'record_thin': 1e-2}")
-    pids = []
-    try:
-        deadline = time.monotonic() + 300
-        pids = _wait_for_workers(proc, pid_file, deadline)
-        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
-        while len(list(tmp_path.glob("starting.*"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)  # until both workers are in their runs' (slow) start
-        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
-        assert len(list(tmp_path.glob("starting.*"))) == 2, "the runs did not start"
-    except BaseException:
-        _kill_all(proc, pids)
-        raise
+    pids = _until_both_workers_marked(proc, pid_file, tmp_path, "starting")
     _interrupt(proc, pids, to_group=False)
     assert list(out.glob("run_*.nc")) == []  # nothing was computed, nothing saved; nothing started after
 
@@ -579,39 +592,21 @@ def test_cli_elastic_sweep_sigint_ends_at_once_without_waiting_for_its_runs(tmp_
     and no worker left (the runs would be run again: nothing of them to save)."""
     import subprocess
     import sys
-    import time
 
-    pid_file, site = tmp_path / "pids", tmp_path / "site"
-    site.mkdir()
+    pid_file = tmp_path / "pids"
     # in the sweep's worker processes only: each elastic run takes 600 s after saying it started
-    (site / "sitecustomize.py").write_text(
-        "import sys\n"
-        "if '--multiprocessing-fork' in sys.orig_argv:\n"
-        "    import os, time\n"
+    env = _env_with_worker_hook(tmp_path, pid_file,
         "    import snapping.simulate.elastic as E\n"
         "    def slow(*a, **k):\n"
         f"        open(os.path.join({str(tmp_path)!r}, f'solving.{{os.getpid()}}'), 'w').close()\n"
         "        time.sleep(600)\n"
         "    E.solve = slow\n")
-    env = _worker_env(pid_file)
-    env["PYTHONPATH"] = os.pathsep.join([str(site), env["PYTHONPATH"]])
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "snapping", "sweep", "--chi", "0.3,0.4,0.5,0.6", "--N", "4",
                              "--stretching", "30", "--workers", "2", "-o", str(out)], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
                             preexec_fn=_sigint_default)
-    pids = []
-    try:
-        deadline = time.monotonic() + 300
-        pids = _wait_for_workers(proc, pid_file, deadline)
-        assert len(pids) == 2, f"the workers did not start ({pids}, sweep exit {proc.poll()})"
-        while len(list(tmp_path.glob("solving.*"))) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.1)  # until both workers are in their runs
-        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()[1]}"
-        assert len(list(tmp_path.glob("solving.*"))) == 2, "the runs did not start"
-    except BaseException:
-        _kill_all(proc, pids)
-        raise
+    pids = _until_both_workers_marked(proc, pid_file, tmp_path, "solving")
     _interrupt(proc, pids, to_group=False)
     assert list(out.glob("run_*.nc")) == []  # nothing saved; no queued run started
 
