@@ -39,6 +39,7 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import time
@@ -481,16 +482,11 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     bar = EP.open_run_bar(problem, method, t_end, progress)
     try:
         if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
-            if sigs is not None:
-                sigs.__enter__()
-            try:
+            with sigs if sigs is not None else contextlib.nullcontext():  # (the signals noted, checkpointed runs)
                 rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
                     solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
                     t_end_given=t_end is not None, stop_fraction=stop_fraction, floor=floor, E0=E0, U0=U0,
                     max_rhs=max_rhs, bar=bar, state=state, poll=poll)
-            finally:
-                if sigs is not None:
-                    sigs.__exit__()
             rows = np.concatenate([np.asarray(rows, dtype=float), rec_steps[:, 1:]])  # (not through lists: 1 ms)
             times = np.concatenate([times, rec_steps[:, 0]])
         else:
