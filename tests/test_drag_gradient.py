@@ -163,3 +163,45 @@ def test_graded_drag_run_keeps_its_steps_and_peaks(monkeypatch):
     assert exact["n_rhs"] < 0.6 * fd["n_rhs"]  # (2484 against 4806)
     for q in ("v_peak", "a_peak", "sigma_peak"):
         assert float(exact[q]) == pytest.approx(float(fd[q]), rel=1e-9)
+
+
+def test_graded_answer_agrees_with_direct_runs_by_differences(monkeypatch):
+    """A graded design answer (a thin line whose bending length is 0.03 L, with drag: the nylon
+    answer's route on few links) against direct runs of its two levels with the W/D rows by forward
+    differences (the route before): the same peaks, and the answer's extrapolation of them."""
+    import math
+
+    from snapping import caps, estimates
+    from snapping.simulate import grading
+    from snapping.simulate.stiffness import grid_damping
+
+    g0 = 9.81
+    Lc, Mc, chi, lb = 1.0, 0.1, 0.5, 0.03
+    kw = {"ei": lb ** 2 * (Mc / Lc) * g0 * Lc ** 3, "diameter": 2e-3, "cd_normal": 1.2}
+    r = caps.cap(None, chi, N=12, check=False, alone=False, graded=True, length=Lc, mass=Mc, **kw)
+    g = r["graded"]
+    assert g["used"] and g["pair"] == (0, 1)
+    orig = RO.Engine.__init__
+
+    def init(self, *a, **k):
+        orig(self, *a, **k)
+        assert self.rp[RB.RP_QFD] == 0.0 and self.rp[RB.RP_DRAG] == 1.0
+        self.rp[RB.RP_QFD] = 1.0
+
+    monkeypatch.setattr(RO.Engine, "__init__", init)
+    a = estimates.catenary_parameter(chi)
+    peaks = []
+    for k in (0, 1):
+        s = 0.5 ** k
+        h = grading.fold_following(chi, frac=1.5 * lb * s / a, h_min=0.4 * lb * s, h_max=min(0.5, 20 * lb * s))
+        links = Links.graded(h)
+        eta = grid_damping(h, links.m, np.full(h.size + 1, lb ** 2), 0.01)
+        body = Body.from_si(Lc, Mc, g0, **kw)
+        body = Body(body.bending, damping=eta, drag_normal=body.drag_normal, drag_tangential=body.drag_tangential)
+        at = run(Problem.catenary(chi, links=links, body=body), method="rodas4", tol=1e-3, progress=False).dataset.attrs
+        peaks.append({"v_peak": float(at["v_peak"]) * math.sqrt(g0 * Lc), "a_peak": float(at["a_peak"]) * g0,
+                      "sigma_peak": float(at["sigma_peak"]) * Mc * g0})
+    for q in caps.QUANTITIES:
+        for k in (0, 1):
+            assert g["levels_peaks"][k][q] == pytest.approx(peaks[k][q], rel=1e-6)
+        assert r["real"][q] == pytest.approx(peaks[1][q] + (peaks[1][q] - peaks[0][q]) / 3.0, rel=1e-6)
