@@ -18,9 +18,10 @@ peaks (SI) of each. A variant is a JSON object of:
   there as measured on level 0 at chi 0.1 (:data:`FOLD_RADIUS`; ``bench_caps.py --profile``), at
   least half the free end's link;
 * ``tol``, ``damp``: RODAS4's tolerance and the damping ratio;
-* ``nowd``: true to run without the stage terms of the work and dissipation rows (with drag each is one
-  forward difference, a full right side, per stage): those two rows come out wrong, the dynamics do
-  not; it measures what an exact derivative of them could save at most.
+* ``nowd``: true to run without the stage terms of the work and dissipation rows (before ``dragexact``,
+  with drag, each was one forward difference, a full right side, per stage; now the dissipation row's
+  are the drag power's exact gradient, one O(N) pass per step): those two rows come out wrong, the
+  dynamics do not; it measures what the rows' stage terms cost.
 
 Usage::
 
