@@ -9,8 +9,9 @@ instead of one forward difference (a full right side) per stage.
 * one compiled RODAS4 step with the exact rows against the same step with the rows by forward
   differences: the angles bit for bit, the dissipation to the difference's accuracy, and 5
   evaluations instead of 11;
+* the compiled step against the Python reference's (``stiff._Stepper``) from a moving state;
 * a drag run (graded links, the nylon answer's settings) with the exact rows against the same run
-  by differences: the same steps and peaks.
+  by differences: the same steps and peaks; a graded design answer against direct runs by differences.
 """
 
 from __future__ import annotations
