@@ -331,6 +331,67 @@ def nylon_problem(chi, level):
     return CR.problem(sp, chi, h.size, on, damping=CR.GRADED_DAMPING, omega_min=0.0, h=h)
 
 
+def fixed_band(kl, ku):
+    """A band LU with partial pivoting and its solve whose loops have the compile-time lengths of
+    ``kl, ku`` (the layout of :func:`snapping.simulate.banded.band_lu`'s stage path: rows of width
+    ``2 kl + ku + 2``, the reciprocal pivots in the last column, back substitution by columns), to
+    time the augmented shape as the engine's fixed-length path would run it."""
+    from numba import njit
+
+    mbw, idiag = kl + ku, 2 * kl + ku + 1
+
+    @njit(fastmath=False, boundscheck=False, error_model="numpy")
+    def lu(R, n, piv):
+        for k in range(n):
+            last = k + mbw >= n
+            qmax = min(kl, n - 1 - k) if last else kl
+            w = min(mbw + 1, n - k) if last else mbw + 1
+            p = k
+            vmax = abs(R[k, kl])
+            for q in range(1, qmax + 1):
+                v = abs(R[k + q, kl - q])
+                if v > vmax:
+                    vmax = v
+                    p = k + q
+            piv[k] = p
+            if vmax == 0.0 or not (vmax - vmax == 0.0):
+                return k + 1
+            if p != k:
+                op = k - p + kl
+                for d in range(w):
+                    tmp = R[k, kl + d]
+                    R[k, kl + d] = R[p, op + d]
+                    R[p, op + d] = tmp
+            inv = 1.0 / R[k, kl]
+            R[k, idiag] = inv
+            for q in range(1, qmax + 1):
+                oi = kl - q
+                m = R[k + q, oi] * inv
+                R[k + q, oi] = m
+                for d in range(1, w):
+                    R[k + q, oi + d] -= m * R[k, kl + d]
+        return 0
+
+    @njit(fastmath=False, boundscheck=False, error_model="numpy")
+    def solve(R, n, piv, b):
+        for k in range(n):
+            pk = piv[k]
+            if pk != k:
+                tmp = b[k]
+                b[k] = b[pk]
+                b[pk] = tmp
+            bk = b[k]
+            for q in range(1, min(kl, n - 1 - k) + 1):
+                b[k + q] -= R[k + q, kl - q] * bk
+        for k in range(n - 1, -1, -1):
+            xk = b[k] * R[k, idiag]
+            b[k] = xk
+            for d in range(1, min(mbw, k) + 1):
+                b[k - d] -= R[k - d, kl + d] * xk
+
+    return lu, solve
+
+
 def costs(N, reps=30):
     """CPU seconds of one LU and one solve of today's band (2N, 5, 4) and the augmented (4N, 9, 8):
     LAPACK's ``dgbtrf``/``dgbtrs`` and the engine's compiled :func:`snapping.simulate.banded.band_lu`
@@ -372,6 +433,24 @@ def costs(N, reps=30):
             BD.band_solve(R, n, kl, ku, pv, x)
         c2 = time.process_time()
         out[f"{name} compiled"] = ((c1 - c0) / reps, (c2 - c1) / reps)
+        flu, fsv = fixed_band(kl, ku)
+        R = np.zeros((n, 2 * kl + ku + 2))
+        R[:, :R0.shape[1]] = R0
+        R0f = R.copy()
+        flu(R, n, pv)
+        fsv(R, n, pv, x)
+        c0 = time.process_time()
+        for _ in range(reps):
+            R[:] = R0f
+            flu(R, n, pv)
+        c1 = time.process_time()
+        for _ in range(reps):
+            x[:] = b
+            fsv(R, n, pv, x)
+        c2 = time.process_time()
+        ref = lapack.dgbtrs(lu, kl, ku, b, piv)[0]
+        assert np.allclose(x, ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max()), "fixed-length band solve"
+        out[f"{name} fixed-length"] = ((c1 - c0) / reps, (c2 - c1) / reps)
     return out
 
 
@@ -387,7 +466,7 @@ def main(argv=None) -> int:
     a = p.parse_args(argv)
     if a.costs:
         for name, (lu, sv) in costs(a.costs, 300 if a.costs < 1000 else 30).items():
-            print(f"{name}: dgbtrf {1e6 * lu:.0f} us, dgbtrs {1e6 * sv:.0f} us ({a.costs} links)")
+            print(f"{name}: LU {1e6 * lu:.0f} us, solve {1e6 * sv:.0f} us ({a.costs} links)")
         print(f"load {os.getloadavg()[0]:.1f}")
         return 0
     pr = nylon_problem(a.chi, a.level)
