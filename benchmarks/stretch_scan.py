@@ -39,8 +39,16 @@ def report(ds, extra=None):
     out["cpu_by_c"] = {f"{c:.4g}": float(np.nansum(cpu[:, j])) for j, c in enumerate(cs)}
     out["cpu_by_chi"] = {f"{x:g}": float(np.nansum(cpu[i]) + np.nansum(icpu[i])) for i, x in enumerate(ds.chi.values)}
     out["cpu_by_level"] = {str(k): float(np.nansum(cpu[:, :, k]) + np.nansum(icpu[:, k])) for k in range(cpu.shape[2])}
+    for q in ("v_peak", "a_peak", "sigma_peak"):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
+        out[f"{q}_cells_within_1pct"] = int((rel <= 0.01).sum())
+        out[f"{q}_median_rel_error"] = float(np.nanmedian(rel))
     out["n_rhs"] = float(np.nansum(ds["n_rhs_level"].values) + np.nansum(ds["n_rhs_ideal_level"].values))
-    out["runs_missing"] = int(np.isnan(ds["v_peak_level"].values).sum() + np.isnan(ds["v_peak_ideal_level"].values).sum())
+    base = int(ds.attrs["levels"])
+    out["runs_missing"] = int(np.isnan(ds["v_peak_level"].values[:, :, :base]).sum()
+                              + np.isnan(ds["v_peak_ideal_level"].values[:, :base]).sum())
+    out["runs"] = int(np.isfinite(ds["v_peak_level"].values).sum() + np.isfinite(ds["v_peak_ideal_level"].values).sum())
     cells = []
     for i, x in enumerate(ds.chi.values):
         for j, c in enumerate(cs):
@@ -68,6 +76,7 @@ def main():
     ap.add_argument("--report", action="store_true", help="summarize the study file only")
     a = ap.parse_args()
     from snapping.regimes import load_study, regimes
+    from snapping.regimes_spec import STRETCH_ESCALATE, STRETCH_EXTRA_LEVELS
 
     js = os.path.splitext(a.out)[0] + ".json"
     if a.report:
@@ -85,7 +94,7 @@ def main():
     err = None
     try:
         ds = regimes("stretching", CHIS, NUMBERS, accuracy="medium", tol=a.tol, method="rodas4-links", out=a.out,
-                     progress=False)
+                     progress=False, escalate=STRETCH_ESCALATE, extra_levels=STRETCH_EXTRA_LEVELS)
     except RuntimeError as exc:  # some runs failed: the study file keeps the others
         err = str(exc)
         ds = load_study(a.out)
