@@ -128,18 +128,22 @@ def shipped():
 
 
 def _richardson(q):
-    """Four levels halving, by hand: the Richardson limit of the last three (order p = log2(d1/d2),
-    limit q3 + d2/(2^p - 1)), its error bar max(|limit - the first three's limit|, |correction|/10);
-    where the last three do not converge monotonically, the finest level, its bar their spread."""
+    """Four or more levels halving (the levels a cell ran: an escalated cell's five, NaN after), by
+    hand: the Richardson limit of the last three (order p = log2(d1/d2), limit q3 + d2/(2^p - 1)), its
+    error bar max(|limit - the three before's limit|, |correction|/10); where the last three do not
+    converge monotonically, the finest level, its bar their spread."""
+    q = np.asarray(q, dtype=float)
+    q = q[:int(np.isfinite(q).cumprod().sum())]
+    assert q.size >= 4
     d = np.diff(q)
     ests = []
-    for k in (2, 3):
+    for k in (q.size - 2, q.size - 1):
         d1, d2 = d[k - 2], d[k - 1]
         ok = d1 != 0 and d2 != 0 and np.sign(d1) == np.sign(d2) and abs(d2) < abs(d1)
         ests.append(q[k] + d2 / (2 ** math.log2(d1 / d2) - 1) if ok else None)
     if ests[1] is None:
-        return q[3], float(np.ptp(q[1:]))
-    err = abs(ests[1] - q[3]) if ests[0] is None else max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[3]))
+        return q[-1], float(np.ptp(q[-3:]))
+    err = abs(ests[1] - q[-1]) if ests[0] is None else max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[-1]))
     return ests[1], err
 
 
@@ -151,18 +155,20 @@ def test_shipped_study_is_the_links_scan(shipped, monkeypatch):
     assert ds.attrs["elastic_method"] == "rodas4-links" == S.STRETCH_METHOD and ds.attrs["tip_time"] == 3e-8
     assert ds.attrs["damping"] == S.STRETCH_DAMPING and ds.attrs["status"] == "complete"
     assert ds.attrs["elastic_start"] == "matched" and ds.attrs["tol_c"] == S.STRETCH_TOL_C
-    assert ds.attrs["peaks"] == "snap"  # its a_peak, sigma_peak are the snap's (branch snappeaks)
+    assert ds.attrs["peaks"] == "snap-taut" == S.STRETCH_PEAKS_KEY  # a the snap's, sigma the taut snap's
     assert (ds.attrs["levels"], ds.attrs["first"], ds.attrs["tol"]) == (4, -1, 1e-6)
-    assert list(ds.chi.values) == CHIS and ds.sizes["number"] == 8
+    assert (ds.attrs["escalate"], ds.attrs["extra_levels"]) == (S.STRETCH_ESCALATE, S.STRETCH_EXTRA_LEVELS) == (0.01, 1)
+    assert list(ds.chi.values) == CHIS and ds.sizes["number"] == 8 and ds.sizes["level"] == 5
     np.testing.assert_allclose(ds.number.values, NUMBERS, rtol=1e-12)
-    assert np.all(np.isfinite(ds.v_peak_level.values)) and np.all(np.isfinite(ds.v_peak_ideal_level.values))
+    assert np.all(np.isfinite(ds.v_peak_level.values[:, :, :4])) and np.all(np.isfinite(ds.v_peak_ideal_level.values[:, :4]))
     from snapping.continuum import QUANTITIES
 
     def fake(*a, **k):
         return {**{q: 1.0 for q in QUANTITIES}, "n_links": 1, "n_rhs": 1, "cpu_time": 0.0}
 
     monkeypatch.setattr(R, "_run_task", fake)
-    new = R.regimes("stretching", CHIS, NUMBERS, accuracy="medium", tol=1e-6, progress=False)
+    new = R.regimes("stretching", CHIS, NUMBERS, accuracy="medium", tol=1e-6, progress=False,
+                    escalate=S.STRETCH_ESCALATE, extra_levels=S.STRETCH_EXTRA_LEVELS)
     assert new.attrs["regimes_study"] == ds.attrs["regimes_study"]
 
 
@@ -170,7 +176,7 @@ def test_shipped_ideal_runs_agree_with_the_bending_study(shipped):
     """The ideal's runs (fold levels -1..2, tol 1e-6) against the bending study's (the same links at
     tol 1e-7: other runs): level by level within 1e-6 relative, the limits within their bars."""
     other = R.bundled_study("bending")
-    a, b = shipped.v_peak_ideal_level.values, other.v_peak_ideal_level.sel(chi=shipped.chi).values
+    a, b = shipped.v_peak_ideal_level.values[:, :4], other.v_peak_ideal_level.sel(chi=shipped.chi).values
     np.testing.assert_allclose(a, b, rtol=1e-6)
     for chi in shipped.chi.values:
         va, ea = float(shipped.v_peak_ideal.sel(chi=chi)), float(shipped.v_peak_ideal_error.sel(chi=chi))
@@ -200,7 +206,7 @@ def test_snap_peaks_resolved_and_capped(shipped):
     within 0.5% of the ideal's."""
     other = R.bundled_study("bending")
     for q in ("a_peak", "sigma_peak"):
-        np.testing.assert_allclose(shipped[f"{q}_ideal_level"].values,
+        np.testing.assert_allclose(shipped[f"{q}_ideal_level"].values[:, :4],
                                    other[f"{q}_ideal_level"].sel(chi=shipped.chi).values, rtol=1e-6)
         n_ok = 0
         for i, chi in enumerate(shipped.chi.values):
@@ -245,7 +251,8 @@ def test_stiffer_lines_approach_the_rigid_chain_monotonically(shipped):
         c = shipped.sel(chi=chi)
         r = c.v_peak_level.values / c.v_peak_ideal_level.values[None, :]  # numbers x levels
         lim = c.v_peak.values / float(c.v_peak_ideal)
-        for col in list(r.T) + [lim]:  # the numbers ascending: c descending
+        for col in list(r.T) + [lim]:  # the numbers ascending: c descending (an escalated level: its cells)
+            col = col[np.isfinite(col)]
             assert np.all(np.diff(col) < 0) and np.all(col <= 1.0 + 1e-6), (chi, col)
         stiff = 1.0 / shipped.number.values >= 25.0 * float(c.v_peak_ideal)
         assert stiff.sum() >= 1 and np.all(lim[stiff] >= 0.99), (chi, lim[stiff])
@@ -270,8 +277,9 @@ def _planted(ds):
     bad = ds.copy(deep=True)
     v = bad.v_peak_level.values
     iv = bad.v_peak_ideal_level.values
-    v[0, 7] = iv[0] * np.array([0.30, 0.60, 0.20, 0.40])
-    v[1, 7] = iv[1] * np.array([0.30, 0.40, 0.48, 0.54])
+    v[0, 7, :4] = iv[0, :4] * np.array([0.30, 0.60, 0.20, 0.40])
+    v[1, 7, :4] = iv[1, :4] * np.array([0.30, 0.40, 0.48, 0.54])
+    v[:2, 7, 4:] = np.nan  # (their four levels only)
     return bad
 
 
