@@ -78,8 +78,14 @@ def snap_peaks(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP
     whose time lies in the window is returned as is; else the window's largest record."""
     t = np.asarray(t, dtype=float)
     je = snap_end(t, v, t_peak, fraction)
+    return {"t_snap_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}
+
+
+def _window_peaks(t, je: int, cols: dict, run_peaks: dict) -> dict:
+    """The peaks over the recorded steps ``0 ... je``: a run peak whose time is in it as is, else the
+    largest record."""
     t_end = float(t[je])
-    out = {"t_snap_end": t_end}
+    out = {}
     for name, col in cols.items():
         val, tp = run_peaks[name]
         if np.isfinite(tp) and tp <= t_end:
@@ -110,12 +116,4 @@ def taut_peaks(t, v, n_slack, cols: dict, run_peaks: dict, t_peak, fraction: flo
     ``"t_taut_end"``."""
     t = np.asarray(t, dtype=float)
     je = taut_end(t, v, n_slack, t_peak, fraction)
-    t_end = float(t[je])
-    out = {"t_taut_end": t_end}
-    for name, col in cols.items():
-        val, tp = run_peaks[name]
-        if np.isfinite(tp) and tp <= t_end:
-            out[name] = float(val)
-        else:
-            out[name] = float(np.max(np.asarray(col, dtype=float)[:je + 1]))
-    return out
+    return {"t_taut_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}
