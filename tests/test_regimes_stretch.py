@@ -155,7 +155,7 @@ def test_shipped_study_is_the_links_scan(shipped, monkeypatch):
     assert ds.attrs["elastic_method"] == "rodas4-links" == S.STRETCH_METHOD and ds.attrs["tip_time"] == 3e-8
     assert ds.attrs["damping"] == S.STRETCH_DAMPING and ds.attrs["status"] == "complete"
     assert ds.attrs["elastic_start"] == "matched" and ds.attrs["tol_c"] == S.STRETCH_TOL_C
-    assert ds.attrs["peaks"] == "snap-taut" == S.STRETCH_PEAKS_KEY  # a the snap's, sigma the taut snap's
+    assert ds.attrs["peaks"] == "snap" == S.STRETCH_PEAKS_KEY  # its a_peak, sigma_peak are the snap's (0.9 window)
     assert (ds.attrs["levels"], ds.attrs["first"], ds.attrs["tol"]) == (4, -1, 1e-6)
     assert (ds.attrs["escalate"], ds.attrs["extra_levels"]) == (S.STRETCH_ESCALATE, S.STRETCH_EXTRA_LEVELS) == (0.01, 1)
     assert list(ds.chi.values) == CHIS and ds.sizes["number"] == 8 and ds.sizes["level"] == 5

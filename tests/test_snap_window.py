@@ -126,13 +126,15 @@ def test_schema_names_and_the_study_keeps_the_snap(monkeypatch):
              "t_snap_v": 1.1, "a_peak_snap": 30.0, "sigma_peak_snap": 4.0, "sigma_peak_taut": 6.0, "n_rhs": 7}
     monkeypatch.setattr(E, "solve", lambda *a, **k: types.SimpleNamespace(dataset=types.SimpleNamespace(attrs=attrs)))
     row = R._run_task(0.5, "stretching", 0.01, {"n_links": 4, "frac": 0.25}, 1e-6)
-    # the acceleration over the snap, the tension over the taut snap (regimes_spec.STRETCH_PEAK_ATTRS)
-    assert (row["v_peak"], row["a_peak"], row["sigma_peak"]) == (2.0, 30.0, 6.0)
-    key = R._study_key("stretching", [0.5], [0.1], {"peaks": "snap-taut"}, 0.5)
+    # the acceleration and tension over the snap; the taut snap's tension beside (regimes_spec.STRETCH_EXTRA_PEAKS)
+    assert (row["v_peak"], row["a_peak"], row["sigma_peak"], row["sigma_peak_taut"]) == (2.0, 30.0, 4.0, 6.0)
+    ideal = R._run_task(0.5, None, 0.0, {"n_links": 4, "frac": 0.25}, 1e-6)
+    assert "sigma_peak_taut" not in ideal  # (a study of another mechanism: no taut column)
+    key = R._study_key("stretching", [0.5], [0.1], {"peaks": "snap"}, 0.5)
     monkeypatch.setattr(R, "_run_task", lambda *a, **k: {**{q: 1.0 for q in R.QUANTITIES}, "n_links": 1, "n_rhs": 1,
                                                          "cpu_time": 0.0})
     ds = R.regimes("stretching", [0.5], [0.1], levels=2, first=-4, progress=False)
-    assert '"peaks": "snap-taut"' in ds.attrs["regimes_study"] and key != R._study_key("stretching", [0.5], [0.1], {}, 0.5)
+    assert '"peaks": "snap"' in ds.attrs["regimes_study"] and key != R._study_key("stretching", [0.5], [0.1], {}, 0.5)
     dr = R.regimes("drag", [0.5], [0.1], levels=2, first=-4, progress=False)
     assert "peaks" not in dr.attrs["regimes_study"]
 

@@ -69,7 +69,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
+                           STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
@@ -203,6 +203,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
     if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
         row.update({q: float(a[name]) for q, name in STRETCH_PEAK_ATTRS.items() if name in a})
+        row.update({q: float(a[name]) for q, name in STRETCH_EXTRA_PEAKS.items() if name in a})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -274,10 +275,15 @@ def bundled_study(mechanism: str) -> xr.Dataset:
         return load_study(str(p))
 
 
+def _extra(mechanism) -> tuple:
+    """The peaks a study of ``mechanism`` keeps beside QUANTITIES (stretching: STRETCH_EXTRA_PEAKS)."""
+    return tuple(STRETCH_EXTRA_PEAKS) if mechanism == "stretching" else ()
+
+
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
     nc, nn, nl = len(chis), len(numbers), len(levels)
     data = {}
-    for q in QUANTITIES + ("n_rhs", "cpu_time"):
+    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time"):
         data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
         data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
     data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
@@ -302,7 +308,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 
     nc, nn = ds.sizes["chi"], ds.sizes["number"]
     base = int(ds.attrs["levels"])  # the levels every cell runs (more: an escalating study's, regimes_escalate)
-    for q in QUANTITIES:
+    for q in QUANTITIES + tuple(q for q in _extra(ds.attrs["mechanism"]) if f"{q}_level" in ds):
         lim, err, order = (np.full((nc, nn), np.nan) for _ in range(3))
         ilim, ierr = np.full(nc, np.nan), np.full(nc, np.nan)
         for i in range(nc):
@@ -528,8 +534,12 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             bar.update(1)
             return
         i, j, k = t
+        if j is None:  # the ideal chain (inextensible: never slack): its taut snap's tension is its run's
+            row = {**row, **{q: row["sigma_peak"] for q in _extra(mechanism)}}
         for q, v in row.items():
             name = f"{q}_ideal_level" if j is None else f"{q}_level"
+            if name not in ds:  # (a study file from before the name: its earlier runs have none)
+                continue
             if j is None:
                 ds[name].values[i, k] = v
             else:
