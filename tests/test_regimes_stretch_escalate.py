@@ -19,13 +19,13 @@ from snapping.continuum import QUANTITIES
 
 
 def _values(chi, number, frac):
-    """Closed-form peaks of one run at fold fraction ``frac`` (0.08 ... 0.005 for medium + 1 level).
+    """Closed-form peaks of one run at fold fraction ``frac`` (0.32 ... 0.02: fold levels -3 ... 0, + 1).
     v converges at order 2 everywhere; a of the cell (chi 0.1, number 0.1) alternates about 100
     (+-0.5 frac / 0.01 %, no order: its bar is the spread of the last three, 2.5%-ish: escalates);
     sigma of the cell (0.5, 0.1) converges at order 1 from far (3f^0.5 correction: orders drift,
     bar over 1%: escalates); the ideal at chi 0.5 has a sigma bar over 1% of its own."""
     v = 10.0 - 5.0 * frac**2
-    k = round(math.log2(frac / 0.08))
+    k = round(math.log2(frac / 0.32))
     a = 100.0 * (1 + 0.5 * frac * (-1) ** k) if (chi, number) == (0.1, 0.1) else 100.0 * (1 - frac**2)
     if (chi, number) == (0.5, 0.1):
         s = 5.0 * (1 - 3 * frac**0.5)
@@ -46,6 +46,7 @@ def fake(monkeypatch):
                 "n_rhs": 1, "cpu_time": 0.0}
 
     monkeypatch.setattr(R, "_run_task", task)
+    monkeypatch.setattr(R, "cell_problem", lambda *a, **k: None)  # (the up-front check of the runs' problems: not run)
     return calls
 
 
@@ -65,19 +66,19 @@ def _richardson_last3(q):
 
 
 def test_cells_over_the_target_run_one_more_level(fake):
-    ds = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], accuracy="medium", progress=False, escalate=0.01,
+    ds = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01,
                    extra_levels=1)
     assert ds.sizes["level"] == 5 and ds.attrs["status"] == "complete"
-    np.testing.assert_allclose(ds.resolution.values, [0.08, 0.04, 0.02, 0.01, 0.005])
+    np.testing.assert_allclose(ds.resolution.values, [0.32, 0.16, 0.08, 0.04, 0.02])
     # by hand: (0.1, 0.1)'s a alternates (bar 2 x 0.5% spread), (0.5, 0.1)'s sigma converges at order 1/2
     # (bar >> 1%): both escalate, and so do the ideals at chi 0.1 (a cell did) and 0.5 (a cell did; its own
     # sigma bar is over 1% too); (0.1, 0.01) and (0.5, 0.01) converge at order 2 (bars 1e-4): they do not
     np.testing.assert_array_equal(ds.levels_run.values, [[4, 5], [4, 5]])
     np.testing.assert_array_equal(ds.levels_run_ideal.values, [5, 5])
     assert len(fake) == 2 * 3 * 4 + 4
-    assert sorted(c for c in fake if c[2] == 0.005) == [(0.1, 0.0, 0.005), (0.1, 0.1, 0.005), (0.5, 0.0, 0.005),
-                                                      (0.5, 0.1, 0.005)]
-    fr = [0.08, 0.04, 0.02, 0.01, 0.005]
+    assert sorted(c for c in fake if c[2] == 0.02) == [(0.1, 0.0, 0.02), (0.1, 0.1, 0.02), (0.5, 0.0, 0.02),
+                                                     (0.5, 0.1, 0.02)]
+    fr = [0.32, 0.16, 0.08, 0.04, 0.02]
     # the escalated cell's sigma: the Richardson limit of its five levels (last three), by hand
     q = [_values(0.5, 0.1, f)["sigma_peak"] for f in fr]
     lim, err = _richardson_last3(q)
@@ -94,10 +95,10 @@ def test_cells_over_the_target_run_one_more_level(fake):
 
 
 def test_a_study_without_escalate_is_unchanged(fake):
-    ds = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], accuracy="medium", progress=False)
+    ds = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False)
     assert ds.sizes["level"] == 4 and "levels_run" not in ds and len(fake) == 2 * 3 * 4
     assert "escalate" not in ds.attrs["regimes_study"] and "extra_levels" not in ds.attrs
-    esc = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], accuracy="medium", progress=False, escalate=0.01)
+    esc = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01)
     assert esc.attrs["regimes_study"] != ds.attrs["regimes_study"] and esc.attrs["extra_levels"] == 1
     # the cells that did not escalate have the same limits as the unescalated study's
     assert float(esc.v_peak.sel(chi=0.1, number=0.01)) == float(ds.v_peak.sel(chi=0.1, number=0.01))
@@ -105,9 +106,9 @@ def test_a_study_without_escalate_is_unchanged(fake):
 
 def test_resume_runs_nothing(fake, tmp_path):
     out = str(tmp_path / "s.nc")
-    a = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], accuracy="medium", progress=False, escalate=0.01, out=out)
+    a = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
     n = len(fake)
-    b = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], accuracy="medium", progress=False, escalate=0.01, out=out)
+    b = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
     assert len(fake) == n and b.attrs["status"] == "complete"
     np.testing.assert_array_equal(a.sigma_peak.values, b.sigma_peak.values)
 
@@ -134,6 +135,6 @@ def test_pending_needs_the_base_levels_and_stops_at_the_last():
                                 {"escalate": 0.01, "extra_levels": 5}, {"extra_levels": 1}])
 def test_bad_escalation_refused(kw, fake):
     with pytest.raises(SnappingInputError) as e:
-        R.regimes("end-mass", [0.5], [0.1], accuracy="medium", progress=False, **kw)
+        R.regimes("end-mass", [0.5], [0.1], levels=4, first=-3, progress=False, **kw)
     assert ("escalate" if "escalate" in kw and kw.get("extra_levels", 1) in (1,) else "extra_levels") in str(e.value)
     assert fake == []
