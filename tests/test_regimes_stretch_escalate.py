@@ -106,9 +106,10 @@ def test_a_study_without_escalate_is_unchanged(fake):
 
 def test_resume_runs_nothing(fake, tmp_path):
     out = str(tmp_path / "s.nc")
-    a = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
+    a = R.regimes("end-mass", [0.1], [0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
     n = len(fake)
-    b = R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
+    assert n == 10 and int(a.levels_run.values[0, 0]) == 5  # (the cell escalates: its a alternates)
+    b = R.regimes("end-mass", [0.1], [0.1], levels=4, first=-3, progress=False, escalate=0.01, out=out)
     assert len(fake) == n and b.attrs["status"] == "complete"
     np.testing.assert_array_equal(a.sigma_peak.values, b.sigma_peak.values)
 
