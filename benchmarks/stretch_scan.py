@@ -8,6 +8,10 @@ method="rodas4-links")``: fold levels -1 ... 2 (the other mechanisms' 1% levels)
 (resumable: a rerun computes only the runs missing; its a_peak, sigma_peak are the runs' snap peaks,
 ``a_peak_snap``/``sigma_peak_snap``, since branch snappeaks: ``results/stretch_scan_snap.json``) and a JSON summary beside it (``.json``), with
 per-run CPU split by c, chi and level (what dominates) and the cells not converged / not within 1%.
+Since branch stretch1pct: escalated (``regimes(escalate=STRETCH_ESCALATE, extra_levels=STRETCH_EXTRA_LEVELS)``:
+a cell whose v, a or sigma bar is over 1% runs fold level 3 too, :mod:`snapping.regimes_escalate`), the taut
+snap's tension kept beside (``sigma_peak_taut``, ``regimes_spec.STRETCH_EXTRA_PEAKS``):
+``results/stretch_scan_esc.json``.
 
 Usage::
 
@@ -39,7 +43,7 @@ def report(ds, extra=None):
     out["cpu_by_c"] = {f"{c:.4g}": float(np.nansum(cpu[:, j])) for j, c in enumerate(cs)}
     out["cpu_by_chi"] = {f"{x:g}": float(np.nansum(cpu[i]) + np.nansum(icpu[i])) for i, x in enumerate(ds.chi.values)}
     out["cpu_by_level"] = {str(k): float(np.nansum(cpu[:, :, k]) + np.nansum(icpu[:, k])) for k in range(cpu.shape[2])}
-    for q in ("v_peak", "a_peak", "sigma_peak"):
+    for q in ("v_peak", "a_peak", "sigma_peak") + (("sigma_peak_taut",) if "sigma_peak_taut" in ds else ()):
         with np.errstate(invalid="ignore", divide="ignore"):
             rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
         out[f"{q}_cells_within_1pct"] = int((rel <= 0.01).sum())
