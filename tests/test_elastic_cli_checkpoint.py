@@ -23,7 +23,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from snapping import _files
 from snapping.cli import main
+from snapping.simulate import elastic_checkpoint as ECK
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RUN = ["simulate", "--chi", "0.25", "--N", "12", "--stretching", "20", "--method", "rodas4",
@@ -39,31 +41,41 @@ def _digest(p) -> str:
 
 
 @pytest.fixture(scope="module")
-def interrupted(tmp_path_factory):
-    """The command run in a subprocess with --checkpoint, SIGINT sent to it at its loop's 2nd return."""
+def runs(tmp_path_factory):
+    """The command run in a subprocess with --checkpoint, SIGINT sent to it at its loop's 2nd
+    return; meanwhile (while the subprocess starts) the uninterrupted run of the same command,
+    no checkpoint, in this process: its -o file, the reference."""
     d = tmp_path_factory.mktemp("interrupted")
     marker, go, ck, out = d / "marker", d / "go", d / "ck.nc", d / "run.nc"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     proc = subprocess.Popen([sys.executable, os.path.join(HERE, "elastic_cli_child.py"), str(marker), str(go), "2",
                              *RUN, "--checkpoint", str(ck), "-o", str(out)], cwd=d, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_sigint_default)
-    t0 = time.monotonic()
-    while not marker.exists() and proc.poll() is None and time.monotonic() - t0 < 120:
-        time.sleep(0.01)
-    assert marker.exists(), proc.communicate()
-    proc.send_signal(signal.SIGINT)  # (the run notes it; its loop stops at the next step boundary)
-    time.sleep(0.2)
-    go.touch()
-    _, err = proc.communicate(timeout=120)
-    return {"rc": proc.returncode, "err": err, "ck": ck, "out": out, "dir": d}
+    try:
+        ref = tmp_path_factory.mktemp("ref") / "ref.nc"
+        assert main([*RUN, "-o", str(ref)]) == 0
+        t0 = time.monotonic()
+        while not marker.exists() and proc.poll() is None and time.monotonic() - t0 < 120:
+            time.sleep(0.01)
+        assert marker.exists(), proc.communicate()
+        proc.send_signal(signal.SIGINT)  # (the run notes it; its loop stops at the next step boundary)
+        time.sleep(0.2)
+        go.touch()
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    return {"rc": proc.returncode, "err": err, "ck": ck, "out": out, "dir": d, "ref": xr.load_dataset(ref)}
 
 
-@pytest.fixture(scope="module")
-def reference(tmp_path_factory):
-    """The uninterrupted run of the same command, no checkpoint: its -o file."""
-    ref = tmp_path_factory.mktemp("ref") / "ref.nc"
-    assert main([*RUN, "-o", str(ref)]) == 0
-    return xr.load_dataset(ref)
+@pytest.fixture
+def interrupted(runs):
+    return runs
+
+
+@pytest.fixture
+def reference(runs):
+    return runs["ref"]
 
 
 def test_sigint_saves_and_the_printed_command_resumes_bit_for_bit(interrupted, reference, tmp_path, capsys):
@@ -150,3 +162,55 @@ def test_misdirected_commands_refused_and_nothing_written(interrupted, tmp_path,
     assert not (tmp_path / "new.nc").exists() and out.read_bytes() == b"x"
     assert _digest(ck) == before
     assert sorted(os.listdir(tmp_path)) == ["ck.nc", "run.nc"]  # (no lock or partial files left)
+
+
+LOCKER = """
+import sys, time
+from snapping._files import OutputBusyError, locked
+if sys.argv[2] == "hold":
+    with locked(sys.argv[1], name="checkpoint"):
+        print("held", flush=True)
+        sys.stdin.read()
+else:
+    try:
+        with locked(sys.argv[1], name="checkpoint"):
+            print("free")
+    except OutputBusyError as exc:
+        print(exc)
+"""
+
+
+def test_checkpoint_locked_while_a_run_resumes_it(interrupted, reference, tmp_path, capsys):
+    """Two processes never both continue one checkpoint: one holding its lock (as a resuming run
+    does) makes a second resume exit 2 naming its PID, the file untouched; and a resuming run
+    holds the lock from its first chunk to its end (another process finds it busy)."""
+    ck, out = tmp_path / "ck.nc", tmp_path / "run.nc"
+    shutil.copy(interrupted["ck"], ck)
+    before = _digest(ck)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    holder = subprocess.Popen([sys.executable, "-c", LOCKER, str(ck), "hold"], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        _refused([*RUN, "--checkpoint", str(ck), "--resume", "-o", str(out)], capsys,
+                 f"--checkpoint={str(ck)!r} is being written by process PID {holder.pid}")
+    finally:
+        holder.communicate("", timeout=30)
+    assert _digest(ck) == before and not out.exists()
+    seen = []
+
+    def probe(run):  # (inside the resumed run: is its checkpoint locked for another process?)
+        if not seen:
+            seen.append(subprocess.run([sys.executable, "-c", LOCKER, str(ck), "try"], capture_output=True,
+                                       text=True, env=env, timeout=60).stdout)
+        return None
+
+    ECK._chunk_hook = probe
+    try:
+        assert main([*RUN, "--checkpoint", str(ck), "--resume", "-o", str(out)]) == 0
+    finally:
+        ECK._chunk_hook = None
+    assert f"is being written by process PID {os.getpid()}" in seen[0], seen
+    assert np.array_equal(xr.load_dataset(out)["a_max"].values, reference["a_max"].values)
+    assert not os.path.exists(_files.lock_path(str(ck)))  # (released at the end)
+    capsys.readouterr()
