@@ -162,6 +162,19 @@ def test_misdirected_commands_refused_and_nothing_written(interrupted, tmp_path,
     assert not (tmp_path / "new.nc").exists() and out.read_bytes() == b"x"
     assert _digest(ck) == before
     assert sorted(os.listdir(tmp_path)) == ["ck.nc", "run.nc"]  # (no lock or partial files left)
+    # the library refuses it too, naming the parameter, its value and the methods that keep checkpoints
+    from snapping._validate import SnappingInputError
+    from snapping.simulate.elastic import Elastic, solve
+    from snapping.simulate.problem import Links, Problem
+
+    P, E = Problem.catenary(0.25, links=Links.uniform(12, lumping="shared")), Elastic.from_wave_speed(20.0)
+    for m in ("radau", "dop853"):
+        with pytest.raises(SnappingInputError, match=f"checkpoint='.*new.nc' with method='{m}': only the methods "
+                                                     r"\('rodas4', 'rodas4-links'\)"):
+            solve(P, E, method=m, checkpoint=tmp_path / "new.nc")
+    with pytest.raises(SnappingInputError, match="checkpoint_every=5.0 with method='radau'"):
+        solve(P, E, method="radau", checkpoint_every=5.0)
+    assert not (tmp_path / "new.nc").exists()
 
 
 LOCKER = """

@@ -291,8 +291,8 @@ def run_elastic(args, problem, elastic, times):
         try:
             r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
                       method=method, stop_fraction=args.stop_fraction, snapshot_times=times,
-                      start=elastic_start(args), progress=False if getattr(args, "no_progress", False) else None,
-                      checkpoint=ck, resume=res, checkpoint_every=every)
+                      start=elastic_start(args), checkpoint=ck, resume=res, checkpoint_every=every,
+                      progress=False if getattr(args, "no_progress", False) else None)
         except ECK.CheckpointMismatch as exc:
             raise SnappingInputError(mismatch_words(exc, args)) from None
         if out is not None:
