@@ -155,6 +155,8 @@ def test_misdirected_commands_refused_and_nothing_written(interrupted, tmp_path,
     _refused([*RUN, "--resume", "-o", str(out)], capsys, "--resume without a file", "--checkpoint FILE")
     _refused([*RUN, "--checkpoint-every", "5", "-o", str(out)], capsys, "--checkpoint-every 5.0 needs --checkpoint")
     _refused([*RUN, "--checkpoint", str(ck), "--resume", "-o", str(ck)], capsys, "name the same file")
+    _refused([*RUN, "--checkpoint", str(tmp_path / "ck.txt"), "-o", str(out)], capsys,
+             "--checkpoint=", "ck.txt' has the suffix .txt")
     # -o existing, without --overwrite: refused before the run (no checkpoint started)
     assert not out.exists()
     out.write_bytes(b"x")

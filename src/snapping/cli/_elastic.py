@@ -217,6 +217,11 @@ def _checkpoint_paths(args, method: str):
     from ..simulate import elastic_checkpoint as ECK
 
     ck, res = getattr(args, "checkpoint", None), args.resume
+    from .._files import netcdf_suffix
+
+    for o, v in (("--checkpoint", ck), ("--resume", res)):
+        if isinstance(v, str):  # (a checkpoint is a netCDF4 run file: never under a name that says another format)
+            netcdf_suffix(v, name=o)
     given = [(o, v) for o, v in (("--checkpoint", ck), ("--resume", res)) if v is not None]
     if given and method not in ECK.METHODS:
         o, v = given[0]

@@ -178,7 +178,10 @@ def _cmd_simulate(args) -> int:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
-    if times and args.output is None and args.resume is None:  # snapshots are profiles: only a run file holds them
+    from ._elastic import is_elastic
+
+    rigid_resume = args.resume is not None and not is_elastic(args)  # (its run file holds the snapshots)
+    if times and args.output is None and not rigid_resume:  # snapshots are profiles: only a run file holds them
         from ..simulate.options import _times
 
         _times(times)  # a bad time is named first
