@@ -6,7 +6,9 @@ uninterrupted run of the command without --checkpoint (the reference: a differen
 no checkpoint at all). Misdirected commands are refused (exit 2) before anything is written,
 naming the option: an existing checkpoint without --resume, a checkpoint of other options,
 --checkpoint with a method that keeps none (Radau, DOP853) or with the rigid chain, -o the
-checkpoint itself, --checkpoint-every without a checkpoint."""
+checkpoint itself, --checkpoint-every without a checkpoint. And one checkpoint is never
+continued by two processes: a resume is refused while another process holds its lock (naming
+that PID), and a resuming run holds it from its first chunk (another process finds it busy)."""
 
 from __future__ import annotations
 
