@@ -150,13 +150,14 @@ def _profile(name: str, chi: float, levels, tols) -> int:
 
 def _step_parts(p, n: int = 200) -> str:
     """The cost of one RODAS4 step's parts on problem ``p`` (at its start): the right side (a step makes
-    ~12 with drag: five stages, a difference along each stage for the quadratic damping, the new f), the
-    Jacobian, the banded LU, a stage's solve (six per step)."""
+    six: five stages and the new f; before ``dragexact``, with drag, ~12: a difference along each stage
+    for the dissipation row), the drag power's gradient (once per attempt, with drag), the Jacobian, the
+    banded LU, a stage's solve (six per step)."""
     import time
 
     import numpy as np
 
-    from snapping.simulate import models as MD, rosenbrock as RB
+    from snapping.simulate import forced as FR, models as MD, rosenbrock as RB
     from snapping.simulate.banded import KL, KU
     from snapping.simulate.methods import rodas4 as M4
 
@@ -166,6 +167,8 @@ def _step_parts(p, n: int = 200) -> str:
     N, w, f = e.N, e.w, np.empty_like(y0)
     b, U = np.linspace(0.0, 1.0, y0.size), np.zeros_like(y0)
     parts = {"rhs": lambda: MD.model_rhs(N, 0.1, y0, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, e.mdl),
+             "drag gradient": lambda: FR.drag_power_gradient(N, 0.1, y0, w.c, w.s, e.mdl[0], e.mdl[1], e.mdl[5],
+                                                             np.empty(2 * N)),
              "jacobian": lambda: RB.jacobian_at(N, 0.1, y0, f, w.sig, e.Dj, e.mdl, e.barr, e.rp),
              "LU": lambda: (RB.assemble(N, e.Dj, 2.5e-4, e.ab), RB.band_lu(e.ab, 2 * N, KL, KU, e.piv)),
              "stage solve": lambda: RB._stage_solve(N, e.Dj, 2.5e-4, e.ab, e.piv, b.copy(), U, e.rhs, e.tmp)}

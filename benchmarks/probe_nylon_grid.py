@@ -18,9 +18,11 @@ peaks (SI) of each. A variant is a JSON object of:
   there as measured on level 0 at chi 0.1 (:data:`FOLD_RADIUS`; ``bench_caps.py --profile``), at
   least half the free end's link;
 * ``tol``, ``damp``: RODAS4's tolerance and the damping ratio;
-* ``nowd``: true to run without the stage terms of the work and dissipation rows (with drag each is one
-  forward difference, a full right side, per stage): those two rows come out wrong, the dynamics do
-  not; it measures what an exact derivative of them could save at most.
+* ``nowd``: true to run without the stage terms of the work and dissipation rows (before ``dragexact``,
+  with drag, each was one forward difference, a full right side, per stage; now the dissipation row's
+  are the drag power's exact gradient, one O(N) pass per step): those two rows come out wrong, the
+  dynamics do not; it measures what the rows' stage terms cost;
+* ``fd``: true to take those stage terms by forward differences, the route before ``dragexact``.
 
 Usage::
 
@@ -28,6 +30,7 @@ Usage::
     python benchmarks/probe_nylon_grid.py --chi 0.1 '{"below": 0.05, "by": 0.5, "w": 0.01}' '{"cap": 0.8}'
     python benchmarks/probe_nylon_grid.py --chi 0.1 --level 1 '{"gscale": true}' '{"damp": 0.1}'
     python benchmarks/probe_nylon_grid.py --chi 0.1 --level 1 '{}' '{"nowd": true}'
+    python benchmarks/probe_nylon_grid.py --chi 0.1 --level 1 '{"fd": true}' '{}' '{"fd": true}' '{}'
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ from snapping import caps, estimates
 from snapping import caps_runs as CR
 from snapping.simulate import grading, run
 
-KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "radius", "tol", "damp", "nowd"}
+KEYS = {"fold", "tip", "held", "gscale", "below", "by", "w", "cap", "radius", "tol", "damp", "nowd", "fd"}
 #: the nylon line's fold at chi 0.1: its smallest radius (bending lengths) against x from the free end, on
 #: graded level 0 at tol 1e-3 (``python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0``)
 FOLD_RADIUS = ((0.0, 0.01, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6),
@@ -82,9 +85,10 @@ def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale
 
 
 @contextlib.contextmanager
-def _without_wd(on: bool):
-    """RODAS4's engines made meanwhile drop the W/D rows' stage terms (``rosenbrock.RP_QUAD``, ``RP_QFD``)."""
-    if not on:
+def _without_wd(on: bool, fd: bool = False):
+    """RODAS4's engines made meanwhile drop the W/D rows' stage terms (``rosenbrock.RP_QUAD``, ``RP_QFD``),
+    or (``fd``) take them by forward differences, the route before ``dragexact``."""
+    if not (on or fd):
         yield
         return
     from snapping.simulate import rosenbrock as RB
@@ -94,8 +98,11 @@ def _without_wd(on: bool):
 
     def init(self, *a, **kw):
         orig(self, *a, **kw)
-        self.rp[RB.RP_QUAD] = 0.0
-        self.rp[RB.RP_QFD] = 0.0
+        if on:
+            self.rp[RB.RP_QUAD] = 0.0
+            self.rp[RB.RP_QFD] = 0.0
+        elif self.rp[RB.RP_QUAD] != 0.0:
+            self.rp[RB.RP_QFD] = 1.0
 
     M4.Engine.__init__ = init
     try:
@@ -123,10 +130,11 @@ def main(argv=None) -> int:
         if bad:
             p.error(f"unknown keys {sorted(bad)} (known: {sorted(KEYS)})")
         tol, damp, nowd = d.pop("tol", CR.GRADED_TOL), d.pop("damp", CR.GRADED_DAMPING), d.pop("nowd", False)
+        fd = d.pop("fd", False)
         h = links(a.chi, lb, a.level, **d)
         pr = CR.problem(sp, a.chi, h.size, on, damping=damp, omega_min=0.0, h=h)
         c0 = time.process_time()
-        with _without_wd(nowd):
+        with _without_wd(nowd, fd):
             at = run(pr, method="rodas4", tol=tol, progress=False).dataset.attrs
         cpu = time.process_time() - c0
         si = caps._si(sp, {q: float(at[q]) for q in CR.QUANTITIES})

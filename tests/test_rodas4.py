@@ -87,7 +87,7 @@ def _engine(p, tol=1e-6):
 
 CASES = {
     "damping": dict(body=Body(bending=1e-3, damping=2e-4)),                    # W/D rows exact
-    "drag": dict(body=Body(bending=1e-3, drag_normal=0.5, drag_tangential=0.05)),  # by differences
+    "drag": dict(body=Body(bending=1e-3, drag_normal=0.5, drag_tangential=0.05)),  # D row: drag power gradient
     "pull": dict(body=Body(bending=1e-3, damping=1e-4), pin=PinMotion.pull((0.3, -0.2))),  # f_t too
     "clamp": dict(body=Body(bending=1e-3, damping=1e-4, clamp=0.3)),
 }

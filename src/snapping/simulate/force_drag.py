@@ -19,6 +19,24 @@ units of ``lambda sqrt(g/L)``, ``c_d`` in units of ``M/L``.
 
 Arrays (length N + 1, by node, each already times ``l_j``): ``CN, CT, KN, KT``; ``VX, VY``
 scratch for the node velocities; ``FX, FY`` the node forces (added to).
+
+The power's gradient (:func:`drag_power_gradient`: the stiff method's dissipation row, whose
+stage terms need ``dp/dtheta`` and ``dp/domega``; O(N), exact). Write node j's force with its
+relative velocity's components ``q = u.tau`` and ``c = u x tau`` (``u_n = c n'``, ``n' = (tau_y,
+-tau_x)``): ``F_j = -phi_n(c) n' - phi_t(q) tau [- c_d |u| u]``, ``phi_n(c) = (c_n l_j |c| + k_n l_j)
+c``, ``phi_t(q) = (c_t l_j |q| + k_t l_j) q``; its power ``P_j = F_j.v_j``. Then, with ``V_n =
+v_j.n'``, ``V_t = v_j.tau``::
+
+    dP_j/du   = -(phi_n' V_n + phi_n) n' - (phi_t' V_t + phi_t) tau [- c_d ((u.v_j)/|u| u + |u| (v_j + u))]
+    dP_j/dpsi = -phi_n' q V_n - phi_n V_t + phi_t' c V_t + phi_t V_n
+
+(``psi`` the tangent's angle: ``dtau = -n' dpsi``, ``dn' = tau dpsi``; ``phi_n' = 2 c_n l_j |c| +
+k_n l_j``). The bisector's angle is the mean of its links' (``dpsi/dtheta_{j-1} = dpsi/dtheta_j =
+1/2``; the free end's and a fold's own link: 1). The velocity ``v_j = v_N + sum_{l >= j} h_l
+omega_l (sin theta_l, -cos theta_l)`` gives, with ``G_l = sum_{j <= l} dP_j/du``::
+
+    dp/domega_l = h_l (sin theta_l, -cos theta_l).G_l
+    dp/dtheta_l = h_l omega_l (cos theta_l, sin theta_l).G_l + (the tangents' dP_j/dpsi dpsi/dtheta_l)
 """
 
 from __future__ import annotations
@@ -27,7 +45,7 @@ import math
 
 from numba import njit
 
-__all__ = ["node_velocities", "add_drag"]
+__all__ = ["node_velocities", "add_drag", "drag_power_gradient"]
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -77,3 +95,63 @@ def add_drag(N, c, s, wx, wy, CN, CT, KN, KT, cd, VX, VY, FX, FY):
         FY[j] += fy
         p += fx * VX[j] + fy * VY[j]
     return p
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def drag_power_gradient(N, y, c, s, h, wx, wy, CN, CT, KN, KT, cd, VX, VY, g):
+    """The gradient of :func:`add_drag`'s power at fixed time (the held end's velocity fixed):
+    ``g[:N] = dp/dtheta``, ``g[N:2N] = dp/domega`` (see the module's notes), from the cos/sin
+    ``c, s`` of the angles ``y[:N]`` and the node velocities ``VX, VY`` of
+    :func:`node_velocities`. O(N), no allocation."""
+    for j in range(N):
+        g[j] = 0.0
+    gx = 0.0  # G_l: the velocity derivatives summed from the free end
+    gy = 0.0
+    for j in range(N):
+        tx = c[j]
+        ty = s[j]
+        half = False
+        if j > 0:
+            bx = c[j - 1] + tx
+            by = s[j - 1] + ty
+            nb = math.sqrt(bx * bx + by * by)
+            if nb > 1e-12:
+                inb = 1.0 / nb
+                tx = bx * inb
+                ty = by * inb
+                half = True
+        vx = VX[j]
+        vy = VY[j]
+        ux = vx - wx
+        uy = vy - wy
+        q = ux * tx + uy * ty
+        cr = ux * ty - uy * tx
+        vn = vx * ty - vy * tx
+        vt = vx * tx + vy * ty
+        acr = abs(cr)
+        aq = abs(q)
+        phn = (CN[j] * acr + KN[j]) * cr
+        dphn = 2.0 * CN[j] * acr + KN[j]
+        pht = (CT[j] * aq + KT[j]) * q
+        dpht = 2.0 * CT[j] * aq + KT[j]
+        an = dphn * vn + phn
+        at = dpht * vt + pht
+        dux = -an * ty - at * tx
+        duy = an * tx - at * ty
+        if j == 0 and cd != 0.0:
+            u = math.sqrt(ux * ux + uy * uy)
+            if u > 0.0:
+                uv = (ux * vx + uy * vy) / u
+                dux -= cd * (uv * ux + u * (vx + ux))
+                duy -= cd * (uv * uy + u * (vy + uy))
+        dpsi = -dphn * q * vn - phn * vt + dpht * cr * vt + pht * vn
+        if half:
+            g[j - 1] += 0.5 * dpsi
+            g[j] += 0.5 * dpsi
+        else:
+            g[j] += dpsi
+        gx += dux
+        gy += duy
+        hj = h[j]
+        g[j] += hj * y[N + j] * (c[j] * gx + s[j] * gy)
+        g[N + j] = hj * (s[j] * gx - c[j] * gy)

@@ -50,7 +50,7 @@ from . import general as G
 from . import kernels as K
 
 __all__ = ["KIND_BODY", "make_body_model", "forced_rhs", "forced_measure", "node_forces", "clamp_angle",
-           "M_BEND", "M_DISS", "NMEAS_B", "NREC_B", "RECORD_NAMES_B", "evaluate_rhs"]
+           "M_BEND", "M_DISS", "NMEAS_B", "NREC_B", "RECORD_NAMES_B", "evaluate_rhs", "drag_power_gradient"]
 
 KIND_BODY = G.KIND_BODY
 
@@ -164,6 +164,24 @@ def node_forces(N, t, y, c, s, par, h, invh, tab, pvx, pvy):
                             tab[o + B_CT * n1:o + (B_CT + 1) * n1], tab[o + B_KN * n1:o + (B_KN + 1) * n1],
                             tab[o + B_KT * n1:o + (B_KT + 1) * n1], par[P_TIPCD], VX, VY, FX, FY)
     return pcl, diss, pdrag, qlast
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def drag_power_gradient(N, t, y, c, s, par, h, tab, g):
+    """The gradient of the drag's power ``sum_j F^drag_j.v_j`` (the dissipation rate's drag
+    part, ``D' = 2R - p``) in the state at fixed time t: ``g[:N] = dp/dtheta``, ``g[N:2N] =
+    dp/domega`` (:func:`snapping.simulate.force_drag.drag_power_gradient`, exact, O(N)); the
+    cos/sin of y's angles into ``c, s``, the node velocities into the table's scratch."""
+    AG.sincos(N, y, c, s)
+    _, _, pvx, pvy, _, _ = G.pin_kinematics(t, par, tab)
+    o = int(par[P_BOFF])
+    n1 = N + 1
+    VX = tab[o + B_VX * n1:o + (B_VX + 1) * n1]
+    VY = tab[o + B_VY * n1:o + (B_VY + 1) * n1]
+    FD.node_velocities(N, y, c, s, h, pvx, pvy, VX, VY)
+    FD.drag_power_gradient(N, y, c, s, h, par[P_WX], par[P_WY], tab[o + B_CN * n1:o + (B_CN + 1) * n1],
+                           tab[o + B_CT * n1:o + (B_CT + 1) * n1], tab[o + B_KN * n1:o + (B_KN + 1) * n1],
+                           tab[o + B_KT * n1:o + (B_KT + 1) * n1], par[P_TIPCD], VX, VY, g)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")

@@ -81,8 +81,9 @@ S_F0, S_F1 = 0, 7
 #: differences and of f_t (in n_rhs too), singular stage matrices
 (CN_JAC, CN_LU, CN_EXTRA, CN_SING) = range(4)
 NCNT = 4
-#: the flags of ``rp``: clamped, bending, W/D have dynamics, their rows by differences, autonomous
-(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO) = range(5)
+#: the flags of ``rp``: clamped, bending, W/D have dynamics, their rows by differences, autonomous,
+#: drag (with RP_QUAD and not RP_QFD: the dissipation row's drag part by its exact gradient)
+(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO, RP_DRAG) = range(6)
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -324,6 +325,11 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
     ch = np.empty(6)
     par, hh, invm, invh, snode, tab = mdl
     El = barr[2]
+    # the drag's power gradient at the step's start (the dissipation row's stage terms, exact)
+    dexact = rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0 and rp[RP_DRAG] != 0.0
+    gq = np.empty(n2 if dexact else 0)
+    if dexact:
+        FR.drag_power_gradient(N, t, y0, c, s, par, hh, tab, gq)
     for st in range(6):
         U = St[1 + st]
         if st == 0:
@@ -351,7 +357,7 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
         _stage_solve(N, Dj, gh, ab, piv, btmp, U, rhs, tmp)
         bw = btmp[n2]
         bd = btmp[n2 + 1]
-        if rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0:  # dD'/domega U_omega, exact
+        if rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0:  # dD'/dx U_x, exact (W' = 0)
             acc = 0.0
             for j in range(1, N):
                 acc += El[j] * (y0[N + j] - y0[N + j - 1]) * (U[N + j] - U[N + j - 1])
@@ -359,6 +365,11 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
             if rp[RP_CLAMP] != 0.0:
                 _, phid = FR.clamp_angle(t, par, tab)
                 bd -= 2.0 * El[N] * (phid - y0[n2 - 1]) * U[n2 - 1]
+            if dexact:  # D' = 2R - p: minus the drag power's gradient along U_x
+                acc = 0.0
+                for i in range(n2):
+                    acc += gq[i] * U[i]
+                bd -= acc
         elif rp[RP_QUAD] != 0.0:  # by one forward difference along U_x
             nu = 0.0
             ny = 0.0

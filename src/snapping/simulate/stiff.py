@@ -129,6 +129,7 @@ class _Stepper:
         self.nlu += 1
         U = []
         n = y.size
+        gq = None  # (the drag power's gradient at y, once per step)
         for i in range(6):
             if i == 0:
                 fi = f0
@@ -150,13 +151,18 @@ class _Stepper:
             Ui[N:2 * N] = Uom
             # W, D: (1/(gamma h)) U_q - dq'/dx U_x = b_q, the directional derivative by a difference
             bq = b[2 * N:]
-            if res.quad and not res.quad_fd:  # dD'/domega U_omega, exact
+            if res.quad and not res.quad_fd:  # dD'/dx U_x, exact (W' = 0)
                 El, om = res.El, y[N:2 * N]
                 bq = bq.copy()
                 bq[1] += 2.0 * float(np.dot(El[1:N] * (om[1:] - om[:-1]), Uom[1:] - Uom[:-1]))
                 if res.clamped:
                     _, phid = FR.clamp_angle(t, res.par, res.tab)
                     bq[1] -= 2.0 * El[N] * (phid - om[N - 1]) * Uom[N - 1]
+                if res.hasdrag:  # D' = 2R - p: the drag's power gradient along U_x
+                    if gq is None:
+                        gq = np.empty(2 * N)
+                        FR.drag_power_gradient(N, t, y, np.empty(N), np.empty(N), res.par, res.h, res.tab, gq)
+                    bq[1] -= float(np.dot(gq, Ui[:2 * N]))
             elif res.quad:
                 ux = Ui[:2 * N]
                 nu = np.sqrt(np.mean(ux * ux))

@@ -39,9 +39,10 @@ What the Jacobian leaves out. Air drag: the node velocities are sums over the ch
 banded; it is left out of ``J``. RODAS4 with an approximate Jacobian loses order (it is a
 Rosenbrock method, not a W-method), so with strong drag the step sizes grow; the results
 stay error-controlled. The work and dissipation components ``W, D`` (quadratures of the
-state) get their exact Jacobian rows in the stage direction: analytic when only bending
-damping acts on them (``D' = sum eta_i/l_i (omega_i - omega_{i-1})^2``, ``W' = 0``), else
-by one forward difference (one extra evaluation per stage: a moving pin or clamp, drag);
+state) get their exact Jacobian rows in the stage direction: analytic with a fixed held end
+and clamp (``W' = 0``, ``D' = sum eta_i/l_i (omega_i - omega_{i-1})^2 - p``, the drag's power
+``p`` by its exact O(N) gradient, :func:`snapping.simulate.forced.drag_power_gradient`), else
+by one forward difference (one extra evaluation per stage: a moving pin or clamp);
 the time derivative ``f_t`` by one forward difference per step for a moving pin or
 clamp.
 """
@@ -218,9 +219,10 @@ class Residual:
         self.autonomous = par[G.P_PIN] == G.PIN_FIXED and int(par[FR.P_CNK]) == 0
         # W, D have dynamics: work of a moving held end or clamp, dissipation by damping or drag
         self.quad = (not self.autonomous) or self.clamped or bool(np.any(self.El != 0.0)) or par[FR.P_HASDRAG] != 0.0
-        # their Jacobian rows: analytic when only damping acts on them (a fixed held end and
-        # clamp, no drag: W' = 0, D' = sum El_i (omega_i - omega_{i-1})^2), else a difference
-        self.quad_fd = self.quad and ((not self.autonomous) or par[FR.P_HASDRAG] != 0.0)
+        # their Jacobian rows: analytic with a fixed held end and clamp (W' = 0, D' = sum El_i
+        # (omega_i - omega_{i-1})^2 - p, the drag's power p by its exact gradient), else a difference
+        self.quad_fd = self.quad and not self.autonomous
+        self.hasdrag = par[FR.P_HASDRAG] != 0.0
         w = G.Work(N)
         self.c, self.s, self.S, self.cp, self.dp, self.sig = w.c, w.s, w.S, w.cp, w.dp, w.sig
         self.Z = np.zeros((7, N + 1))
