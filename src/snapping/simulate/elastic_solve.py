@@ -54,7 +54,7 @@ from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
-from .snap_window import snap_peaks
+from .snap_window import snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
@@ -558,6 +558,9 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
     snap = snap_peaks(times, rec[:, STEP_NAMES.index("v_max")],
                       {k: rec[:, STEP_NAMES.index(f"{k}_max")] for k in ("a", "sigma")}, ref, ref["v"][1])
     results.update(a_peak_snap=snap["a"], sigma_peak_snap=snap["sigma"], t_snap_end=snap["t_snap_end"])
+    taut = taut_peaks(times, rec[:, STEP_NAMES.index("v_max")], rec[:, STEP_NAMES.index("n_slack")],
+                      {"sigma": rec[:, STEP_NAMES.index("sigma_max")]}, ref, ref["v"][1])
+    results.update(sigma_peak_taut=taut["sigma"], t_taut_end=taut["t_taut_end"])
     cols = {k: rec[:, STEP_NAMES.index(k)] for k in ("sigma_max", "dt", "n_slack", "sigma_min")}
     ring, ok, note = EC.peak_guard(np.asarray(times), cols, wave_speed=line.wave_speed, length=float(np.sum(line.h)),
                                    start=start if initial is None else "initial", t_snap_sigma=ref["sigma"][1],
