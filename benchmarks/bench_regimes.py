@@ -61,7 +61,8 @@ STUDIES = {
     # {"chis": [0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8)[1:], "damping": 1.0, "start": "stretched"}
     # with the other settings as here
     "stretching": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 0.3, 8), "exact": True,
-                   "accuracy": "medium", "tol": 1e-6, "damping": 4.0, "start": "matched"},
+                   "accuracy": "medium", "tol": 1e-6, "damping": 4.0, "start": "matched",
+                   "escalate": 0.01, "extra_levels": 1},  # (branch stretch1pct: regimes_spec.STRETCH_ESCALATE, ..._EXTRA_LEVELS)
 }
 
 

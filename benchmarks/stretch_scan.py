@@ -8,6 +8,10 @@ method="rodas4-links")``: fold levels -1 ... 2 (the other mechanisms' 1% levels)
 (resumable: a rerun computes only the runs missing; its a_peak, sigma_peak are the runs' snap peaks,
 ``a_peak_snap``/``sigma_peak_snap``, since branch snappeaks: ``results/stretch_scan_snap.json``) and a JSON summary beside it (``.json``), with
 per-run CPU split by c, chi and level (what dominates) and the cells not converged / not within 1%.
+Since branch stretch1pct: escalated (``regimes(escalate=STRETCH_ESCALATE, extra_levels=STRETCH_EXTRA_LEVELS)``:
+a cell whose v, a or sigma bar is over 1% runs fold level 3 too, :mod:`snapping.regimes_escalate`), the taut
+snap's tension kept beside (``sigma_peak_taut``, ``regimes_spec.STRETCH_EXTRA_PEAKS``):
+``results/stretch_scan_esc.json``.
 
 Usage::
 
@@ -39,8 +43,16 @@ def report(ds, extra=None):
     out["cpu_by_c"] = {f"{c:.4g}": float(np.nansum(cpu[:, j])) for j, c in enumerate(cs)}
     out["cpu_by_chi"] = {f"{x:g}": float(np.nansum(cpu[i]) + np.nansum(icpu[i])) for i, x in enumerate(ds.chi.values)}
     out["cpu_by_level"] = {str(k): float(np.nansum(cpu[:, :, k]) + np.nansum(icpu[:, k])) for k in range(cpu.shape[2])}
+    for q in ("v_peak", "a_peak", "sigma_peak") + (("sigma_peak_taut",) if "sigma_peak_taut" in ds else ()):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
+        out[f"{q}_cells_within_1pct"] = int((rel <= 0.01).sum())
+        out[f"{q}_median_rel_error"] = float(np.nanmedian(rel))
     out["n_rhs"] = float(np.nansum(ds["n_rhs_level"].values) + np.nansum(ds["n_rhs_ideal_level"].values))
-    out["runs_missing"] = int(np.isnan(ds["v_peak_level"].values).sum() + np.isnan(ds["v_peak_ideal_level"].values).sum())
+    base = int(ds.attrs["levels"])
+    out["runs_missing"] = int(np.isnan(ds["v_peak_level"].values[:, :, :base]).sum()
+                              + np.isnan(ds["v_peak_ideal_level"].values[:, :base]).sum())
+    out["runs"] = int(np.isfinite(ds["v_peak_level"].values).sum() + np.isfinite(ds["v_peak_ideal_level"].values).sum())
     cells = []
     for i, x in enumerate(ds.chi.values):
         for j, c in enumerate(cs):
@@ -68,6 +80,7 @@ def main():
     ap.add_argument("--report", action="store_true", help="summarize the study file only")
     a = ap.parse_args()
     from snapping.regimes import load_study, regimes
+    from snapping.regimes_spec import STRETCH_ESCALATE, STRETCH_EXTRA_LEVELS
 
     js = os.path.splitext(a.out)[0] + ".json"
     if a.report:
@@ -85,7 +98,7 @@ def main():
     err = None
     try:
         ds = regimes("stretching", CHIS, NUMBERS, accuracy="medium", tol=a.tol, method="rodas4-links", out=a.out,
-                     progress=False)
+                     progress=False, escalate=STRETCH_ESCALATE, extra_levels=STRETCH_EXTRA_LEVELS)
     except RuntimeError as exc:  # some runs failed: the study file keeps the others
         err = str(exc)
         ds = load_study(a.out)

@@ -69,7 +69,7 @@ import xarray as xr
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
-                           STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_SNAP_PEAKS, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
+                           STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
 __all__ = ["regimes", "MECHANISMS", "ACCURACY", "load_study", "cell_problem", "cell_links", "eta_grid", "BEND_FLOOR", "bundled_study", "BUNDLED",
@@ -202,7 +202,8 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
                            f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
     row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
     if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
-        row.update({q: float(a[f"{q}_snap"]) for q in STRETCH_SNAP_PEAKS if f"{q}_snap" in a})
+        row.update({q: float(a[name]) for q, name in STRETCH_PEAK_ATTRS.items() if name in a})
+        row.update({q: float(a[name]) for q, name in STRETCH_EXTRA_PEAKS.items() if name in a})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -274,10 +275,15 @@ def bundled_study(mechanism: str) -> xr.Dataset:
         return load_study(str(p))
 
 
+def _extra(mechanism) -> tuple:
+    """The peaks a study of ``mechanism`` keeps beside QUANTITIES (stretching: STRETCH_EXTRA_PEAKS)."""
+    return tuple(STRETCH_EXTRA_PEAKS) if mechanism == "stretching" else ()
+
+
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
     nc, nn, nl = len(chis), len(numbers), len(levels)
     data = {}
-    for q in QUANTITIES + ("n_rhs", "cpu_time"):
+    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time"):
         data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
         data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
     data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
@@ -298,19 +304,20 @@ def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> x
 
 def _finish(ds: xr.Dataset) -> xr.Dataset:
     """The limits, error bars, orders and ratios of every cell whose levels are all done."""
+    from .regimes_escalate import extrapolate_prefix, pending, prefix
+
     nc, nn = ds.sizes["chi"], ds.sizes["number"]
-    for q in QUANTITIES:
+    base = int(ds.attrs["levels"])  # the levels every cell runs (more: an escalating study's, regimes_escalate)
+    for q in QUANTITIES + tuple(q for q in _extra(ds.attrs["mechanism"]) if f"{q}_level" in ds):
         lim, err, order = (np.full((nc, nn), np.nan) for _ in range(3))
         ilim, ierr = np.full(nc, np.nan), np.full(nc, np.nan)
         for i in range(nc):
-            row = ds[f"{q}_ideal_level"].values[i]
-            if np.all(np.isfinite(row)):
-                e = extrapolate(ds.resolution_ideal.values, row)
+            e = extrapolate_prefix(ds.resolution_ideal.values, ds[f"{q}_ideal_level"].values[i], base)
+            if e is not None:
                 ilim[i], ierr[i] = e["limit"], e["error"]
             for j in range(nn):
-                row = ds[f"{q}_level"].values[i, j]
-                if np.all(np.isfinite(row)):
-                    e = extrapolate(ds.resolution.values, row)
+                e = extrapolate_prefix(ds.resolution.values, ds[f"{q}_level"].values[i, j], base)
+                if e is not None:
                     lim[i, j], err[i, j], order[i, j] = e["limit"], e["error"], e["order"]
         ds[q] = (("chi", "number"), lim, {"long_name": f"continuum limit of {q}"})
         ds[f"{q}_error"] = (("chi", "number"), err, {"long_name": f"error bar of {q}"})
@@ -322,7 +329,14 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
         ds[f"{q}_ratio_error"] = (("chi", "number"),
                                   np.abs(r) * np.hypot(err / lim, (ierr / ilim)[:, None]))
     _mark(ds)
-    done = np.isfinite(ds["v_peak_level"].values).all() and np.isfinite(ds["v_peak_ideal_level"].values).all()
+    done = (np.isfinite(ds["v_peak_level"].values[:, :, :base]).all()
+            and np.isfinite(ds["v_peak_ideal_level"].values[:, :base]).all())
+    if ds.sizes["level"] > base:  # an escalating study: the levels each cell ran, and whether any is owed
+        ds["levels_run"] = (("chi", "number"), np.array([[prefix(r) for r in rows] for rows in ds["v_peak_level"].values],
+                                                        dtype=np.int8),
+                            {"long_name": "levels the cell ran (the base, plus those its error bars asked for)"})
+        ds["levels_run_ideal"] = ("chi", np.array([prefix(r) for r in ds["v_peak_ideal_level"].values], dtype=np.int8))
+        done = done and not pending(ds, float(ds.attrs["escalate"]), base)
     ds.attrs["status"] = "complete" if done else "partial"
     return ds
 
@@ -330,7 +344,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
             first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
             damping: float | None = None, start: str = STRETCH_START, method: str | None = None, workers: int = 1, scheduler=None, out=None,
-            progress: bool = True) -> xr.Dataset:
+            progress: bool = True, escalate: float | None = None, extra_levels: int | None = None) -> xr.Dataset:
     """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
 
     Parameters
@@ -371,6 +385,10 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         The study file (netCDF), rewritten after each run; reused when it holds this study.
     progress : bool
         A progress bar (runs done).
+    escalate : float, optional
+        A cell whose v_peak, a_peak or sigma_peak error bar is above this fraction of its limit runs
+        one more level, up to ``extra_levels`` (default 1) more (:mod:`snapping.regimes_escalate`; the
+        ideal at that chi too). Both are in the study's key. None (the default): every cell runs ``levels``.
 
     Returns
     -------
@@ -418,7 +436,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         if not isinstance(method, str) or method not in STRETCH_METHODS:
             raise V.SnappingInputError(f"method={method!r} is not one of {STRETCH_METHODS} (a stretching study's "
                                        f"elastic methods)")
-        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR, peaks="snap")
+        acc.update(elastic_method=method, stop_floor=STRETCH_STOP_FLOOR, peaks=STRETCH_PEAKS_KEY)
         if method == "rodas4-links":  # its tip links floored (regimes_spec.stretch_tip_floor)
             acc["tip_time"] = STRETCH_TIP_TIME
         if start != "stretched":  # (the stop-29 study's key, run from "stretched", had no start)
@@ -427,6 +445,11 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     elif method is not None:
         raise V.SnappingInputError(f"method={method!r}: the elastic method is for the stretching mechanism only, "
                                    f"not {mechanism!r}")
+    if escalate is not None:
+        acc["escalate"] = V.open_interval("escalate", escalate, 0.0, 1.0)
+        acc["extra_levels"] = V.integer("extra_levels", 1 if extra_levels is None else extra_levels, 1, 4)
+    elif extra_levels is not None:
+        raise V.SnappingInputError(f"extra_levels={extra_levels!r}: give it with escalate (the error bar that asks for them)")
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
@@ -435,8 +458,9 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         raise V.SnappingInputError(f"chis={chis!r}: give one or more distinct values")
     numbers = _numbers(numbers)
     grading = MECHANISMS[mechanism][1]
-    levels_p = _levels(grading, acc, ratio)
-    ideal_p = _levels("fold", acc, ratio)
+    all_levels = dict(acc, levels=acc["levels"] + acc.get("extra_levels", 0))
+    levels_p = _levels(grading, all_levels, ratio)
+    ideal_p = _levels("fold", all_levels, ratio)
     key = _study_key(mechanism, chis, numbers, acc, ratio)
     ds = _empty(mechanism, chis, numbers, levels_p, ideal_p, key, acc, ratio)
     lock = None
@@ -461,7 +485,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     # the runs still to do: (chi index, number index or None for the ideal, level index)
     todo = []
     for i, chi in enumerate(chis):
-        for k in range(len(levels_p)):
+        for k in range(acc["levels"]):  # the base levels (an escalating study's further ones: below)
             if not np.isfinite(ds["v_peak_ideal_level"].values[i, k]):
                 todo.append((i, None, k))
             for j in range(len(numbers)):
@@ -476,17 +500,21 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
 
     todo.sort(key=lambda t: (t[2], prev_cost(t), t[0], -1 if t[1] is None else t[1]))  # coarse levels first
     calls = {}
-    for t in todo:
-        i, j, k = t
-        if j is None:
-            calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
-        else:
-            calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start,
-                        acc.get("elastic_method", STRETCH_METHOD))
+
+    def add_calls(runs):
+        for t in runs:
+            i, j, k = t
+            if j is None:
+                calls[t] = (chis[i], None, 0.0, ideal_p[k], acc["tol"])
+            else:
+                calls[t] = (chis[i], mechanism, numbers[j], levels_p[k], acc["tol"], damping, start,
+                            acc.get("elastic_method", STRETCH_METHOD))
+
+    add_calls(todo)
     for args in calls.values():  # every run's problem is checked before any starts
         cell_problem(*args[:4], damping=damping, method=args[7] if len(args) > 7 else None)
 
-    bar = tqdm(total=len(ds.chi) * (len(numbers) + 1) * len(levels_p), initial=0, desc=f"regimes {mechanism}",
+    bar = tqdm(total=len(ds.chi) * (len(numbers) + 1) * acc["levels"], initial=0, desc=f"regimes {mechanism}",
                unit="run", disable=not progress)
     bar.update(bar.total - len(todo))
     failures = []
@@ -506,8 +534,12 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             bar.update(1)
             return
         i, j, k = t
+        if j is None:  # the ideal chain (inextensible: never slack): its taut snap's tension is its run's
+            row = {**row, **{q: row["sigma_peak"] for q in _extra(mechanism)}}
         for q, v in row.items():
             name = f"{q}_ideal_level" if j is None else f"{q}_level"
+            if name not in ds:  # (a study file from before the name: its earlier runs have none)
+                continue
             if j is None:
                 ds[name].values[i, k] = v
             else:
@@ -515,36 +547,49 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         save()
         bar.update(1)
 
+    def execute(todo):
+        if scheduler is not None and todo:
+            from dask.distributed import as_completed as dask_completed
+
+            from .sweep_run import _client_for
+
+            client, owned = _client_for(scheduler)
+            futures = {}
+            try:
+                futures = {client.submit(_run_task, *calls[t], pure=False): t for t in todo}
+                for fut in dask_completed(futures):
+                    collect(futures[fut], fut.result)
+            except BaseException:
+                client.cancel(list(futures))
+                raise
+            finally:
+                if owned:
+                    client.close()
+        elif workers > 1 and len(todo) > 1:
+            from . import _workers
+
+            order = list(todo)
+            _workers.run_all(min(workers, len(todo)), _run_task, [calls[t] for t in order],
+                             lambda args, res: collect(order[[calls[t] for t in order].index(args)], res))
+        else:
+            for t in todo:
+                collect(t, lambda t=t: _run_task(*calls[t]))
+
     import contextlib
 
     with lock if lock is not None else contextlib.nullcontext():
         try:
-            if scheduler is not None and todo:
-                from dask.distributed import as_completed as dask_completed
+            execute(todo)
+            while "escalate" in acc:  # the cells over the target run their next level, round by round
+                from .regimes_escalate import pending
 
-                from .sweep_run import _client_for
-
-                client, owned = _client_for(scheduler)
-                futures = {}
-                try:
-                    futures = {client.submit(_run_task, *calls[t], pure=False): t for t in todo}
-                    for fut in dask_completed(futures):
-                        collect(futures[fut], fut.result)
-                except BaseException:
-                    client.cancel(list(futures))
-                    raise
-                finally:
-                    if owned:
-                        client.close()
-            elif workers > 1 and len(todo) > 1:
-                from . import _workers
-
-                order = list(todo)
-                _workers.run_all(min(workers, len(todo)), _run_task, [calls[t] for t in order],
-                                 lambda args, res: collect(order[[calls[t] for t in order].index(args)], res))
-            else:
-                for t in todo:
-                    collect(t, lambda t=t: _run_task(*calls[t]))
+                more = pending(ds, acc["escalate"], acc["levels"])
+                if not more:
+                    break
+                add_calls(more)
+                bar.total += len(more)
+                bar.refresh()
+                execute(more)
         finally:
             bar.close()
         ds = _finish(ds)

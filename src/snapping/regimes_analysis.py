@@ -291,6 +291,13 @@ def report(ds, quantities=("v_peak", "a_peak", "sigma_peak")) -> list[str]:
     if ds.attrs.get("peaks") == "snap":
         lines.append("a_peak, sigma_peak of the cells: the snap's (each run's a_peak_snap, sigma_peak_snap: up to v_max "
                      "below 0.9 of its peak after it, snapping.simulate.snap_window), not the run's")
+    elif ds.attrs.get("peaks") == "snap-taut":
+        lines.append("a_peak of the cells: the snap's (each run's a_peak_snap: up to v_max below 0.9 of its peak after "
+                     "it); sigma_peak: the taut snap's (sigma_peak_taut: until the line first goes slack after the "
+                     "speed peak; snapping.simulate.snap_window), not the run's")
+    if ds.sizes["level"] > int(ds.attrs.get("levels", ds.sizes["level"])):
+        lines.append(f"escalated: a cell whose v, a or sigma bar exceeds {ds.attrs['escalate']:g} of its limit runs up "
+                     f"to {ds.attrs['extra_levels']} more level(s) (levels_run; snapping.regimes_escalate)")
     for q in quantities:
         lines.append(f"{q}: limit +- error (ratio to the ideal)")
         lines.append(f"{'chi':>6} {'ideal':>18} " + " ".join(f"{name + '=' + format(n, 'g'):>28}"
@@ -390,8 +397,11 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
     """
     from .continuum import extrapolate
 
+    from .regimes_escalate import prefix
+
     nums = ds.number.values
     res = ds.resolution.values
+    base = int(ds.attrs.get("levels", res.size))
     out = {"chi": {}}
     pts = []
     for chi in ds.chi.values:
@@ -399,8 +409,9 @@ def level_ratios(ds, quantity: str = "v_peak") -> dict:
         lv = c[f"{quantity}_level"].values / c[f"{quantity}_ideal_level"].values[None, :]
         r, e, o = (np.full(nums.size, np.nan) for _ in range(3))
         for j in range(nums.size):
-            if np.all(np.isfinite(lv[j])):
-                x = extrapolate(res, lv[j])
+            n = prefix(lv[j])  # the levels both ran (an escalated study's cells: more than the base, regimes_escalate)
+            if n >= base:
+                x = extrapolate(res[:n], lv[j][:n])
                 # else a failed extrapolation (an order near 0, a correction of the ratio's own size): left out
                 if 0.0 < x["limit"] < 2.0 and abs(x["error"]) <= RATIO_MAX_ERROR * x["limit"]:
                     r[j], e[j], o[j] = x["limit"], x["error"], x["order"]

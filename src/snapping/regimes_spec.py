@@ -9,7 +9,7 @@ from __future__ import annotations
 __all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_METHODS", "STRETCH_STOP_FLOOR", "STRETCH_START",
            "STRETCH_DAMPING", "STRETCH_MAX_RHS",
            "STRETCH_TOL_C", "stretch_tol", "STRETCH_TIP_TIME", "STRETCH_MAX_RHS_LINKS", "stretch_tip_floor",
-           "STRETCH_SNAP_PEAKS"]
+           "STRETCH_SNAP_PEAKS", "STRETCH_PEAK_ATTRS", "STRETCH_PEAKS_KEY", "STRETCH_EXTRA_PEAKS", "STRETCH_ESCALATE", "STRETCH_EXTRA_LEVELS"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -135,3 +135,23 @@ def stretch_tip_floor(c: float, method: str) -> float:
 #: ``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`); the study's key
 #: says ``"peaks": "snap"`` (a file of the run's peaks is not resumed)
 STRETCH_SNAP_PEAKS = ("a_peak", "sigma_peak")
+
+#: stretching (branch stretch1pct): the run attribute each of the study's peaks is taken from: the
+#: acceleration and the tension over the snap (0.9 window, :data:`STRETCH_SNAP_PEAKS`)
+STRETCH_PEAK_ATTRS = {"a_peak": "a_peak_snap", "sigma_peak": "sigma_peak_snap"}
+#: the study key's ``"peaks"`` for :data:`STRETCH_PEAK_ATTRS`
+STRETCH_PEAKS_KEY = "snap"
+#: stretching: further peaks a study keeps beside :data:`snapping.continuum.QUANTITIES` (levels, limit,
+#: error, order, ratio), from the run attribute named: the tension over the taut snap (until the line
+#: first goes slack after the speed peak, :func:`snapping.simulate.snap_window.taut_end`). Measured, not
+#: the study's sigma_peak: in soft lines it is a turning point after the 0.9 window and before any slack
+#: link, but it grows with the fold levels by a near-constant step (chi 0.1, c 7.53: 27.75, 28.87, 29.97),
+#: so it has no continuum limit on these levels (docs/guide/regimes.md "The taut snap's tension").
+#: The ideal chain's (inextensible: never slack) is its run's sigma_peak
+STRETCH_EXTRA_PEAKS = {"sigma_peak_taut": "sigma_peak_taut"}
+
+#: stretching, the shipped scan (``benchmarks/stretch_scan.py``): a cell (or the ideal at a chi) whose
+#: v_peak, a_peak or sigma_peak error bar exceeds this fraction of its limit runs one more level
+#: (``regimes(escalate=)``, :mod:`snapping.regimes_escalate`), up to :data:`STRETCH_EXTRA_LEVELS` more
+STRETCH_ESCALATE = 0.01
+STRETCH_EXTRA_LEVELS = 1

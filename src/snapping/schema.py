@@ -261,6 +261,11 @@ ELASTIC_RESULT_ATTRS: dict[str, str] = {
     "sigma_peak_snap": ("peak of the maximum tension over the snap (as a_peak_snap): excludes the slack fold and "
                         "recoil after the snap, which the run's sigma_peak may hold"),
     "t_snap_end": "end of the snap's window: the first recorded step after the speed peak with v_max < 0.9 v_peak",
+    "sigma_peak_taut": ("peak of the maximum tension over the taut snap: from the start until the line first goes "
+                        "slack after the speed peak, never before t_snap_end (t_taut_end); sigma_peak itself where it "
+                        "lies in that window, else the largest recorded step (snapping.simulate.snap_window)"),
+    "t_taut_end": ("end of the taut snap's window: the first recorded step at or after the speed peak with a slack "
+                   "link (the run's last step if none), at least t_snap_end"),
     "n_slack_steps": "number of recorded steps with a slack link",
     "dissipated_total": "energy dissipated by the axial damping over the run",
     "wave_speed": "smallest longitudinal wave speed sqrt(EA/lambda) of the links",

@@ -159,6 +159,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
+    args._argv = list(sys.argv[1:] if argv is None else argv)  # (an interrupted run's resume command repeats it)
     import warnings
 
     restore = _on_sigterm_raise()
@@ -232,11 +233,16 @@ def _outside_run(args) -> str:
     import os
 
     out = getattr(args, "output", None)
-    if getattr(args, "_elastic_running", False):  # (the extensible line's solve: no checkpoint, no resume)
+    if getattr(args, "_elastic_running", False):  # (the extensible line's solve, outside its checkpointed loop)
         kept = (f"{out} is unchanged" if out and os.path.exists(out) else
                 f"nothing was written{f' ({out} does not exist)' if out else ''}")
-        return (f"during the extensible line's run, which keeps no checkpoint and cannot be resumed: {kept}; "
-                f"run the command again")
+        ck = getattr(args, "checkpoint", None) or (args.resume if isinstance(args.resume, str) else None)
+        if ck is None:
+            return (f"during the extensible line's run, which keeps no checkpoint (no --checkpoint FILE) and cannot "
+                    f"be resumed: {kept}; run the command again")
+        had = (f"its checkpoint {ck} is kept as last saved: add --resume to the command to continue it"
+               if os.path.exists(ck) else f"no checkpoint was saved ({ck} does not exist): run the command again")
+        return f"during the extensible line's run, outside its step loop (where its checkpoint is saved): {kept}; {had}"
     if args.command == "simulate" and out and not os.path.exists(out):
         return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
     return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"

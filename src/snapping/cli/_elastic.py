@@ -11,8 +11,7 @@ import math
 #: the dests of the elastic options (any of them given: the elastic model)
 ELASTIC_DESTS = ("ea", "stretching", "axial_damping_si", "axial_damping", "grid_damping", "strain_table")
 #: simulate options the elastic model does not take (dest: why)
-NOT_ELASTIC = {"resume": "--resume (it continues a rigid-link checkpoint)",
-               "record_thin": "--record-thin (it thins the rigid-link record)",
+NOT_ELASTIC = {"record_thin": "--record-thin (it thins the rigid-link record)",
                "dt0": "--dt0 (it sets the rigid-link methods' first step)",
                "max_link_error": "--max-link-error (it checks rigid links)", "chords": "--chords",
                "max_energy_drift": "--max-energy-drift", "dt_min": "--dt-min", "max_rejections": "--max-rejections",
@@ -184,20 +183,124 @@ def elastic_start(args) -> str:
     return getattr(args, "elastic_start", None) or "stretched"
 
 
+#: the options of the stored inputs of an extensible-line checkpoint (elastic_checkpoint.read's keys)
+MISMATCH_OPTIONS = {"N": "--N", "method": "--method", "tol": "--tol", "t_end": "--t-end",
+                    "stop_fraction": "--stop-fraction", "snapshot_times": "--snapshot-times",
+                    "start": "--elastic-start", "initial": "the start (--chi/--supports/--shape, --elastic-start)",
+                    "elastic": "--ea/--stretching/--strain-table/--damping/--axial-damping/--grid-damping",
+                    "problem": "the problem (--chi/--supports/--shape, --tip-mass, --taper, --pin-motion, "
+                               "--gravity, ...)", "chi": "--chi", "tip_mass": "--tip-mass", "gravity": "--gravity",
+                    "pin_motion": "--pin-motion"}
+
+
+def check_rigid_checkpoint(args) -> None:
+    """--checkpoint, and --resume without its file, are the extensible line's: refused for the
+    rigid chain (whose run is checkpointed to its -o file and resumed by --resume RUN.nc)."""
+    from .._validate import SnappingInputError
+
+    if getattr(args, "checkpoint", None) is not None:
+        raise SnappingInputError(f"--checkpoint {args.checkpoint} is the extensible line's (--ea/--stretching/"
+                                 f"--strain-table): the rigid chain's run is checkpointed to its -o RUN.nc file "
+                                 f"(every --checkpoint-every seconds) and continued by --resume RUN.nc")
+    if args.resume is True:
+        raise SnappingInputError("--resume needs the run file to continue, --resume RUN.nc (without a file it "
+                                 "continues the extensible line's --checkpoint FILE)")
+
+
+def _checkpoint_paths(args, method: str):
+    """(checkpoint, resume, checkpoint_every) of the options for :func:`solve`, checked: only
+    rodas4 and rodas4-links keep checkpoints; --resume alone continues --checkpoint's file;
+    --checkpoint-every needs a checkpoint; neither file is -o."""
+    import os
+
+    from .._validate import SnappingInputError
+    from ..simulate import elastic_checkpoint as ECK
+
+    ck, res = getattr(args, "checkpoint", None), args.resume
+    from .._files import netcdf_suffix
+
+    for o, v in (("--checkpoint", ck), ("--resume", res)):
+        if isinstance(v, str):  # (a checkpoint is a netCDF4 run file: never under a name that says another format)
+            netcdf_suffix(v, name=o)
+    given = [(o, v) for o, v in (("--checkpoint", ck), ("--resume", res)) if v is not None]
+    if given and method not in ECK.METHODS:
+        o, v = given[0]
+        shown = o if v is True else f"{o} {v}"
+        raise SnappingInputError(f"{shown} with --method {args.method} (the extensible line's {method}): only "
+                                 f"--method rodas4 (or stiff) and rodas4-links keep checkpoints")
+    if res is True:
+        if ck is None:
+            raise SnappingInputError("--resume without a file continues the extensible line's --checkpoint FILE: "
+                                     "give --checkpoint FILE (or --resume FILE)")
+        res = ck
+    if ck is None and res is None:
+        if "checkpoint_every" in getattr(args, "_explicit", ()):
+            raise SnappingInputError(f"--checkpoint-every {args.checkpoint_every} needs --checkpoint FILE (the "
+                                     f"extensible line's checkpoint; its run file -o is written when it ends)")
+        return None, None, None
+    if args.output is not None:
+        for o, v in (("--checkpoint", ck), ("--resume", res)):
+            if v is not None and os.path.realpath(v) == os.path.realpath(args.output):
+                raise SnappingInputError(f"{o} {v} and -o {args.output} name the same file: the checkpoint and the "
+                                         f"finished run are kept apart; choose another -o or --checkpoint path")
+    return ck, res, args.checkpoint_every
+
+
+def resume_command(args, path) -> str:
+    """The command that continues this interrupted run: the one given, its --checkpoint and
+    --resume replaced by ``--checkpoint PATH --resume``."""
+    import shlex
+
+    argv, out, i = list(getattr(args, "_argv", None) or []), [], 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--checkpoint", "--resume"):
+            takes = a == "--checkpoint" or (i + 1 < len(argv) and not argv[i + 1].startswith("-"))
+            i += 2 if takes else 1
+            continue
+        if a.startswith(("--checkpoint=", "--resume=")):
+            i += 1
+            continue
+        out.append(a)
+        i += 1
+    return "snapping " + shlex.join(out + ["--checkpoint", str(path), "--resume"])
+
+
+def mismatch_words(exc, args) -> str:
+    """A refused checkpoint's message in the command line's words: the options that differ."""
+    opt = MISMATCH_OPTIONS.get(exc.key, exc.key)
+    return (f"{opt} contradicts the checkpoint {exc.path!r}: its run has {exc.key}={exc.stored!r}, this command "
+            f"{exc.key}={exc.given!r}; a resumed run continues the stored run: give the interrupted run's options, "
+            f"or another --checkpoint path to start a new run")
+
+
 def run_elastic(args, problem, elastic, times):
-    """Solve, write -o, and return (summary, dataset)."""
+    """Solve (with --checkpoint: checkpointed, or continued with --resume), write -o, and return
+    (summary, dataset). -o is checked before the run and locked while it lasts."""
+    import contextlib
+
     from .. import _files
+    from .._validate import SnappingInputError
+    from ..simulate import elastic_checkpoint as ECK
     from ..simulate.elastic import solve
 
+    method = ELASTIC_METHOD.get(args.method, "radau")
+    ck, res, every = _checkpoint_paths(args, method)
     out = None
     if args.output is not None:
         out = _files.check_output(args.output, overwrite=args.overwrite)
-    args._elastic_running = True  # (an interruption now is inside a run that keeps no checkpoint: main says so)
-    r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
-              method=ELASTIC_METHOD.get(args.method, "radau"), stop_fraction=args.stop_fraction,
-              snapshot_times=times, start=elastic_start(args),
-              progress=False if getattr(args, "no_progress", False) else None)
-    if out is not None:
-        ds = r.dataset
-        _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
+    args._elastic_running = True  # (an interruption outside solve's loop: main says what was kept)
+    with _files.locked(out) if out is not None else contextlib.nullcontext():
+        if out is not None:
+            _files.check_output(out, overwrite=args.overwrite)  # (again, under the lock)
+        try:
+            r = solve(problem, elastic, t_end=args.t_end, tol=1e-6 if args.tol is None else args.tol,
+                      method=method, stop_fraction=args.stop_fraction, snapshot_times=times,
+                      start=elastic_start(args), checkpoint=ck, resume=res, checkpoint_every=every,
+                      progress=False if getattr(args, "no_progress", False) else None)
+        except ECK.CheckpointMismatch as exc:
+            raise SnappingInputError(mismatch_words(exc, args)) from None
+        if out is not None:
+            ds = r.dataset
+            _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
     return r.summary(), r.dataset

@@ -68,6 +68,8 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.25 --N 60 --stretching 30 --grid-damping 1  # c = 30 sqrt(gL)\n"
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --ea 900 --damping 2  # SI: N, N s\n"
             "  snapping simulate --chi 0.25 --N 60 --length 2 --mass 0.5 --strain-table rope.csv -o run.nc\n"
+            "  snapping simulate --chi 0.25 --N 60 --stretching 30 --method rodas4 --checkpoint ck.nc -o run.nc\n"
+            "  snapping simulate --chi 0.25 --N 60 --stretching 30 --method rodas4 --checkpoint ck.nc -o run.nc --resume\n"
             "\n"
             "in space (snapping.spatial; --dims 3, implied by --perturb and --whirl):\n"
             "  snapping simulate --dims 3 --chi 0.25 --N 200 -o run3d.nc   # a planar start, run in 3D\n"
@@ -78,8 +80,12 @@ def _add_simulate(sub) -> None:
             "With -o the run is checkpointed to its file every --checkpoint-every seconds; Ctrl-C\n"
             "(SIGINT) or SIGTERM stops it at a step boundary, saves it and prints the command that\n"
             "resumes it (exit status 130 or 143). A resumed run gives the same file, bit for bit.\n"
-            "The extensible line's run (--ea/--stretching/--strain-table) keeps no checkpoint: it\n"
-            "writes -o when it ends, and an interrupted one writes nothing (exit status 130 or 143).\n"
+            "The extensible line's run (--ea/--stretching/--strain-table) writes -o when it ends;\n"
+            "with --method rodas4 or rodas4-links and --checkpoint FILE.nc it keeps a checkpoint there\n"
+            "(every --checkpoint-every seconds, and on Ctrl-C or SIGTERM, exit status 130 or 143), which\n"
+            "the same command with --resume added continues, bit for bit; without --checkpoint an\n"
+            "interrupted one writes nothing. A checkpoint is never replaced by another run, and one of\n"
+            "other options is refused, naming the option that differs.\n"
             "\n"
             "Output files: -o must be a new path or, with --overwrite, an existing regular file (a\n"
             "device, FIFO or directory is never replaced; a symbolic link is written through, to its\n"
@@ -134,10 +140,15 @@ def _add_simulate(sub) -> None:
     p.add_argument("-o", "--output", default=None,
                    help="write the run to this netCDF4 file: .nc, .nc4 or .netcdf (a new path, or --overwrite)")
     p.add_argument("--overwrite", action="store_true", help="replace an existing -o file (default: refuse it)")
-    p.add_argument("--resume", metavar="RUN.nc", default=None,
-                   help="continue the interrupted or checkpointed run in this file (written back to it, or to -o)")
+    p.add_argument("--resume", metavar="RUN.nc", default=None, nargs="?", const=True,
+                   help="continue the interrupted or checkpointed run in this file (written back to it, or to -o); "
+                        "the extensible line: its --checkpoint file (the same command, with --resume added)")
     p.add_argument("--checkpoint-every", type=float, default=300.0, metavar="SECONDS",
-                   help="with -o: save the run's full state every this many seconds (default 300; 0: very often)")
+                   help="with -o (the extensible line: with --checkpoint): save the run's full state every this "
+                        "many seconds (default 300; 0: very often)")
+    p.add_argument("--checkpoint", metavar="FILE.nc", default=None,
+                   help="the extensible line (--method rodas4 or rodas4-links): keep its checkpoint in this new file "
+                        "(saved on Ctrl-C/SIGTERM and every --checkpoint-every seconds; -o gets the finished run)")
     p.add_argument("--max-link-error", type=float, default=1e-2,
                    help="fail when a link length is off 1/N by more than this fraction (default 1e-2)")
     p.add_argument("--max-energy-drift", type=float, default=None,
@@ -167,15 +178,20 @@ def _cmd_simulate(args) -> int:
         times = [float(v) for v in args.snapshot_times.split(",") if v.strip()]
     except ValueError:
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} is not a comma-separated list of times")
-    if times and args.output is None and args.resume is None:  # snapshots are profiles: only a run file holds them
+    from ._elastic import is_elastic
+
+    rigid_resume = args.resume is not None and not is_elastic(args)  # (its run file holds the snapshots)
+    if times and args.output is None and not rigid_resume:  # snapshots are profiles: only a run file holds them
         from ..simulate.options import _times
 
         _times(times)  # a bad time is named first
         raise SnappingInputError(f"--snapshot-times={args.snapshot_times!r} without -o RUN.nc: the snapshots are "
                                  f"profiles kept only in the run file; add -o RUN.nc (or leave out --snapshot-times)")
-    from ._elastic import elastic_from_args
+    from ._elastic import check_rigid_checkpoint, elastic_from_args
 
     elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
+    if elastic is None:
+        check_rigid_checkpoint(args)
     if elastic is None and args.method == "rodas4-links":
         raise SnappingInputError("--method rodas4-links steps the extensible line only: give --ea, --stretching or "
                                  "--strain-table (the rigid chain's methods: fast, dop853, rodas4, stiff, "
@@ -186,10 +202,13 @@ def _cmd_simulate(args) -> int:
         return cmd_simulate3d(args, times, scales)
     progress = False if args.no_progress else None
     start_given = args.chi is not None or args.supports is not None or args.shape is not None
+    if elastic is not None and (not start_given or args.N is None):  # (a resumed one: checked against them)
+        raise SnappingInputError("the arguments --chi (or --supports/--shape) and --N are required by the extensible "
+                                 "line's run, also with --resume (its checkpoint is checked against them)")
     if args.resume is None and (not start_given or args.N is None):
         raise SnappingInputError("the arguments --chi (or --supports/--shape) and --N are required (or --resume RUN.nc)")
     problem = None
-    if args.resume is None:
+    if args.resume is None or elastic is not None:
         from ..simulate.problem import from_options
 
         taper = None if args.taper is None else _numbers("--taper", args.taper.replace(":", ","), 1, 2)
@@ -295,7 +314,16 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
     from .. import units
     from ._elastic import run_elastic
 
-    summary, ds = run_elastic(args, problem, elastic, times)
+    from ..simulate.errors import RunInterrupted
+
+    try:
+        summary, ds = run_elastic(args, problem, elastic, times)
+    except RunInterrupted as exc:  # (saved in its --checkpoint file: the same words as the rigid chain's)
+        from ._elastic import resume_command
+
+        print(f"snapping simulate: {exc.args[0].split(';')[0]}; resume with: {resume_command(args, exc.path)}",
+              file=sys.stderr)
+        return exc.exit_status
     if args.output:
         summary["output"] = args.output
     numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass)

@@ -9,20 +9,74 @@ and the snapshots' states as ``ckpt_`` variables (:data:`snapping.schema.ELASTIC
 sealed with the rigid runs' integrity digest (:func:`snapping.simulate.dataset.seal`; read back
 through :func:`snapping.simulate.dataset.verify_digest`). The inputs the run's numbers depend on
 are stored as JSON (``checkpoint_inputs``); resuming needs the same problem and elastic objects
-and options, and refuses others by name.
+and options, and refuses others by name (:class:`CheckpointMismatch`).
+
+The checkpoint a run writes, and the file it resumes, are locked while the run lasts
+(:func:`held`: :func:`snapping._files.locked`, the rigid runs' lock): a second process
+resuming or writing the same file is refused, naming the holder's PID. :class:`Poller` is
+what the run does between returns of its compiled loop: a due checkpoint, or a noted signal
+(saved, then :class:`~snapping.simulate.errors.RunInterrupted`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import time
 
 import numpy as np
 
+from .. import _files
 from .. import _validate as V
-from .dataset import save, seal, verify_digest
+from .dataset import check_writable, save, seal, verify_digest
+from .elastic_dataset import dataset as _dataset
+from .errors import RunInterrupted
 from ._netcdf import open_netcdf
 
-__all__ = ["VERSION", "PREFIX", "write", "read", "state_vars"]
+__all__ = ["VERSION", "PREFIX", "METHODS", "write", "read", "state_vars", "check_paths", "held", "Poller",
+           "CheckpointMismatch", "Signals"]
+
+#: the elastic methods that keep checkpoints (their compiled loops)
+METHODS = ("rodas4", "rodas4-links")
+
+
+class CheckpointMismatch(V.SnappingInputError):
+    """A resumed checkpoint whose stored input ``key`` (``stored``) differs from the call's (``given``)."""
+
+    def __init__(self, message: str, key: str, stored, given, path: str):
+        super().__init__(message)
+        self.key, self.stored, self.given, self.path = key, stored, given, path
+
+
+def check_paths(checkpoint, resume):
+    """The checkpoint to write (a symbolic link's target) and the file to resume, checked: the
+    resumed file exists; the checkpoint is a new path or the resumed file itself (a checkpoint
+    is never replaced by another run: SnappingInputError naming it). Returns (checkpoint, resume)."""
+    if resume is not None:
+        resume = _files.check_input(resume, name="resume")
+    if checkpoint is None:
+        return None, resume
+    own = resume is not None and os.path.realpath(os.fspath(checkpoint)) == os.path.realpath(resume)
+    p = check_writable(checkpoint, name="checkpoint", overwrite=True)
+    if not own and os.path.exists(p):
+        raise V.SnappingInputError(f"checkpoint={str(checkpoint)!r} already exists: a checkpoint is never replaced by "
+                                   f"another run; pass resume={str(checkpoint)!r} to continue the run it holds, or "
+                                   f"choose another path")
+    return p, resume
+
+
+@contextlib.contextmanager
+def held(checkpoint, resume):
+    """Hold the locks of ``checkpoint`` and of ``resume`` (either may be None) while a run writes
+    and continues them, and check the paths again under them (another process may have made the
+    checkpoint since). A file another process holds: :class:`snapping._files.OutputBusyError`."""
+    with contextlib.ExitStack() as stack:
+        for p, name in ((checkpoint, "checkpoint"), (resume, "resume")):
+            if p is not None:
+                stack.enter_context(_files.locked(p, name=name))
+        check_paths(checkpoint, resume)
+        yield
 
 #: layout version of the ``ckpt_`` variables
 VERSION = 1
@@ -78,9 +132,9 @@ def read(path, key: dict, names) -> dict:
     given = json.loads(json.dumps(key, sort_keys=True))
     for k in sorted(set(stored) | set(given)):
         if stored.get(k) != given.get(k):
-            raise V.SnappingInputError(f"{what}: the run stored there has {k}={stored.get(k)!r}, this call "
-                                       f"{k}={given.get(k)!r}: a resumed run continues the stored run with the same "
-                                       f"problem, elastic and options")
+            raise CheckpointMismatch(f"{what}: the run stored there has {k}={stored.get(k)!r}, this call "
+                                     f"{k}={given.get(k)!r}: a resumed run continues the stored run with the same "
+                                     f"problem, elastic and options", k, stored.get(k), given.get(k), str(path))
     missing = [PREFIX + k for k in names if PREFIX + k not in ds.variables]
     if missing:
         raise V.SnappingInputError(f"{what} is not a complete checkpoint: missing {missing[:5]}")
@@ -134,6 +188,52 @@ class Signals:
         for sig, h in self.handlers.items():
             signal.signal(sig, h)
         return False
+
+
+class Poller:
+    """``poll(run, chunks)`` of a checkpointed run's compiled loop (:func:`elastic_solve._run_rodas`),
+    called after each of its returns at a step boundary: saves a checkpoint (status 'checkpoint')
+    when ``every`` seconds of wall time have passed since the last (None: never), or, once
+    ``sigs`` (:class:`Signals`) noted a signal, saves the run so far (status 'interrupted') and
+    raises :class:`RunInterrupted`.
+
+    ``rows``, ``times`` (the record before this session's chunks), the snapshot lists, the
+    running peak's ``peak_state`` and ``n_restep`` (a one-element list) are the run's own
+    objects, read when a checkpoint is taken; ``key`` the inputs stored with it."""
+
+    def __init__(self, sigs, every, path, key, *, solver, line, inputs, rows, times, snaps, peak_state, n_restep,
+                 wall_before, wall0):
+        self.sigs, self.every, self.path, self.key = sigs, every, path, key
+        self.solver, self.line, self.inputs, self.rows, self.times = solver, line, inputs, rows, times
+        self.snap_t, self.snap_z, self.snap_kind = snaps
+        self.peak_state, self.n_restep, self.wall_before, self.wall0 = peak_state, n_restep, wall_before, wall0
+        self.last = time.monotonic()
+
+    def __call__(self, run, chunks):
+        from . import elastic_advance as EA
+
+        signum = self.sigs.poll(run)
+        if signum is None and (self.every is None or time.monotonic() - self.last < self.every):
+            return
+        solver = self.solver
+        t = float(solver.t)
+        rec = np.concatenate([np.asarray(self.rows, dtype=float)] + [c[:, 1:] for c in chunks])
+        tt = np.concatenate([np.asarray(self.times, dtype=float)] + [c[:, 0] for c in chunks])
+        sc = run.sctl
+        pk = (float(sc[EA.S_PEAKT]), run.peak_z.copy()) if sc[EA.S_RUN] > 0.0 else self.peak_state
+        wall = self.wall_before + time.perf_counter() - self.wall0
+        how = f"continue with solve(..., resume={self.path!r})"
+        status = "checkpoint" if signum is None else "interrupted"
+        reason = f"running; checkpoint at t={t:.9g}, step {len(tt) - 1}; if the run was killed, {how}" \
+            if signum is None else f"interrupted by {signal_name(signum)} at t={t:.9g}, step {len(tt) - 1}; {how}"
+        base = _dataset(self.line, tt, rec, self.snap_t + [pk[0], t], self.snap_z + [pk[1], solver.y.copy()],
+                        self.snap_kind + ["peak", "final"], {**self.inputs, "status": status, "stop_reason": reason,
+                                                             "t_final": t, "n_steps": len(tt) - 1, "wall_time": wall})
+        ds, path = write(self.path, base, run.state(), self.snap_t, self.snap_z, self.snap_kind, self.key, wall,
+                         self.n_restep[0])
+        self.last = time.monotonic()
+        if signum is not None:
+            raise RunInterrupted(f"{reason} (saved in {path})", int(signum), dataset=ds, path=path)
 
 
 def signal_name(signum) -> str:

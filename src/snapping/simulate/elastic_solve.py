@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
 import time
 
 import numpy as np
@@ -55,9 +54,8 @@ from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
-from .snap_window import snap_peaks
+from .snap_window import snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
-from .errors import RunInterrupted
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
 from .elastic_links_rodas import LinksStepper
@@ -343,8 +341,10 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         written on SIGINT or SIGTERM (status 'interrupted', then :class:`RunInterrupted` is
         raised, as by :func:`snapping.simulate.run`) and every ``checkpoint_every`` seconds of
         wall time (status 'checkpoint'; 0: at every return of the compiled loop, None: only
-        when stopped). An existing file is refused unless it is ``resume``'s. The run's numbers
-        are the same with or without it.
+        when stopped). An existing file is refused unless it is ``resume``'s. It (and ``resume``)
+        is locked while the run lasts (:func:`snapping._files.locked`: another process writing or
+        resuming it gets :class:`snapping._files.OutputBusyError`, naming its PID). The run's
+        numbers are the same with or without it.
     resume : path, optional
         A checkpoint of this run to continue (the same ``problem``, ``elastic`` and options:
         others are refused by name, as is a file whose digest fails); the result equals the
@@ -376,24 +376,32 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         stop_floor = V.positive("stop_floor", stop_floor)
     progress = check_progress(progress)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
-    if (checkpoint is not None or resume is not None or checkpoint_every is not None) and \
-            (method not in ("rodas4", "rodas4-links") or not COMPILED_LOOP):
-        raise V.SnappingInputError(f"checkpoint/checkpoint_every/resume with method={method!r}: only 'rodas4' and "
-                                   "'rodas4-links' (compiled loop) keep checkpoints")
+    asked = [(k, v) for k, v in (("checkpoint", checkpoint), ("resume", resume), ("checkpoint_every", checkpoint_every))
+             if v is not None]
+    if asked and (method not in ECK.METHODS or not COMPILED_LOOP):
+        k, v = asked[0]
+        raise V.SnappingInputError(f"{k}={str(v) if k != 'checkpoint_every' else v!r} with method={method!r}: only the "
+                                   f"methods {ECK.METHODS} (compiled loop) keep checkpoints")
     if checkpoint is None:
         checkpoint = resume
     if checkpoint_every is not None and checkpoint is None:
         raise V.SnappingInputError(f"checkpoint_every={checkpoint_every!r} needs a checkpoint file (checkpoint=PATH)")
-    if checkpoint is not None:
-        from .dataset import check_writable
-        own = resume is not None and os.path.realpath(os.fspath(checkpoint)) == os.path.realpath(os.fspath(resume))
-        checkpoint = check_writable(checkpoint, name="checkpoint", overwrite=own)
+    checkpoint, resume = ECK.check_paths(checkpoint, resume)
     inputs = {"N": line.N, "method": method, "tol": tol, "t_end": 0.0 if t_end is None else t_end,
               "stop_fraction": stop_fraction, "t_end_max": t_end_max, "start": start if initial is None else "initial",
               "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
               "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
               "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
+    with ECK.held(checkpoint, resume) if checkpoint is not None else contextlib.nullcontext():
+        return _solve(line, problem, inputs, method=method, tol=tol, t_end=t_end, t_end_max=t_end_max,
+                      stop_fraction=stop_fraction, start=start, initial=initial, snaps=snaps, max_rhs=max_rhs,
+                      stop_floor=stop_floor, progress=progress, checkpoint=checkpoint,
+                      checkpoint_every=checkpoint_every, resume=resume)
 
+
+def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fraction, start, initial, snaps, max_rhs,
+           stop_floor, progress, checkpoint, checkpoint_every, resume):
+    """:func:`solve` once its inputs are checked (and its checkpoint files locked)."""
     wall0, wall_before = time.perf_counter(), 0.0
     z0 = _initial(line, start, initial)
     t_bound = t_end if t_end is not None else t_end_max
@@ -454,30 +462,10 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
             snap_t, snap_z, snap_kind = got["snap_t"], got["snap_z"], got["snap_kind"]
             snaps = [x for x in snaps if x > times[-1]]
             n_restep[0] = got["n_restep"]
-        sigs, last = ECK.Signals(), [time.monotonic()]
-
-        def poll(run, chunks):  # between chunks: a due checkpoint, or a signal (save, raise RunInterrupted)
-            signum = sigs.poll(run)
-            if signum is None and (checkpoint_every is None or time.monotonic() - last[0] < checkpoint_every):
-                return
-            t = float(solver.t)
-            rec = np.concatenate([np.asarray(rows, dtype=float)] + [c[:, 1:] for c in chunks])
-            tt = np.concatenate([np.asarray(times, dtype=float)] + [c[:, 0] for c in chunks])
-            sc = run.sctl
-            pk = (float(sc[EA.S_PEAKT]), run.peak_z.copy()) if sc[EA.S_RUN] > 0.0 else peak_state
-            wall = wall_before + time.perf_counter() - wall0
-            how = f"continue with solve(..., resume={checkpoint!r})"
-            status = "checkpoint" if signum is None else "interrupted"
-            reason = f"running; checkpoint at t={t:.9g}, step {len(tt) - 1}; if the run was killed, {how}" \
-                if signum is None else f"interrupted by {ECK.signal_name(signum)} at t={t:.9g}, step {len(tt) - 1}; {how}"
-            base = _dataset(line, tt, rec, snap_t + [pk[0], t], snap_z + [pk[1], solver.y.copy()],
-                            snap_kind + ["peak", "final"], {**inputs, "status": status, "stop_reason": reason,
-                                                            "t_final": t, "n_steps": len(tt) - 1, "wall_time": wall})
-            ds, path = ECK.write(checkpoint, base, run.state(), snap_t, snap_z, snap_kind, key, wall,
-                                 n_restep[0])
-            last[0] = time.monotonic()
-            if signum is not None:
-                raise RunInterrupted(f"{reason} (saved in {path})", int(signum), dataset=ds, path=path)
+        sigs = ECK.Signals()  # (between chunks: a due checkpoint, or a signal: save, raise RunInterrupted)
+        poll = ECK.Poller(sigs, checkpoint_every, checkpoint, key, solver=solver, line=line, inputs=inputs, rows=rows,
+                          times=times, snaps=(snap_t, snap_z, snap_kind), peak_state=peak_state, n_restep=n_restep,
+                          wall_before=wall_before, wall0=wall0)
 
     bar = EP.open_run_bar(problem, method, t_end, progress)
     try:
@@ -570,6 +558,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     snap = snap_peaks(times, rec[:, STEP_NAMES.index("v_max")],
                       {k: rec[:, STEP_NAMES.index(f"{k}_max")] for k in ("a", "sigma")}, ref, ref["v"][1])
     results.update(a_peak_snap=snap["a"], sigma_peak_snap=snap["sigma"], t_snap_end=snap["t_snap_end"])
+    taut = taut_peaks(times, rec[:, STEP_NAMES.index("v_max")], rec[:, STEP_NAMES.index("n_slack")],
+                      {"sigma": rec[:, STEP_NAMES.index("sigma_max")]}, ref, ref["v"][1])
+    results.update(sigma_peak_taut=taut["sigma"], t_taut_end=taut["t_taut_end"])
     cols = {k: rec[:, STEP_NAMES.index(k)] for k in ("sigma_max", "dt", "n_slack", "sigma_min")}
     ring, ok, note = EC.peak_guard(np.asarray(times), cols, wave_speed=line.wave_speed, length=float(np.sum(line.h)),
                                    start=start if initial is None else "initial", t_snap_sigma=ref["sigma"][1],

@@ -27,6 +27,17 @@ straight when the tip has slowed by 10%), so ``sigma_peak_snap`` is then the lar
 while the tip is within 10% of its peak speed: a value at the window's end, not a turning
 point (documented, with its level convergence, in the guide).
 
+**The taut snap** (branch stretch1pct, for the tension): the snap's window extended until the line
+first goes slack after the speed peak (the first recorded step at or after it with a slack link; the
+run's end if none), never shorter than the 0.9 window (:func:`taut_end`, ``sigma_peak_taut``,
+``t_taut_end``). Why (measured, ``benchmarks/stretch_taut.py``, docs/guide/regimes.md "The taut
+snap's tension"): in soft lines the tension peak is a turning point after the 0.9 window but before
+any link goes slack, so the 0.9 window cut it at its edge (a value that moved with the level):
+chi 0.1, c 7.53, fold level -1: 25.69 at the window's end, 27.75 at the turning point (v_max there
+0.64 of its peak, no slack link in the whole run); chi 0.3, c 442.7: 18.93 at the window's end, the
+tension wave's arrival at the held end 21.77 at +2.29e-3 = 1.01 L/c after the speed peak, the first
+slack link at +5.87e-3 and the recoil's 24.4 after it (excluded).
+
 The snap's peaks are computed from the run's per-step records: where the run's refined peak
 (``a_peak``, ``sigma_peak``) falls inside the window it is taken as is (so the snap's peaks
 equal the run's whenever the run's peaks belong to the snap, bit for bit); otherwise the
@@ -37,7 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SNAP_FRACTION", "snap_end", "snap_peaks"]
+__all__ = ["SNAP_FRACTION", "snap_end", "snap_peaks", "taut_end", "taut_peaks"]
 
 #: the snap lasts, after the speed peak, until v_max has fallen below this fraction of its peak
 SNAP_FRACTION = 0.9
@@ -67,8 +78,14 @@ def snap_peaks(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP
     whose time lies in the window is returned as is; else the window's largest record."""
     t = np.asarray(t, dtype=float)
     je = snap_end(t, v, t_peak, fraction)
+    return {"t_snap_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}
+
+
+def _window_peaks(t, je: int, cols: dict, run_peaks: dict) -> dict:
+    """The peaks over the recorded steps ``0 ... je``: a run peak whose time is in it as is, else the
+    largest record."""
     t_end = float(t[je])
-    out = {"t_snap_end": t_end}
+    out = {}
     for name, col in cols.items():
         val, tp = run_peaks[name]
         if np.isfinite(tp) and tp <= t_end:
@@ -76,3 +93,27 @@ def snap_peaks(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP
         else:
             out[name] = float(np.max(np.asarray(col, dtype=float)[:je + 1]))
     return out
+
+
+def taut_end(t, v, n_slack, t_peak, fraction: float = SNAP_FRACTION) -> int:
+    """Index of the last recorded step of the taut snap: the first step at or after the speed peak
+    (the first recorded time >= ``t_peak``) with a slack link (``n_slack`` > 0), the run's last step if
+    none, and never before :func:`snap_end` (the 0.9 window)."""
+    t, ns = np.asarray(t, dtype=float), np.asarray(n_slack)
+    je = snap_end(t, v, t_peak, fraction)
+    if ns.shape != t.shape:
+        raise ValueError("n_slack and t differ in length")
+    if not np.isfinite(t_peak):
+        return je
+    ip = int(np.searchsorted(t, t_peak, side="left"))
+    slack = np.flatnonzero(ns[ip:] > 0)
+    jf = t.size - 1 if slack.size == 0 else ip + int(slack[0])
+    return max(je, jf)
+
+
+def taut_peaks(t, v, n_slack, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP_FRACTION) -> dict:
+    """As :func:`snap_peaks`, over the taut snap (:func:`taut_end`): ``{name: value}`` plus
+    ``"t_taut_end"``."""
+    t = np.asarray(t, dtype=float)
+    je = taut_end(t, v, n_slack, t_peak, fraction)
+    return {"t_taut_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}

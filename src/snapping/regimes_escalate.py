@@ -1,0 +1,89 @@
+"""Escalation of a regime study's levels: a cell whose error bar is over the target runs one more
+(finer) level (issue 24, branch stretch1pct).
+
+A study run with ``regimes(..., escalate=target, extra_levels=m)`` holds ``levels + m`` levels; every
+cell runs the first ``levels`` (the base), and a cell whose continuum extrapolation
+(:func:`snapping.continuum.extrapolate` over the levels it has) leaves the error bar of v_peak,
+a_peak or sigma_peak above ``target`` of its limit runs the next level, until it is within the
+target or has all ``levels + m``. The ideal chain at a chi runs a level when any of its cells does
+(the same-links ratio needs both on the same links) or when its own bars are over the target. A
+cell's row holds its levels as a prefix of the level dimension (NaN after): :func:`prefix`.
+
+Why (measured, docs/guide/regimes.md "Escalated levels"): at chi = 0.1 the ideal chain's own
+a_peak is only +-2.0% on the stretching study's four levels (453,413, 582,569, 633,683, 648,205:
+orders 1.3, 1.8, the first level pre-asymptotic), so every stiff cell there is too; one level more
+settles them, and costs the cells that are already within 1% nothing.
+
+>>> import numpy as np
+>>> prefix(np.array([1.0, 2.0, np.nan, 4.0]))
+2
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .continuum import extrapolate
+
+__all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "pending"]
+
+#: the peaks whose error bars decide an escalation
+ESCALATE_QUANTITIES = ("v_peak", "a_peak", "sigma_peak")
+
+
+def prefix(row) -> int:
+    """The number of leading finite values of ``row`` (the levels a cell has run)."""
+    ok = np.isfinite(np.asarray(row, dtype=float))
+    bad = np.flatnonzero(~ok)
+    return int(ok.size if bad.size == 0 else bad[0])
+
+
+def extrapolate_prefix(res, row, base: int):
+    """:func:`snapping.continuum.extrapolate` over the leading finite levels of ``row`` (resolutions
+    ``res``), or None where fewer than ``base`` are done."""
+    n = prefix(row)
+    if n < base:
+        return None
+    return extrapolate(np.asarray(res, dtype=float)[:n], np.asarray(row, dtype=float)[:n])
+
+
+def over_target(res, rows: dict, base: int, target: float) -> bool:
+    """Whether any of ``rows`` ({quantity: levels}) has, over its done levels, an error bar above
+    ``target`` times its limit (a zero or non-finite limit counts as over)."""
+    for q in ESCALATE_QUANTITIES:
+        if q not in rows:
+            continue
+        e = extrapolate_prefix(res, rows[q], base)
+        if e is None:
+            return False
+        lim, err = e["limit"], e["error"]
+        if not (math.isfinite(lim) and math.isfinite(err) and lim != 0.0 and abs(err) <= target * abs(lim)):
+            return True
+    return False
+
+
+def pending(ds, target: float, base: int) -> list[tuple]:
+    """The runs an escalating study still owes: ``(chi index, number index or None for the ideal,
+    level index)``, each the next level of a cell (or ideal) whose base levels are all done."""
+    nl = ds.sizes["level"]
+    res = ds.resolution.values
+    out = []
+    for i in range(ds.sizes["chi"]):
+        want = 0
+        for j in range(ds.sizes["number"]):
+            n = prefix(ds["v_peak_level"].values[i, j])
+            if n < base:
+                continue
+            rows = {q: ds[f"{q}_level"].values[i, j] for q in ESCALATE_QUANTITIES}
+            if n < nl and over_target(res, rows, base, target):
+                out.append((i, j, n))
+                n += 1
+            want = max(want, n)
+        n = prefix(ds["v_peak_ideal_level"].values[i])
+        if base <= n < nl:
+            rows = {q: ds[f"{q}_ideal_level"].values[i] for q in ESCALATE_QUANTITIES}
+            if n < want or over_target(ds.resolution_ideal.values, rows, base, target):
+                out.append((i, None, n))
+    return out
