@@ -82,3 +82,22 @@ def test_augmented_stage_solve_is_the_dense_exact_one(name, gh):
     # today's banded solve leaves drag out: it is not the exact one (the test can tell them apart)
     ban = np.concatenate(probe.StageMatrix(res, D, gh).solve(b[:N], b[N:]))
     assert np.abs(ban - ref).max() > 1e-6 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("gh", [1e-4, 1e-3])
+def test_one_defect_correction_by_a_difference_is_the_dense_corrected_solve(gh):
+    # corrfd1 (J U by one difference of the compiled right side) = corr1 (the dense exact product)
+    # to the difference's rounding, and both much closer to the exact solve than the banded one
+    res, y, f = _state(_problems()["nylon"], 8)
+    N = res.N
+    D = res.jacobian(0.0, y, f)
+    rng = np.random.default_rng(9)
+    b = rng.standard_normal(2 * N) / gh
+    ref = np.linalg.solve(probe.dense_stage_matrix(res, D, gh), b)
+    ban = np.concatenate(probe.StageMatrix(res, D, gh).solve(b[:N], b[N:]))
+    corr = np.concatenate(probe.stage_class("corr1")(res, D, gh).solve(b[:N], b[N:]))
+    fd = np.concatenate(probe.stage_class("corrfd1")(res, D, gh).solve(b[:N], b[N:]))
+    scale = np.abs(ref).max()
+    assert np.abs(fd - corr).max() <= 1e-5 * scale
+    e_ban, e_corr = np.abs(ban - ref).max(), np.abs(corr - ref).max()
+    assert e_ban > 1e-6 * scale and e_corr < 0.2 * e_ban
