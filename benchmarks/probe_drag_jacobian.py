@@ -15,15 +15,18 @@ velocities are sums over the chain). This probe runs the nylon line's graded lev
   ``(w_a, w_T, z_x, z_y)``, bandwidths ``KL_AUG, KU_AUG``: one ``dgbtrf`` per step, one ``dgbtrs``
   per stage, as today, on a wider band);
 * ``corrK``: today's banded solve, then K defect corrections with the exact stage matrix
-  (``U += S_b^{-1} (b - S U)``; each an extra banded solve and an O(N) product in compiled form).
+  (``U += S_b^{-1} (b - S U)``, S dense here);
+* ``corrfdK``: the same corrections with ``J U`` by one forward difference of the compiled right side
+  along U: O(N), one evaluation and one banded solve more per stage and correction, no new LU.
 
 It prints the steps, rejections and the peaks (nondimensional) of each, and (``--costs``) the
-LAPACK times of the two band shapes on a given number of links: the compiled step's extra cost.
+times of the two band shapes' LU and solve on a given number of links (LAPACK, the engine's
+compiled band code, one band code with compile-time lengths for both): the compiled step's extra cost.
 
 Usage::
 
     python benchmarks/probe_drag_jacobian.py --level -1 --modes banded aug dense corr1 --norm rms
-    python benchmarks/probe_drag_jacobian.py --level 0 --modes banded aug
+    python benchmarks/probe_drag_jacobian.py --level 0 --modes banded aug corrfd1
     python benchmarks/probe_drag_jacobian.py --level -1 --modes aug --tol 1e-5
     python benchmarks/probe_drag_jacobian.py --costs 2127
 """
