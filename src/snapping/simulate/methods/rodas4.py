@@ -86,7 +86,7 @@ class Engine(DP.Engine):
         auto = par[G.P_PIN] == G.PIN_FIXED and int(par[FR.P_CNK]) == 0
         quad = (not auto) or clamped or bool(np.any(self.barr[2] != 0.0)) or par[FR.P_HASDRAG] != 0.0
         qfd = quad and not auto  # (a fixed held end and clamp: W' = 0, D' = 2R - p exact, drag's p too)
-        self.rp = np.array([clamped, par[FR.P_HASBEND] != 0.0, quad, qfd, auto, par[FR.P_HASDRAG] != 0.0],
+        self.rp = np.array([clamped, par[FR.P_HASBEND] != 0.0, quad, qfd, auto, par[FR.P_HASDRAG] != 0.0, False],
                            dtype=float)
         self.Dj = np.zeros((4, NCOL, 2 * N))
         self.ab = np.zeros((2 * N, RB.WROW))
