@@ -142,3 +142,23 @@ def test_off_by_default_and_flag_off_is_the_step_unchanged():
     r = run(p, method="rodas4", tol=1e-4, t_end=0.02, progress=False)
     assert "drag_jacobian" not in r.dataset.attrs
     np.testing.assert_array_equal(a[0], _compiled_step(_engine(p), y0, 3e-3, False)[0])
+
+
+def test_option_validated_stored_and_read_back(tmp_path):
+    p = _problem(8)
+    for bad in ("exact", 1, None):
+        with pytest.raises(SnappingInputError, match=r"drag_jacobian=.*banded.*correct"):
+            run(p, method="rodas4", t_end=0.01, drag_jacobian=bad)
+    with pytest.raises(SnappingInputError, match="drag_jacobian='correct' is an option of method='rodas4'"):
+        run(0.3, 8, method="fast", t_end=0.01, drag_jacobian="correct")
+    from snapping.simulate import inputs_from_attrs, rerun
+
+    a = run(p, method="rodas4", tol=1e-4, t_end=0.05, drag_jacobian="correct", progress=False).dataset
+    b = run(p, method="rodas4", tol=1e-4, t_end=0.05, progress=False).dataset
+    assert a.attrs["drag_jacobian"] == "correct" and inputs_from_attrs(a)["drag_jacobian"] == "correct"
+    for d, per in ((a, 11), (b, 5)):  # (per attempted step; the corrections' evaluations counted)
+        att = int(d.attrs["n_steps"]) + int(d.attrs["n_rejected"])
+        assert per * att + int(d.attrs["n_steps"]) <= int(d.attrs["n_rhs"]) <= per * att + int(d.attrs["n_steps"]) + 5
+    assert a.attrs["n_steps"] < b.attrs["n_steps"]  # (the drag's Jacobian in the stages: fewer steps)
+    c = rerun(a).dataset
+    np.testing.assert_array_equal(a.v_max.values, c.v_max.values)

@@ -220,5 +220,6 @@ def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, pro
     DP._warm_up()
     _warm_up()
     eng = Engine(y0, 0.0, mdl=problem.model(), **opts.engine_kwargs())
+    eng.rp[RB.RP_DCORR] = 1.0 if opts.drag_jacobian == "correct" else 0.0
     inputs["dt0"] = eng.dt0
     return inputs, eng
