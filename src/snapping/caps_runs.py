@@ -50,7 +50,7 @@ GRID_DAMPING = 1.0
 GRADED_TOL = 1e-3
 #: the graded runs' stage solves where the line has drag (``run(drag_jacobian=...)``): ``"banded"`` (drag
 #: left out of RODAS4's Jacobian) or ``"correct"`` (each stage corrected once for it; branch ``dragcorr``)
-GRADED_DRAG_JACOBIAN = "banded"
+GRADED_DRAG_JACOBIAN = "correct"
 GRADED_DAMPING = 0.01
 GRADED_ORDER = 2.0
 #: the coarser graded level, in bending lengths: links along the fold's path at most FOLD_LINK (at the
