@@ -227,6 +227,8 @@ def main(argv=None) -> int:
     p.add_argument("--profile", choices=lines.names(),
                    help="where this line's graded runs' time goes (--levels, --tols)")
     p.add_argument("--tols", nargs="+", type=float, default=None, help="RODAS4's tolerances of --profile")
+    p.add_argument("--drag-jacobian", choices=("banded", "correct"), default=None,
+                   help="the graded runs' stage solves on lines with drag (caps_runs.GRADED_DRAG_JACOBIAN)")
     p.add_argument("--escalation", nargs="+", choices=lines.names(),
                    help="the escalated graded answer of these lines at --chi on --N[0] links: each level, the "
                         "pair extrapolated, why it stopped, CPU; beside it the levels-0-1 answer (before)")
@@ -237,6 +239,10 @@ def main(argv=None) -> int:
         if len(a.levels) != 3:
             p.error("--order takes three --levels")
         return _order(a.order, a.chi, tuple(a.levels))
+    if a.drag_jacobian:
+        from snapping import caps_runs
+
+        caps_runs.GRADED_DRAG_JACOBIAN = a.drag_jacobian
     if a.escalation:
         return _escalation(a.escalation, a.chi, a.N[0])
     before_kw = {"graded": False} if a.before == "uniform" else {"graded": False, "damping": 0.0}

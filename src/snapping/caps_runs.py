@@ -48,6 +48,9 @@ GRID_DAMPING = 1.0
 #: bending wave, and the order of convergence their Richardson extrapolation assumes (measured on the
 #: nylon line, chi 0.25, levels of 535, 1054 and 2091 links: 1.92 in the tension, 1.9 in the speed)
 GRADED_TOL = 1e-3
+#: the graded runs' stage solves where the line has drag (``run(drag_jacobian=...)``): ``"banded"`` (drag
+#: left out of RODAS4's Jacobian) or ``"correct"`` (each stage corrected once for it; branch ``dragcorr``)
+GRADED_DRAG_JACOBIAN = "correct"
 GRADED_DAMPING = 0.01
 GRADED_ORDER = 2.0
 #: the coarser graded level, in bending lengths: links along the fold's path at most FOLD_LINK (at the
@@ -254,11 +257,11 @@ def richardson(coarse: float, fine: float, order: float = GRADED_ORDER, ratio: f
     return fine + d, abs(d)
 
 
-def _run(problem_, method: str, tol: float) -> dict:
+def _run(problem_, method: str, tol: float, drag_jacobian: str = "banded") -> dict:
     from .simulate import run
 
     t0, c0 = time.perf_counter(), time.process_time()
-    r = run(problem_, method=method, tol=tol, progress=False)
+    r = run(problem_, method=method, tol=tol, progress=False, drag_jacobian=drag_jacobian)
     a = r.dataset.attrs
     if a.get("status") != "completed":
         raise RuntimeError(f"a run of the real model did not complete ({a.get('status')}: {a.get('stop_reason', '')})")
@@ -347,7 +350,7 @@ class Runs:
         if key not in self.done:
             h = graded_h(self.chi, bending_length(self.sp), level)
             p = problem(self.sp, self.chi, h.size, on, damping=GRADED_DAMPING, omega_min=0.0, h=h)
-            r = _run(p, "rodas4", GRADED_TOL)
+            r = _run(p, "rodas4", GRADED_TOL, GRADED_DRAG_JACOBIAN if "drag" in on else "banded")
             r["links"] = int(h.size)
             self.done[key] = r
             self._logged({"run": ("+".join(on) or "ideal") + f" (graded {level})", "N": int(h.size),

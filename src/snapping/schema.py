@@ -175,6 +175,12 @@ INPUT_ATTRS: dict[str, str] = {
     "max_rejections": "consecutive rejected steps at which the run fails",
 }
 
+#: Inputs of one method, written only when not their default (a default run's file is unchanged).
+OPTIONAL_INPUT_ATTRS: dict[str, str] = {
+    "drag_jacobian": ("the stiff method's stage solves: 'banded' (the default, not written; drag left out of the "
+                      "Jacobian) or 'correct' (each stage corrected once for it)"),
+}
+
 #: Inputs added after the first files were written, with the value that reproduces an older file.
 INPUT_DEFAULTS: dict[str, float] = {"max_energy_drift": 0.0, "dt_min": 1e-14, "max_rejections": 100}
 

@@ -448,6 +448,8 @@ def _inputs_from_attrs(ds: xr.Dataset) -> dict:
             out[k] = int(v)
         else:
             out[k] = None if float(v) == 0.0 and k == "max_energy_drift" else float(v)
+    if "drag_jacobian" in a:  # (stored only when not the default)
+        out["drag_jacobian"] = str(a["drag_jacobian"])
     if str(a.get("initial", "catenary")) == "snapshot":
         out["initial"] = initial_from_dataset(ds)
     if str(a.get("initial", "catenary")) == "problem":

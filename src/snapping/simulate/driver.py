@@ -152,6 +152,13 @@ def _validate_start(chi, N, method, chords, initial, problem):
     return chi, N
 
 
+def _check_drag_jacobian(opts, method: str) -> None:
+    """SnappingInputError for ``drag_jacobian`` other than the default on a method without stage solves."""
+    if opts.drag_jacobian != "banded" and method not in ("rodas4", "stiff"):
+        raise V.SnappingInputError(f"drag_jacobian={opts.drag_jacobian!r} is an option of method='rodas4' (stiff) "
+                                   f"only; this run's method is {method!r}: leave drag_jacobian='banded'")
+
+
 def run(
     chi: float | None = None,
     N: int | None = None,
@@ -172,6 +179,7 @@ def run(
     max_energy_drift: float | None = None,
     dt_min: float = 1e-14,
     max_rejections: int = 100,
+    drag_jacobian: str = "banded",
     checkpoint_every: float | None = CHECKPOINT_EVERY,
     problem=None,
     overwrite: bool = False,
@@ -276,6 +284,11 @@ def run(
         The run fails when the adaptive time step falls below this floor.
     max_rejections : int
         The run fails after more than this many consecutive rejected steps.
+    drag_jacobian : {"banded", "correct"}
+        ``method="rodas4"`` only: its stage solves use the banded Jacobian, which leaves air
+        drag out (``"banded"``, the default), or correct each stage once for it (``"correct"``:
+        ``J U`` by one difference of the right side, one evaluation and one banded solve more per
+        stage; on drag-dominated lines far fewer steps, :mod:`snapping.simulate.rosenbrock`).
     checkpoint_every : float or None
         With ``output``: save the full state of the run to ``output`` (status
         'checkpoint', atomically) every this many seconds of wall time (0: at every
@@ -324,7 +337,9 @@ def run(
     method, choice = _choose(method, problem, tol, t_end)
     opts = RunOptions(tol=default_tol(method) if tol is None else tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
-                      max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections)
+                      max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections,
+                      drag_jacobian=drag_jacobian)
+    _check_drag_jacobian(opts, method)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     progress = check_progress(progress)
     method_ = M.method(method)
@@ -366,6 +381,7 @@ def check_inputs(chi=None, N=None, **options) -> dict:
     if kw["tol"] is None:
         kw["tol"] = default_tol(kw["method"])
     opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])
+    _check_drag_jacobian(opts, kw["method"])
     check_checkpoint_every(kw["checkpoint_every"])
     check_progress(kw["progress"])
     need = check_memory(N, opts, chi=chi, method=kw["method"])

@@ -35,6 +35,10 @@ MAX_TOL = 0.1
 #: smallest stepper tolerance accepted (a few times the round-off of an O(1) velocity)
 MIN_TOL = 1e-15
 _DT_MIN_DEFAULT = 1e-14
+#: the stiff method's stage solves (``drag_jacobian``): ``"banded"`` (the banded Jacobian, drag left out;
+#: the default) or ``"correct"`` (each stage corrected once for what it leaves out: one evaluation and one
+#: banded solve more per stage, :func:`snapping.simulate.rosenbrock._stage_correct`)
+DRAG_JACOBIAN = ("banded", "correct")
 #: record buffer rows handed back to Python at a time (the engines' chunk; memory_need counts it)
 RECORD_CHUNK = 8192
 #: latest end time accepted (units of sqrt(l/g); the snap is at t ~ 1.2)
@@ -58,6 +62,7 @@ class RunOptions:
     max_energy_drift: float | None = None
     dt_min: float = 1e-14
     max_rejections: int = 100
+    drag_jacobian: str = "banded"
 
     def __post_init__(self):
         def put(name, value):
@@ -99,6 +104,10 @@ class RunOptions:
             else V.positive("max_energy_drift", self.max_energy_drift))
         put("dt_min", dt_min)
         put("max_rejections", V.integer("max_rejections", self.max_rejections, 0))
+        if not isinstance(self.drag_jacobian, str) or self.drag_jacobian not in DRAG_JACOBIAN:
+            raise V.SnappingInputError(f"drag_jacobian={self.drag_jacobian!r} is not one of {DRAG_JACOBIAN} (the "
+                                       "stiff method's stage solves: the banded Jacobian, which leaves drag out, or "
+                                       "that and one correction per stage)")
 
     @classmethod
     def names(cls) -> tuple[str, ...]:
@@ -123,13 +132,15 @@ class RunOptions:
                 "max_rejections": self.max_rejections}
 
     def input_attrs(self) -> dict:
-        """The options as run-file attributes (schema.INPUT_ATTRS; 0 stands for None)."""
+        """The options as run-file attributes (schema.INPUT_ATTRS; 0 stands for None; ``drag_jacobian``
+        only when not the default, so the default run's file is unchanged)."""
         return {"tol": self.tol, "dt0": 0.0 if self.dt0 is None else self.dt0,
                 "t_end": 0.0 if self.t_end is None else self.t_end, "stop_fraction": self.stop_fraction,
                 "snapshot_times": list(self.snapshot_times), "record_thin": self.record_thin,
                 "t_end_max": self.t_end_max, "max_link_error": self.max_link_error,
                 "max_energy_drift": 0.0 if self.max_energy_drift is None else self.max_energy_drift,
-                "dt_min": self.dt_min, "max_rejections": self.max_rejections}
+                "dt_min": self.dt_min, "max_rejections": self.max_rejections,
+                **({} if self.drag_jacobian == "banded" else {"drag_jacobian": self.drag_jacobian})}
 
 
 def _times(snapshot_times) -> tuple:

@@ -82,8 +82,10 @@ S_F0, S_F1 = 0, 7
 (CN_JAC, CN_LU, CN_EXTRA, CN_SING) = range(4)
 NCNT = 4
 #: the flags of ``rp``: clamped, bending, W/D have dynamics, their rows by differences, autonomous,
-#: drag (with RP_QUAD and not RP_QFD: the dissipation row's drag part by its exact gradient)
-(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO, RP_DRAG) = range(6)
+#: drag (with RP_QUAD and not RP_QFD: the dissipation row's drag part by its exact gradient), the
+#: stage solves corrected once for what the banded Jacobian leaves out (drag: :func:`_stage_correct`)
+(RP_CLAMP, RP_BEND, RP_QUAD, RP_QFD, RP_AUTO, RP_DRAG, RP_DCORR) = range(7)
+NRP = 7
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
@@ -275,6 +277,36 @@ def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _stage_correct(N, t, y0, f0, Dj, gh, ab, piv, b, U, ytmp, rhs, tmp, c, s, S, cp, dp, sig, mdl):
+    """One defect correction of the angle part of a stage ``U`` solved with the banded Jacobian
+    (which leaves drag out, :func:`jacobian_at`): ``J U`` by one forward difference of the right
+    side along U at the step's start (the scaling of the W/D rows' differences), the residual of
+    the exact stage equation ``r = b - (U/(gamma h) - J U)``, and ``U += S_b^{-1} r`` by one more
+    banded solve (no new factorisation). Returns the evaluations made (0 or 1)."""
+    n = y0.shape[0]
+    n2 = 2 * N
+    nu = 0.0
+    ny = 0.0
+    for i in range(n2):
+        nu += U[i] * U[i]
+        ny += y0[i] * y0[i]
+    nu = math.sqrt(nu / n2)
+    if not nu > 0.0:
+        return 0
+    dl = 1e-7 * (1.0 + math.sqrt(ny / n2)) / nu
+    for i in range(n):
+        ytmp[i] = y0[i] + dl * U[i] if i < n2 else y0[i]
+    MD.model_rhs(N, t, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+    for j in range(N):  # (the residual into tmp: theta rows, then omega rows with J U's acceleration part)
+        tmp[N + j] = b[N + j] - (U[N + j] / gh - (tmp[N + j] - f0[N + j]) / dl)
+        tmp[j] = b[j] - (U[j] / gh - U[N + j])
+    _stage_solve(N, Dj, gh, ab, piv, tmp, ytmp, rhs, tmp)
+    for i in range(n2):
+        U[i] += ytmp[i]
+    return 1
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def omega_floor(N, j, Dj, y, hl):
     """The roundoff floor of the error estimate of link j's angular velocity (the error
     norm's scale of that component is ``max(tol (1 + |omega_j|), floor)``): rounding the
@@ -355,6 +387,10 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
             for i in range(n):
                 btmp[i] += dh * ft[i]
         _stage_solve(N, Dj, gh, ab, piv, btmp, U, rhs, tmp)
+        if rp[RP_DCORR] != 0.0:
+            k = _stage_correct(N, t, y0, f0, Dj, gh, ab, piv, btmp, U, ytmp, rhs, tmp, c, s, S, cp, dp, sig, mdl)
+            nev += k
+            cnt[CN_EXTRA] += float(k)
         bw = btmp[n2]
         bd = btmp[n2 + 1]
         if rp[RP_QUAD] != 0.0 and rp[RP_QFD] == 0.0:  # dD'/dx U_x, exact (W' = 0)

@@ -86,7 +86,7 @@ class Engine(DP.Engine):
         auto = par[G.P_PIN] == G.PIN_FIXED and int(par[FR.P_CNK]) == 0
         quad = (not auto) or clamped or bool(np.any(self.barr[2] != 0.0)) or par[FR.P_HASDRAG] != 0.0
         qfd = quad and not auto  # (a fixed held end and clamp: W' = 0, D' = 2R - p exact, drag's p too)
-        self.rp = np.array([clamped, par[FR.P_HASBEND] != 0.0, quad, qfd, auto, par[FR.P_HASDRAG] != 0.0],
+        self.rp = np.array([clamped, par[FR.P_HASBEND] != 0.0, quad, qfd, auto, par[FR.P_HASDRAG] != 0.0, False],
                            dtype=float)
         self.Dj = np.zeros((4, NCOL, 2 * N))
         self.ab = np.zeros((2 * N, RB.WROW))
@@ -220,5 +220,6 @@ def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, pro
     DP._warm_up()
     _warm_up()
     eng = Engine(y0, 0.0, mdl=problem.model(), **opts.engine_kwargs())
+    eng.rp[RB.RP_DCORR] = 1.0 if opts.drag_jacobian == "correct" else 0.0
     inputs["dt0"] = eng.dt0
     return inputs, eng
