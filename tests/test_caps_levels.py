@@ -144,3 +144,19 @@ def test_fly_line_graded_at_100_links():
     kf = [runs.get(tuple(on), n)["kappa_peak"] / n for n in (100, 200)]
     assert kf[0] < math.pi / 2 and kf[1] >= kf[0]
     assert g["used"] and g["collapse_run"] == "with bending"
+
+
+def test_escalation_runs_a_level_up_to_4000_links():
+    # levels 1 + 0.1 4^-k (order 2): the estimates (Richardson's corrections) 2.5% on levels 0-1, 0.625% on
+    # 1-2; with the links
+    # 491 2^k the third level (1964) is run; with 3810 links for level 2 too (the fly line's level 3 at
+    # chi 0.1 is 3810), it is run; 4236 (the nylon line's level 3 at chi 0.25) is not
+    def run_level(k):
+        calls.append(k)
+        return {q: 1.0 + 0.1 * 4.0 ** -k for q in Q}
+    for links, ran in ((3810, [0, 1, 2]), (4001, [0, 1])):
+        calls = []
+        g = caps_runs.graded_levels(run_level, lambda k: 491 if k == 0 else (965 if k == 1 else links),
+                                    within=0.01, quantities=Q)
+        assert calls == ran
+        assert g["stopped"] == ("within" if links <= 4000 else "max_links")

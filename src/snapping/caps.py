@@ -24,7 +24,7 @@ onto one link), the full run is made on two levels of links graded to the free e
 lengths and extrapolated at order 2, with an error estimate per peak (the nylon line: 545 and 1072
 links, its tension within 0.11% of the converged value, estimate 0.55%); while any peak's estimate
 is over 1% a finer level is run and the last two extrapolated, up to
-:data:`snapping.caps_runs.MAX_GRADED_LINKS` links (:func:`snapping.caps_runs.graded_levels`).
+:data:`snapping.caps_runs.MAX_ESCALATED_LINKS` links (:func:`snapping.caps_runs.graded_levels`).
 
 **Stretching** is the elastic model (:func:`snapping.simulate.elastic.solve`), which has no
 bending or drag; it is run when EA is given and matters: when the line's peak speed (the full

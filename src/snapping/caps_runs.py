@@ -26,7 +26,7 @@ __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "S
            "STRETCH_N", "STRETCH_LEVELS", "STRETCH_START", "STRETCH_METHOD", "accept_factors", "QUANTITIES",
            "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
            "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
-           "grading_for", "graded_levels", "observed_order", "GRADED_WITHIN"]
+           "MAX_ESCALATED_LINKS", "grading_for", "graded_levels", "observed_order", "GRADED_WITHIN"]
 
 #: links of the coarser level of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -169,9 +169,12 @@ GRADE_LINKS = 20.0
 #: by a factor 0.5-0.8 per halving)
 COLLAPSE = 1.5707963267948966
 #: the most links of the finer graded level (the nylon line's: 1072; their cost grows as 1/lb): a line
-#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved;
-#: also the most links of a level run by the escalation (:func:`graded_levels`: the nylon line's 2127)
+#: whose bending length is shorter is answered on its uniform links, and the answer says it is not resolved
 MAX_GRADED_LINKS = 2500
+#: the most links of a level run by the escalation (:func:`graded_levels`): the fly line's level 3 at
+#: chi 0.1 (3810 links; 4.8 s of CPU with drag in the stage solves, `caps_runs.GRADED_DRAG_JACOBIAN`)
+#: fits, the nylon line's at chi 0.25 (4236) does not
+MAX_ESCALATED_LINKS = 4000
 
 
 def grading_rule(lb: float, h_tip: float, kappa_h=None, where: str = "without bending",
@@ -376,7 +379,7 @@ def observed_order(f0: float, f1: float, f2: float, ratio: float = 2.0) -> float
     return math.log(d0 / d1) / math.log(ratio)
 
 
-def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links: int = MAX_GRADED_LINKS,
+def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links: int = MAX_ESCALATED_LINKS,
                   order: float = GRADED_ORDER, quantities=QUANTITIES) -> dict:
     """The graded levels of an answer, escalated: levels 0 and 1 (``run_level(k)``: the peaks of level
     k, {peak: value}), then each next level (``links_of(k)``: its links, without running it) while any
