@@ -277,12 +277,10 @@ def _stage_solve(N, Dj, gh, ab, piv, b, U, rhs, tmp):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
-def _stage_correct(N, t, y0, f0, Dj, gh, ab, piv, b, U, ytmp, rhs, tmp, c, s, S, cp, dp, sig, mdl):
-    """One defect correction of the angle part of a stage ``U`` solved with the banded Jacobian
-    (which leaves drag out, :func:`jacobian_at`): ``J U`` by one forward difference of the right
-    side along U at the step's start (the scaling of the W/D rows' differences), the residual of
-    the exact stage equation ``r = b - (U/(gamma h) - J U)``, and ``U += S_b^{-1} r`` by one more
-    banded solve (no new factorisation). Returns the evaluations made (0 or 1)."""
+def _rhs_along(N, t, y0, U, ytmp, tmp, c, s, S, cp, dp, sig, mdl):
+    """The right side into ``tmp`` at ``y0`` moved along the angle part of ``U`` (its first 2N rows)
+    by the step of the forward differences along U, ``dl = 1e-7 (1 + rms(y0)) / rms(U)`` (rms over the
+    2N rows), in ``ytmp``; returns ``dl``, or -1.0 without evaluating when ``rms(U)`` is not > 0."""
     n = y0.shape[0]
     n2 = 2 * N
     nu = 0.0
@@ -292,11 +290,25 @@ def _stage_correct(N, t, y0, f0, Dj, gh, ab, piv, b, U, ytmp, rhs, tmp, c, s, S,
         ny += y0[i] * y0[i]
     nu = math.sqrt(nu / n2)
     if not nu > 0.0:
-        return 0
+        return -1.0
     dl = 1e-7 * (1.0 + math.sqrt(ny / n2)) / nu
     for i in range(n):
         ytmp[i] = y0[i] + dl * U[i] if i < n2 else y0[i]
     MD.model_rhs(N, t, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+    return dl
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _stage_correct(N, t, y0, f0, Dj, gh, ab, piv, b, U, ytmp, rhs, tmp, c, s, S, cp, dp, sig, mdl):
+    """One defect correction of the angle part of a stage ``U`` solved with the banded Jacobian
+    (which leaves drag out, :func:`jacobian_at`): ``J U`` by one forward difference of the right
+    side along U at the step's start (the scaling of the W/D rows' differences), the residual of
+    the exact stage equation ``r = b - (U/(gamma h) - J U)``, and ``U += S_b^{-1} r`` by one more
+    banded solve (no new factorisation). Returns the evaluations made (0 or 1)."""
+    n2 = 2 * N
+    dl = _rhs_along(N, t, y0, U, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+    if dl < 0.0:
+        return 0
     for j in range(N):  # (the residual into tmp: theta rows, then omega rows with J U's acceleration part)
         tmp[N + j] = b[N + j] - (U[N + j] / gh - (tmp[N + j] - f0[N + j]) / dl)
         tmp[j] = b[j] - (U[j] / gh - U[N + j])
@@ -407,17 +419,8 @@ def rodas_step(N, t, h, y0, y1, St, ft, Dj, ab, piv, ytmp, btmp, rhs, tmp, c, s,
                     acc += gq[i] * U[i]
                 bd -= acc
         elif rp[RP_QUAD] != 0.0:  # by one forward difference along U_x
-            nu = 0.0
-            ny = 0.0
-            for i in range(n2):
-                nu += U[i] * U[i]
-                ny += y0[i] * y0[i]
-            nu = math.sqrt(nu / n2)
-            if nu > 0.0:
-                dl = 1e-7 * (1.0 + math.sqrt(ny / n2)) / nu
-                for i in range(n):
-                    ytmp[i] = y0[i] + dl * U[i] if i < n2 else y0[i]
-                MD.model_rhs(N, t, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+            dl = _rhs_along(N, t, y0, U, ytmp, tmp, c, s, S, cp, dp, sig, mdl)
+            if not dl < 0.0:
                 nev += 1
                 cnt[CN_EXTRA] += 1.0
                 bw += (tmp[n2] - f0[n2]) / dl
