@@ -139,3 +139,25 @@ def test_bad_escalation_refused(kw, fake):
         R.regimes("end-mass", [0.5], [0.1], levels=4, first=-3, progress=False, **kw)
     assert ("escalate" if "escalate" in kw and kw.get("extra_levels", 1) in (1,) else "extra_levels") in str(e.value)
     assert fake == []
+
+
+def test_a_failed_escalated_run_is_reported_not_retried(monkeypatch):
+    # every run of the extra level (fraction 0.02) raises: the study must end, naming the failures
+    # (the four escalated runs of the first test, each tried once), and keep the base levels' limits
+    calls = []
+
+    def task(chi, mechanism, number, level, tol, *a, **k):
+        calls.append((chi, number if mechanism else 0.0, level["frac"]))
+        if len(calls) > 100:  # (a BaseException: not caught as the run's failure)
+            pytest.fail("the failed escalated runs are tried again and again")
+        if level["frac"] == 0.02:
+            raise ValueError("planted failure")
+        return {**_values(chi, number if mechanism else 0.0, level["frac"]), "n_links": int(1 / level["frac"]),
+                "n_rhs": 1, "cpu_time": 0.0}
+
+    monkeypatch.setattr(R, "_run_task", task)
+    monkeypatch.setattr(R, "cell_problem", lambda *a, **k: None)
+    with pytest.raises(RuntimeError, match="4 run\\(s\\) of the study failed.*planted failure"):
+        R.regimes("end-mass", [0.1, 0.5], [0.01, 0.1], levels=4, first=-3, progress=False, escalate=0.01,
+                  extra_levels=1)
+    assert len(calls) == 2 * 3 * 4 + 4 and sum(c[2] == 0.02 for c in calls) == 4

@@ -580,12 +580,14 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     with lock if lock is not None else contextlib.nullcontext():
         try:
             execute(todo)
+            tried = set()  # (a failed run leaves its level owed: it is not tried again)
             while "escalate" in acc:  # the cells over the target run their next level, round by round
                 from .regimes_escalate import pending
 
-                more = pending(ds, acc["escalate"], acc["levels"])
+                more = [m for m in pending(ds, acc["escalate"], acc["levels"]) if m not in tried]
                 if not more:
                     break
+                tried.update(more)
                 add_calls(more)
                 bar.total += len(more)
                 bar.refresh()
