@@ -60,21 +60,28 @@ def node_velocities(N, y, c, s, h, pvx, pvy, VX, VY):
 
 
 @njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
+def _tangent(c, s, j):
+    """The unit tangent at node ``j`` (cos/sin ``c, s`` of the link angles): link j's, or for j > 0
+    the bisector of links j - 1 and j where they are not opposite; ``(tx, ty, bisector?)``."""
+    tx = c[j]
+    ty = s[j]
+    if j > 0:
+        bx = c[j - 1] + tx
+        by = s[j - 1] + ty
+        nb = math.sqrt(bx * bx + by * by)
+        if nb > 1e-12:
+            inb = 1.0 / nb
+            return bx * inb, by * inb, True
+    return tx, ty, False
+
+
+@njit(cache=True, fastmath=False, boundscheck=False, error_model="numpy")
 def add_drag(N, c, s, wx, wy, CN, CT, KN, KT, cd, VX, VY, FX, FY):
     """Add the drag forces (velocities ``VX, VY`` from :func:`node_velocities`); returns their
     power ``sum_j F_j.v_j`` (<= 0 without wind)."""
     p = 0.0
     for j in range(N):
-        tx = c[j]
-        ty = s[j]
-        if j > 0:
-            bx = c[j - 1] + tx
-            by = s[j - 1] + ty
-            nb = math.sqrt(bx * bx + by * by)
-            if nb > 1e-12:
-                inb = 1.0 / nb
-                tx = bx * inb
-                ty = by * inb
+        tx, ty, _ = _tangent(c, s, j)
         ux = VX[j] - wx
         uy = VY[j] - wy
         ut = ux * tx + uy * ty
@@ -108,18 +115,7 @@ def drag_power_gradient(N, y, c, s, h, wx, wy, CN, CT, KN, KT, cd, VX, VY, g):
     gx = 0.0  # G_l: the velocity derivatives summed from the free end
     gy = 0.0
     for j in range(N):
-        tx = c[j]
-        ty = s[j]
-        half = False
-        if j > 0:
-            bx = c[j - 1] + tx
-            by = s[j - 1] + ty
-            nb = math.sqrt(bx * bx + by * by)
-            if nb > 1e-12:
-                inb = 1.0 / nb
-                tx = bx * inb
-                ty = by * inb
-                half = True
+        tx, ty, half = _tangent(c, s, j)
         vx = VX[j]
         vy = VY[j]
         ux = vx - wx
