@@ -67,7 +67,7 @@ import numpy as np
 import xarray as xr
 
 from . import _validate as V
-from .continuum import QUANTITIES, _uniform_levels, extrapolate, level_parameters
+from .continuum import QUANTITIES, _uniform_levels, level_parameters
 from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
                            STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
@@ -304,7 +304,7 @@ def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> x
 
 def _finish(ds: xr.Dataset) -> xr.Dataset:
     """The limits, error bars, orders and ratios of every cell whose levels are all done."""
-    from .regimes_escalate import extrapolate_prefix, pending, prefix
+    from .regimes_escalate import extrapolate_prefix, mark_levels_run
 
     nc, nn = ds.sizes["chi"], ds.sizes["number"]
     base = int(ds.attrs["levels"])  # the levels every cell runs (more: an escalating study's, regimes_escalate)
@@ -332,11 +332,7 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
     done = (np.isfinite(ds["v_peak_level"].values[:, :, :base]).all()
             and np.isfinite(ds["v_peak_ideal_level"].values[:, :base]).all())
     if ds.sizes["level"] > base:  # an escalating study: the levels each cell ran, and whether any is owed
-        ds["levels_run"] = (("chi", "number"), np.array([[prefix(r) for r in rows] for rows in ds["v_peak_level"].values],
-                                                        dtype=np.int8),
-                            {"long_name": "levels the cell ran (the base, plus those its error bars asked for)"})
-        ds["levels_run_ideal"] = ("chi", np.array([prefix(r) for r in ds["v_peak_ideal_level"].values], dtype=np.int8))
-        done = done and not pending(ds, float(ds.attrs["escalate"]), base)
+        done = not mark_levels_run(ds, base) and done
     ds.attrs["status"] = "complete" if done else "partial"
     return ds
 
@@ -580,14 +576,13 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     with lock if lock is not None else contextlib.nullcontext():
         try:
             execute(todo)
-            tried = set()  # (a failed run leaves its level owed: it is not tried again)
+            tried = set()
             while "escalate" in acc:  # the cells over the target run their next level, round by round
-                from .regimes_escalate import pending
+                from .regimes_escalate import next_round
 
-                more = [m for m in pending(ds, acc["escalate"], acc["levels"]) if m not in tried]
+                more = next_round(ds, acc["escalate"], acc["levels"], tried)
                 if not more:
                     break
-                tried.update(more)
                 add_calls(more)
                 bar.total += len(more)
                 bar.refresh()

@@ -27,7 +27,8 @@ import numpy as np
 
 from .continuum import extrapolate
 
-__all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "pending"]
+__all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "pending", "next_round",
+           "mark_levels_run"]
 
 #: the peaks whose error bars decide an escalation
 ESCALATE_QUANTITIES = ("v_peak", "a_peak", "sigma_peak")
@@ -87,3 +88,21 @@ def pending(ds, target: float, base: int) -> list[tuple]:
             if n < want or over_target(ds.resolution_ideal.values, rows, base, target):
                 out.append((i, None, n))
     return out
+
+
+def next_round(ds, target: float, base: int, tried: set) -> list[tuple]:
+    """The runs of the next round of escalation: :func:`pending` less those in ``tried`` (a failed
+    run leaves its level owed; it is not tried again in the same call), added to ``tried``."""
+    more = [m for m in pending(ds, target, base) if m not in tried]
+    tried.update(more)
+    return more
+
+
+def mark_levels_run(ds, base: int) -> bool:
+    """Add an escalating study's ``levels_run`` (chi, number) and ``levels_run_ideal`` (chi): the
+    levels each cell and each ideal ran; returns whether any run is still owed (:func:`pending`)."""
+    ds["levels_run"] = (("chi", "number"), np.array([[prefix(r) for r in rows] for rows in ds["v_peak_level"].values],
+                                                    dtype=np.int8),
+                        {"long_name": "levels the cell ran (the base, plus those its error bars asked for)"})
+    ds["levels_run_ideal"] = ("chi", np.array([prefix(r) for r in ds["v_peak_ideal_level"].values], dtype=np.int8))
+    return bool(pending(ds, float(ds.attrs["escalate"]), base))
