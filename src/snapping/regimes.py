@@ -18,36 +18,32 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
   shortest wave at every node the damping ratio ``zeta`` (``damping``, default 1) and vanishes
   as h^2 with the links, so the continuum extrapolation removes it (checked: the limits at
   zeta 0.5, 1 and 2 agree within their error bars, ``benchmarks/bench_regimes.py``). Run with
-  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps). A cell is flagged
-  ``converged`` = 0 where its finest links do not resolve the bending length at the fold
-  (``bending_resolution`` < 1, :mod:`snapping.regimes_resolution`): such levels are
-  pre-asymptotic, and their extrapolation can look converged without being so.
+  RODAS4 (L-stable: the damped grid-scale waves do not limit its steps); its acceleration and tension peaks
+  the snap's without the release's grid-scale spike at t = 0 (``"peaks": "snap"``,
+  :func:`snapping.simulate.snap_window.run_snap_peaks`). ``converged`` = 0 where the finest links do not
+  resolve the bending length at the fold (``bending_resolution`` < 1, :mod:`snapping.regimes_resolution`):
+  pre-asymptotic levels, whose extrapolation can look converged without being so.
 * ``drag`` (normal number d, tangential ``d * pi C_t / C_n`` with the default coefficients
   of :mod:`snapping.units`), ``drag-normal``, ``drag-tangential``: ``Body(drag_...)``;
   fold-following graded chains (the ideal's own levels: number -> 0 is the ideal limit).
-* ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``);
-  fold-following graded chains.
+* ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``); fold-following graded chains.
 * ``stretching``: the extensible line (:func:`snapping.simulate.elastic.solve`, from the start
   ``start``, default ``STRETCH_START`` = ``"matched"``: at rest at the catenary, stretched to the
   rigid chain's tensions just after release, so that no release wave rings; ``"stretched"``, the
   hanging equilibrium let go, was the study of stop 29) of wave speed c; the number scanned is the
   *inverse* stretching number ``sqrt(g L)/c`` (so that number -> 0 is the inextensible
-  ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4
-  (``STRETCH_METHOD``: in link coordinates by default, the shipped study's; ``method="rodas4"``
-  in node coordinates) and the elastic grid damping ``damping`` (the shortest longitudinal
-  mode's damping ratio, a link damping ``zeta h sqrt(EA lambda)`` vanishing with h, so the
-  continuum extrapolation removes it), its acceleration and tension peaks the snap's
-  (``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`; the key says
-  ``"peaks": "snap"``), the stop rule armed at ``STRETCH_STOP_FLOOR``
-  (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links
-  costs 6.8 M evaluations for one coarse cell (chi = 0.3, c = 30, 108 links) and puts the
-  acceleration peak at 2.9e6.
+  ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4 (``STRETCH_METHOD``:
+  in link coordinates by default, the shipped study's; ``method="rodas4"`` in node coordinates) and the
+  elastic grid damping ``damping`` (the shortest longitudinal mode's damping ratio, a link damping
+  ``zeta h sqrt(EA lambda)`` vanishing with h, so the continuum extrapolation removes it), its acceleration
+  and tension peaks the snap's (``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`;
+  the key says ``"peaks": "snap"``), the stop rule armed at ``STRETCH_STOP_FLOOR``
+  (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links costs 6.8 M
+  evaluations for one coarse cell (chi = 0.3, c = 30, 108 links) and puts the acceleration peak at 2.9e6.
 
-The work is one task per (cell, level) run, on the sweep's workers: local processes
-(:func:`snapping._workers.run_all`) or a Dask cluster (``scheduler``). The study file
-``out`` is rewritten (atomically) after every run: an interrupted study keeps what is
-done, and a rerun computes only the runs missing. A file at ``out`` that holds another
-study (other mechanism, grid or accuracy) is refused, never overwritten.
+One task per (cell, level) run, on local processes (:func:`snapping._workers.run_all`) or a Dask
+cluster (``scheduler``). The study file ``out`` is rewritten (atomically) after every run: a rerun
+computes only the runs missing; a file holding another study (key: mechanism, grid, accuracy) is refused.
 
 Example
 -------
@@ -57,6 +53,7 @@ Example
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import math
@@ -68,7 +65,7 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, level_parameters
-from .regimes_spec import (ACCURACY, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
+from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
                            STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
@@ -204,6 +201,9 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
         row.update({q: float(a[name]) for q, name in STRETCH_PEAK_ATTRS.items() if name in a})
         row.update({q: float(a[name]) for q, name in STRETCH_EXTRA_PEAKS.items() if name in a})
+    elif mechanism == "bending" and number > 0:  # the snap's, not the release's grid-scale spike at t = 0
+        from .simulate.snap_window import run_snap_peaks
+        row.update({q: v for q, v in run_snap_peaks(ds).items() if q in BEND_SNAP_PEAKS})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
     return row
 
@@ -423,6 +423,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
     if mechanism in ("bending", "stretching"):
         acc["damping"] = damping
+    if mechanism == "bending":  # (a file of the run's peaks, before branch snapbend, is not resumed)
+        acc["peaks"] = BEND_PEAKS_KEY
     if mechanism == "stretching":
         from .simulate.elastic_model import STARTS
 
@@ -570,8 +572,6 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         else:
             for t in todo:
                 collect(t, lambda t=t: _run_task(*calls[t]))
-
-    import contextlib
 
     with lock if lock is not None else contextlib.nullcontext():
         try:

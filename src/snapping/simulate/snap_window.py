@@ -38,6 +38,22 @@ chi 0.1, c 7.53, fold level -1: 25.69 at the window's end, 27.75 at the turning 
 tension wave's arrival at the held end 21.77 at +2.29e-3 = 1.01 L/c after the speed peak, the first
 slack link at +5.87e-3 and the recoil's 24.4 after it (excluded).
 
+**The snap without the release** (branch snapbend, the bending study): a line with bending stiffness
+released from rest in its folded shape rings at the grid scale at once: the first step's acceleration is
+the largest of the run, and it doubles with each fold level (chi 0.5, beta 0.01, fold levels -1 ... 2:
+a_peak 96, 197, 395, 789 at t = 0, against the snap's 10.2 at t 0.97 while v_max rises to its 1.81 at
+t 1.10), a mesh artefact of the start, not the snap. :func:`release_window` starts the window at the
+last recorded step before the speed peak at which v_max was below ``RELEASE_FRACTION`` (1/2) of its
+peak (the whip's rise), and ends it as the snap's (0.9 after the peak). Why 1/2: the release's spike
+dies out within the first steps (a rate of sqrt(B)/h^2: gone by t 1e-3 where v_max is 1% of its peak),
+while the snap's acceleration and tension peaks come with the speed's own (the ideal's within 1e-3 of
+the speed peak, v_max there above 0.99 of its peak): any fraction between leaves both where they are;
+1/2 is far from both (measured on the shipped study's cells, docs/guide/regimes.md "Bending").
+:func:`run_snap_peaks` applies it to a run Dataset (its ``t``, ``v_max``, ``a_max``, ``sigma_max`` and
+the run's refined peaks). The curvature is not windowed: a bent line's largest curvature is its
+start's (the rest shape's fold, a continuum quantity: bending bounds it) or the fall's, and over the
+window its maximum would be the window's first value, not a turning point.
+
 The snap's peaks are computed from the run's per-step records: where the run's refined peak
 (``a_peak``, ``sigma_peak``) falls inside the window it is taken as is (so the snap's peaks
 equal the run's whenever the run's peaks belong to the snap, bit for bit); otherwise the
@@ -48,10 +64,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SNAP_FRACTION", "snap_end", "snap_peaks", "taut_end", "taut_peaks"]
+__all__ = ["SNAP_FRACTION", "RELEASE_FRACTION", "snap_end", "snap_peaks", "taut_end", "taut_peaks", "release_start",
+           "release_window", "run_snap_peaks"]
 
 #: the snap lasts, after the speed peak, until v_max has fallen below this fraction of its peak
 SNAP_FRACTION = 0.9
+#: the snap without the release starts at the last step before the speed peak with v_max below this
+#: fraction of its peak (:func:`release_window`)
+RELEASE_FRACTION = 0.5
 
 
 def snap_end(t, v, t_peak, fraction: float = SNAP_FRACTION) -> int:
@@ -81,17 +101,17 @@ def snap_peaks(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = SNAP
     return {"t_snap_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}
 
 
-def _window_peaks(t, je: int, cols: dict, run_peaks: dict) -> dict:
-    """The peaks over the recorded steps ``0 ... je``: a run peak whose time is in it as is, else the
+def _window_peaks(t, je: int, cols: dict, run_peaks: dict, js: int = 0) -> dict:
+    """The peaks over the recorded steps ``js ... je``: a run peak whose time is in it as is, else the
     largest record."""
-    t_end = float(t[je])
+    t_start, t_end = float(t[js]), float(t[je])
     out = {}
     for name, col in cols.items():
         val, tp = run_peaks[name]
-        if np.isfinite(tp) and tp <= t_end:
+        if np.isfinite(tp) and tp <= t_end and (js == 0 or tp >= t_start):
             out[name] = float(val)
         else:
-            out[name] = float(np.max(np.asarray(col, dtype=float)[:je + 1]))
+            out[name] = float(np.max(np.asarray(col, dtype=float)[js:je + 1]))
     return out
 
 
@@ -117,3 +137,43 @@ def taut_peaks(t, v, n_slack, cols: dict, run_peaks: dict, t_peak, fraction: flo
     t = np.asarray(t, dtype=float)
     je = taut_end(t, v, n_slack, t_peak, fraction)
     return {"t_taut_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks)}
+
+
+def release_start(t, v, t_peak, fraction: float = RELEASE_FRACTION) -> int:
+    """Index of the first recorded step of the snap without the release: the last step before the speed
+    peak (before the first recorded time >= ``t_peak``) whose speed ``v`` is below ``fraction`` times the
+    peak (the largest of ``v``); 0 if none (or no peak time)."""
+    t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
+    if t.size == 0:
+        raise ValueError("no recorded steps")
+    if not np.isfinite(t_peak):
+        return 0
+    ip = int(np.searchsorted(t, t_peak, side="left"))
+    below = np.flatnonzero(v[:ip] < fraction * max(float(np.max(v)), 0.0))
+    return 0 if below.size == 0 else int(below[-1])
+
+
+def release_window(t, v, cols: dict, run_peaks: dict, t_peak, start_fraction: float = RELEASE_FRACTION,
+                   fraction: float = SNAP_FRACTION) -> dict:
+    """As :func:`snap_peaks`, over the snap without the release (:func:`release_start` ...
+    :func:`snap_end`): ``{name: value}`` plus ``"t_snap_start"`` and ``"t_snap_end"``. A run peak
+    whose time lies in the window (both ends included) is returned as is; else the window's largest
+    record."""
+    t = np.asarray(t, dtype=float)
+    js, je = release_start(t, v, t_peak, start_fraction), snap_end(t, v, t_peak, fraction)
+    if je < js:  # (cannot happen: the start is before the speed peak, the end at or after it)
+        raise ValueError("the window ends before it starts")
+    return {"t_snap_start": float(t[js]), "t_snap_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks, js)}
+
+
+def run_snap_peaks(ds) -> dict:
+    """The snap's ``a_peak`` and ``sigma_peak`` of a run Dataset (:func:`snapping.simulate.run`) without the
+    release (:func:`release_window`), from its per-step ``t``, ``v_max``, ``a_max``, ``sigma_max`` and its
+    refined peaks (``a_peak`` at ``t_snap_a``, ``sigma_peak`` at ``t_snap_sigma``, the speed's at
+    ``t_snap_v``); plus ``t_snap_start``, ``t_snap_end``."""
+    a = ds.attrs
+    cols = {q: ds[f"{q}_max"].values for q in ("a", "sigma")}
+    run_peaks = {q: (float(a[f"{q}_peak"]), float(a[f"t_snap_{q}"])) for q in ("a", "sigma")}
+    w = release_window(ds["t"].values, ds["v_max"].values, cols, run_peaks, float(a["t_snap_v"]))
+    return {"a_peak": w["a"], "sigma_peak": w["sigma"], "t_snap_start": w["t_snap_start"],
+            "t_snap_end": w["t_snap_end"]}
