@@ -1,0 +1,155 @@
+"""The snap's peaks without the release (issue 24, branch snapbend): :func:`release_window`,
+:func:`run_snap_peaks` of :mod:`snapping.simulate.snap_window` and the bending study's use of them.
+
+* synthetic records: a speed bump v = exp(-(t - 1)^2 / (2 s^2)) on t in [0, 1.5] (closed form: v is
+  1/2 at 1 - s sqrt(2 ln 2), 0.9 at 1 +- s sqrt(2 ln(1/0.9))), an acceleration with a release spike
+  at t = 0 (the run's refined peak there) and a snap peak with the speed: the window starts at the
+  last step before the peak with v < 1/2 and ends as the snap's, the spike is excluded, the snap's
+  refined run peak kept as is, a spike inside the window kept, a run peak before the window replaced;
+* a real bending run (chi 0.5, beta 0.01, fold level -3, 38 links) whose run a_peak is the release's
+  at t = 0: the windowed peak is the largest a_max over the steps found by hand (plain loops), lies
+  near the speed peak, below the release's, and agrees with the finer level's within 2% (the release
+  spike doubles: 11.8 at level -4, 23.7 at -3); a small-beta run keeps the run's peaks bit for bit;
+* the study's worker takes the windowed peaks for bending (the ideal keeps the run's), and a study
+  file of the run's peaks (no ``"peaks"`` in its key) is refused.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from snapping import _validate as V
+from snapping import regimes as R
+from snapping.continuum import level_parameters
+from snapping.simulate import run
+from snapping.simulate.snap_window import RELEASE_FRACTION, release_start, release_window, run_snap_peaks
+
+S_W = 0.2
+T = np.linspace(0.0, 1.5, 1501)  # step 1e-3
+V_ = np.exp(-((T - 1.0) ** 2) / (2 * S_W**2))
+T_HALF = 1.0 - S_W * math.sqrt(2 * math.log(2))  # v = 1/2 (closed form), rising
+T_NINE = 1.0 + S_W * math.sqrt(2 * math.log(1 / 0.9))  # v = 0.9, falling
+I_START = int(np.flatnonzero(T < T_HALF)[-1])  # last step below half before the peak, by hand
+I_END = int(np.flatnonzero(T > T_NINE)[0])  # first step below 0.9 after it
+
+
+def _a():
+    a = 100.0 * V_**4  # the snap's acceleration, peaking with the speed (100 at t = 1)
+    a[:5] += 1000.0 * np.exp(-T[:5] / 1e-3)  # the release's spike: 1000 at t = 0
+    return a
+
+
+def test_window_starts_at_the_last_step_below_half_the_peak():
+    assert RELEASE_FRACTION == 0.5
+    assert release_start(T, V_, 1.0) == I_START
+    assert T[I_START] == pytest.approx(T_HALF, abs=1.01e-3) and T[I_START] < T_HALF
+    assert release_start(T, V_, float("nan")) == 0
+    # a speed never below half before its peak: the window from the start
+    assert release_start(T, 0.6 + 0.4 * V_, 1.0) == 0
+    w = release_window(T, V_, {}, {}, 1.0)
+    assert w["t_snap_start"] == T[I_START] and w["t_snap_end"] == T[I_END]
+
+
+def test_release_spike_is_excluded_and_snap_peak_kept_as_is():
+    a = _a()
+    out = release_window(T, V_, {"a": a}, {"a": (1000.0, 0.0)}, 1.0)  # the run's peak: the release
+    assert out["a"] == pytest.approx(100.0, rel=1e-12)  # the bump's own maximum at t = 1 exactly
+    # the run's refined peak inside the window is returned as is (not the recorded maximum)
+    out = release_window(T, V_, {"a": a}, {"a": (100.25, 1.0003)}, 1.0)
+    assert out["a"] == 100.25
+    # the window's start and end are inside it: a run peak there is kept
+    assert release_window(T, V_, {"a": a}, {"a": (7.0, T[I_START])}, 1.0)["a"] == 7.0
+    assert release_window(T, V_, {"a": a}, {"a": (7.0, T[I_END])}, 1.0)["a"] == 7.0
+    # one a step before the start, or after the end: the window's largest record
+    assert release_window(T, V_, {"a": a}, {"a": (7.0, T[I_START - 1])}, 1.0)["a"] == pytest.approx(100.0)
+    assert release_window(T, V_, {"a": a}, {"a": (7.0, T[I_END + 1])}, 1.0)["a"] == pytest.approx(100.0)
+
+
+def test_spikes_inside_and_outside_the_window():
+    a = _a()
+    j = I_START + 3  # inside, v just above 1/2
+    a[j] = 500.0
+    k = I_START - 3  # before the window (v just below 1/2)
+    a[k] = 900.0
+    out = release_window(T, V_, {"a": a, "s": a}, {"a": (900.0, T[k]), "s": (500.0, T[j])}, 1.0)
+    assert out["a"] == 500.0 and out["s"] == 500.0
+
+
+def _lv(first):
+    return level_parameters(1, 0.5, first=first)[0]
+
+
+@pytest.fixture(scope="module")
+def big_beta():
+    """chi 0.5, beta 0.01 (the shipped study's largest) at fold levels -4 and -3, the study's RODAS4."""
+    return {f: run(R.cell_problem(0.5, "bending", 0.01, _lv(f)), method="rodas4", tol=1e-6, progress=False).dataset
+            for f in (-4, -3)}
+
+
+def test_real_run_release_excluded_by_hand(big_beta):
+    ds = big_beta[-3]
+    a = ds.attrs
+    t, v, am = ds.t.values, ds.v_max.values, ds.a_max.values
+    # the run's a_peak is the release's: at t = 0, and it doubles with the level (grid scale)
+    assert a["t_snap_a"] == 0.0 and am[0] == pytest.approx(a["a_peak"], rel=1e-12)
+    assert big_beta[-4].attrs["t_snap_a"] == 0.0
+    assert a["a_peak"] / big_beta[-4].attrs["a_peak"] == pytest.approx(2.0, rel=0.05)
+    # the window by hand: plain loops over the records
+    vp = max(v)
+    ip = 0
+    while t[ip] < a["t_snap_v"]:
+        ip += 1
+    js = ip - 1
+    while v[js] >= 0.5 * vp:
+        js -= 1
+    je = ip
+    while v[je] >= 0.9 * vp:
+        je += 1
+    best = -1.0
+    for i in range(js, je + 1):
+        best = max(best, am[i])
+    out = run_snap_peaks(ds)
+    assert out["a_peak"] == best and out["t_snap_start"] == t[js] and out["t_snap_end"] == t[je]
+    assert out["a_peak"] < 0.5 * a["a_peak"]
+    i_best = int(np.flatnonzero(am == best)[0])
+    assert abs(t[i_best] - a["t_snap_v"]) < 0.3  # the snap's, near the speed peak (t 1.09), not the start
+    # the tension peak is the snap's already: the run's, kept as is
+    assert js > 0 and t[js] <= a["t_snap_sigma"] <= t[je] and out["sigma_peak"] == a["sigma_peak"]
+    # the windowed peak converges with the level (the release's doubles)
+    assert run_snap_peaks(big_beta[-4])["a_peak"] == pytest.approx(out["a_peak"], rel=0.02)
+
+
+def test_small_beta_run_keeps_its_peaks_bit_for_bit():
+    ds = run(R.cell_problem(0.3, "bending", 1e-6, _lv(-4)), method="rodas4", tol=1e-6, progress=False).dataset
+    a = ds.attrs
+    assert a["t_snap_a"] > 0.5  # the snap's, not the release's
+    out = run_snap_peaks(ds)
+    assert out["a_peak"] == a["a_peak"] and out["sigma_peak"] == a["sigma_peak"]
+
+
+def test_study_worker_takes_the_windowed_peaks(big_beta):
+    row = R._run_task(0.5, "bending", 0.01, _lv(-3), 1e-6)
+    ds = big_beta[-3]
+    assert row["a_peak"] == run_snap_peaks(ds)["a_peak"] < ds.attrs["a_peak"]
+    assert row["v_peak"] == ds.attrs["v_peak"] and row["kappa_peak"] == ds.attrs["kappa_peak"]
+    ideal = R._run_task(0.5, None, 0.0, _lv(-4), 1e-6)  # the ideal: the run's own peaks
+    di = run(R.cell_problem(0.5, None, 0.0, _lv(-4)), method="fast", tol=1e-6, progress=False).dataset
+    assert ideal["a_peak"] == di.attrs["a_peak"]
+
+
+def test_study_of_the_runs_peaks_is_not_resumed(tmp_path):
+    from snapping.sweep_files import atomic_to_netcdf
+
+    chis, betas = [0.5], [0.01]
+    acc = {"levels": 2, "first": -4, "n0": 50, "tol": 1e-6, "damping": 1.0}  # the key before branch snapbend
+    lev = R._levels("fold", acc, 0.5)
+    old = R._empty("bending", chis, betas, lev, lev, R._study_key("bending", chis, betas, acc, 0.5), acc, 0.5)
+    out = tmp_path / "old.nc"
+    atomic_to_netcdf(old, str(out))
+    with pytest.raises(V.SnappingInputError, match="holds another study"):
+        R.regimes("bending", chis, betas, levels=2, first=-4, tol=1e-6, out=str(out), progress=False)
+    with pytest.raises(V.SnappingInputError, match='"peaks": "snap"'):
+        R.regimes("bending", chis, betas, levels=2, first=-4, tol=1e-6, out=str(out), progress=False)
