@@ -158,7 +158,7 @@ STRETCH_EXTRA_LEVELS = 1
 
 #: bending (branch snapbend): the peaks a study keeps from each run's snap without the release
 #: (:func:`snapping.simulate.snap_window.run_snap_peaks`: from the last step before the speed peak with v_max
-#: below half its peak until it falls below 0.9 of it after), not its whole run: the rest start's folded shape
+#: below half its peak to the first after, the run's end), not its whole run: the rest start's folded shape
 #: rings at the grid scale when let go, its acceleration at t = 0 doubling with each fold level (chi 0.5,
 #: beta 0.01: 96, 197, 395, 789 against the snap's 10.2). kappa_peak stays the run's (snap_window's module text)
 BEND_SNAP_PEAKS = ("a_peak", "sigma_peak")

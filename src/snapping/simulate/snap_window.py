@@ -42,17 +42,25 @@ slack link at +5.87e-3 and the recoil's 24.4 after it (excluded).
 released from rest in its folded shape rings at the grid scale at once: the first step's acceleration is
 the largest of the run, and it doubles with each fold level (chi 0.5, beta 0.01, fold levels -1 ... 2:
 a_peak 96, 197, 395, 789 at t = 0, against the snap's 10.2 at t 0.97 while v_max rises to its 1.81 at
-t 1.10), a mesh artefact of the start, not the snap. :func:`release_window` starts the window at the
-last recorded step before the speed peak at which v_max was below ``RELEASE_FRACTION`` (1/2) of its
-peak (the whip's rise), and ends it as the snap's (0.9 after the peak). Why 1/2: the release's spike
-dies out within the first steps (a rate of sqrt(B)/h^2: gone by t 1e-3 where v_max is 1% of its peak),
-while the snap's acceleration and tension peaks come with the speed's own (the ideal's within 1e-3 of
-the speed peak, v_max there above 0.99 of its peak): any fraction between leaves both where they are;
-1/2 is far from both (measured on the shipped study's cells, docs/guide/regimes.md "Bending").
+t 1.10), a mesh artefact of the start, not the snap. :func:`release_window` keeps the whip: the steps
+while v_max is at least ``RELEASE_FRACTION`` (1/2) of its peak around the peak, from the last step
+before the peak below it to the first after (the run's last step: the inextensible run stops there,
+``stop_fraction`` 1/2). Why (measured, docs/guide/regimes.md "Bending"):
+
+* the start: the release's spike dies out long before the tip is fast (chi 0.5, beta 0.01, level -1:
+  a_max 96 at t = 0, 4.4 at t 3.5e-3 where v_max is 1.6% of its peak, the fall's ~2 from t 0.03, v_max
+  5%), while the snap's acceleration and tension peaks come with the speed's (the ideal's within 1e-3 of
+  the speed peak, v_max there above 0.99 of its peak);
+* the end is the run's, not the elastic snap's 0.9: a stiff rod's peaks come after the speed's, while
+  the tip slows (chi 0.1, beta 0.01, level -1: v_max peaks at t 0.866, the acceleration at t 1.056
+  (17.70) and the tension at 1.060 (10.66), v_max there 0.80 and 0.79 of its peak: a 0.9 window cut both
+  at its edge, 12.17 and 3.28). An inextensible line has no slack/recoil phase to exclude.
+
 :func:`run_snap_peaks` applies it to a run Dataset (its ``t``, ``v_max``, ``a_max``, ``sigma_max`` and
 the run's refined peaks). The curvature is not windowed: a bent line's largest curvature is its
 start's (the rest shape's fold, a continuum quantity: bending bounds it) or the fall's, and over the
-window its maximum would be the window's first value, not a turning point.
+window its maximum would be the window's first value, not a turning point (chi 0.5, beta 0.01: 5.58 at
+t ~ 0.2 against 4.74 at the window's start).
 
 The snap's peaks are computed from the run's per-step records: where the run's refined peak
 (``a_peak``, ``sigma_peak``) falls inside the window it is taken as is (so the snap's peaks
@@ -153,14 +161,14 @@ def release_start(t, v, t_peak, fraction: float = RELEASE_FRACTION) -> int:
     return 0 if below.size == 0 else int(below[-1])
 
 
-def release_window(t, v, cols: dict, run_peaks: dict, t_peak, start_fraction: float = RELEASE_FRACTION,
-                   fraction: float = SNAP_FRACTION) -> dict:
-    """As :func:`snap_peaks`, over the snap without the release (:func:`release_start` ...
-    :func:`snap_end`): ``{name: value}`` plus ``"t_snap_start"`` and ``"t_snap_end"``. A run peak
-    whose time lies in the window (both ends included) is returned as is; else the window's largest
-    record."""
+def release_window(t, v, cols: dict, run_peaks: dict, t_peak, fraction: float = RELEASE_FRACTION) -> dict:
+    """As :func:`snap_peaks`, over the snap without the release: while v_max is at least ``fraction`` of
+    its peak around the peak (:func:`release_start` ... :func:`snap_end` at ``fraction``; the run's end
+    for a run stopped at half its peak speed): ``{name: value}`` plus ``"t_snap_start"`` and
+    ``"t_snap_end"``. A run peak whose time lies in the window (both ends included) is returned as is;
+    else the window's largest record."""
     t = np.asarray(t, dtype=float)
-    js, je = release_start(t, v, t_peak, start_fraction), snap_end(t, v, t_peak, fraction)
+    js, je = release_start(t, v, t_peak, fraction), snap_end(t, v, t_peak, fraction)
     if je < js:  # (cannot happen: the start is before the speed peak, the end at or after it)
         raise ValueError("the window ends before it starts")
     return {"t_snap_start": float(t[js]), "t_snap_end": float(t[je]), **_window_peaks(t, je, cols, run_peaks, js)}
