@@ -161,3 +161,16 @@ def test_study_of_the_runs_peaks_is_not_resumed(tmp_path):
         R.regimes("bending", chis, betas, levels=2, first=-4, tol=1e-6, out=str(out), progress=False)
     with pytest.raises(V.SnappingInputError, match='"peaks": "snap"'):
         R.regimes("bending", chis, betas, levels=2, first=-4, tol=1e-6, out=str(out), progress=False)
+
+
+def test_shipped_bending_study_keeps_the_snaps_peaks():
+    from snapping.regimes_analysis import report
+
+    ds = R.bundled_study("bending")
+    assert '"peaks": "snap"' in ds.attrs["regimes_study"] and ds.attrs["peaks"] == "snap"
+    assert any("without the release" in line for line in report(ds))
+    # the release's spike doubled with each level (chi 0.5, beta 0.01: 96, 197, 395, 789); the snap's does not:
+    # each level's a_peak within 5% of the one before, and far below the release's at the first level (96)
+    a = ds.a_peak_level.sel(chi=0.5, number=0.01).values
+    a = a[np.isfinite(a)]
+    assert a.size >= 4 and np.all(np.abs(np.diff(a)) <= 0.05 * a[1:]) and a[0] < 20.0

@@ -288,7 +288,10 @@ def report(ds, quantities=("v_peak", "a_peak", "sigma_peak")) -> list[str]:
     name = ds.attrs["number_name"]
     lines = [f"regime study: {ds.attrs['mechanism']} ({ds.attrs['mechanism_description']}), number {name}; "
              f"{ds.attrs['grading']} levels x{ds.sizes['level']}, status {ds.attrs['status']}"]
-    if ds.attrs.get("peaks") == "snap":
+    if ds.attrs.get("peaks") == "snap" and ds.attrs["mechanism"] == "bending":
+        lines.append("a_peak, sigma_peak of the cells: the snap's without the release (while v_max is above half its "
+                     "peak around it: snapping.simulate.snap_window.run_snap_peaks), not the run's")
+    elif ds.attrs.get("peaks") == "snap":
         lines.append("a_peak, sigma_peak of the cells: the snap's (each run's a_peak_snap, sigma_peak_snap: up to v_max "
                      "below 0.9 of its peak after it, snapping.simulate.snap_window), not the run's")
     elif ds.attrs.get("peaks") == "snap-taut":
