@@ -327,8 +327,7 @@ def _check_drag_jacobian(args, elastic) -> None:
         return
     why = None
     if elastic is not None:
-        why = ("the extensible line (--ea/--stretching/--strain-table) has no drag, and its RODAS4 solves its "
-               "own banded Jacobian exactly")
+        why = "the extensible line (--ea/--stretching/--strain-table) has no drag (no body options are built for it)"
     elif wants_3d(args):
         why = "a 3D run (--dims 3, --perturb, --whirl) is stepped by DOP853, which has no stage solves"
     elif args.resume is None and args.method in ("dop853", "euler-richardson", "euler-richardson-fixed"):
