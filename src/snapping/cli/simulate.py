@@ -61,6 +61,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
             "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
             "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
+            "  snapping simulate --chi 0.3 --N 40 --bending 1e-3 --drag-normal 2 --method rodas4 --drag-jacobian correct\n"
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
