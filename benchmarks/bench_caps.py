@@ -209,7 +209,7 @@ def _escalation(names, chi: float, N: int) -> int:
     return 0
 
 
-def _answers(names, chis, N: int) -> int:
+def _answers(names, chis, N) -> int:
     """Each line's design answer (``caps.cap(name, chi, N=N)``, the defaults) at each chi: a markdown table of
     its wall and CPU seconds (the machine's load beside them), the links of each graded level (or the uniform
     N), each peak's error bar (graded: the escalation's estimate; uniform: the change N/2 -> N), the capping
@@ -228,7 +228,7 @@ def _answers(names, chis, N: int) -> int:
                 links = "/".join(map(str, g["levels"])) + f" (graded; {g['stopped']})"
                 err = [g["relative_error"][q] for q in caps.QUANTITIES]
             else:
-                links = f"{r['N']} uniform"
+                links = f"{r['N']} uniform" + (f" (auto: {'/'.join(map(str, r['auto_N']))})" if r.get("auto_N") else "")
                 err = [abs(r["resolution"][q]) for q in caps.QUANTITIES] if r["resolution"] else [float("nan")] * 3
             st = r["stretching"]
             if st.get("run") and not all(st["resolved"].values()):
@@ -268,9 +268,11 @@ def main(argv=None) -> int:
                    help="the design answer of each of these lines (caps.cap defaults) at each --chis on --N[0] links: "
                         "wall and CPU s, links, each peak's error bar, the capping mechanism, T ideal and real")
     p.add_argument("--chis", nargs="+", type=float, default=[0.1], help="the separations of --answers")
+    p.add_argument("--auto", action="store_true", help="--answers with N='auto' (links doubled from 100 until the "
+                                                        "tension moves by <= 1%%), not --N")
     a = p.parse_args(argv)
     if a.answers:
-        return _answers(a.answers, a.chis, a.N[0])
+        return _answers(a.answers, a.chis, "auto" if a.auto else a.N[0])
     if a.profile:
         return _profile(a.profile, a.chi, a.levels, a.tols or [_graded_tol()])
     if a.order:
