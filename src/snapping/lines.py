@@ -75,8 +75,8 @@ BODY_KEYS = ("ei", "bending_damping", "curvature", "diameter", "air_density", "c
 @lru_cache(maxsize=64)
 def _stations(taper: tuple) -> tuple:
     """A taper's stations ``(x, r)`` as two read-only float arrays, made once per taper (:meth:`Line.ratio` is
-    called per node and per quadrature point when a tapered line's chain is built: the fly line's finest graded
-    level, 3810 links, called it about 65,000 times)."""
+    called per node and per quadrature point when a tapered line's chain is built: 246,326 times in the fly line's
+    answer at chi 0.1 before its runs read their profiles once, ``caps_runs._on_nodes``)."""
     xs, rs = (np.asarray(c, dtype=float) for c in zip(*taper))
     xs.flags.writeable = False
     rs.flags.writeable = False
