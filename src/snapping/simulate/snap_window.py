@@ -77,8 +77,8 @@ __all__ = ["SNAP_FRACTION", "RELEASE_FRACTION", "snap_end", "snap_peaks", "taut_
 
 #: the snap lasts, after the speed peak, until v_max has fallen below this fraction of its peak
 SNAP_FRACTION = 0.9
-#: the snap without the release starts at the last step before the speed peak with v_max below this
-#: fraction of its peak (:func:`release_window`)
+#: the snap without the release (:func:`release_window`) runs while v_max is at least this fraction of its
+#: peak around the peak: from the last step before the peak below it to the first after
 RELEASE_FRACTION = 0.5
 
 
