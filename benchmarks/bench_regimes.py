@@ -42,13 +42,19 @@ DATA = os.path.join(HERE, "..", "src", "snapping", "data", "regimes")
 STUDIES = {
     # end-mass and drag: 3 fold levels (-1 ... 1) as shipped before, escalated (branch dragesc): a cell (or the ideal
     # at a chi) whose v/a/sigma_peak bar is over 1% runs one more level, up to 2 more (the ideal's own a_peak at
-    # chi 0.1 is +-5% on 3 levels, +-2% on 4); `--escalate-from OLD` seeds the file with the 3-level study's runs
+    # chi 0.1 is +-5% on 3 levels, +-2% on 4); `--escalate-from OLD` seeds the file with the 3-level study's runs.
+    # A cell whose last level took more than 600,000 evaluations is not escalated (escalate_max_rhs; marked
+    # escalation_capped): end mass 0.0072 at chi 0.1 took 987,000 at level 3 (7,328 links, 217 s CPU), its level 4
+    # would take ~700 s; 0.0193 took 1,039,000 at level 2
     # (the end-mass numbers: the shipped file's since d50abbc; this dict said geomspace(1e-5, 1, 8), not what shipped)
     "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.array([1.93e-6, 1e-5, 5.18e-5, 2.68e-4, 1.39e-3,
                                                                     7.2e-3, 0.0193, 0.0373]), "accuracy": "medium",
-                 "levels": 3, "escalate": 0.01, "extra_levels": 2},
+                 "levels": 3, "escalate": 0.01, "extra_levels": 2, "escalate_max_rhs": 600_000},
+    # drag: the escalation capped at 600,000 evaluations a run (escalate_max_rhs): the heavy-drag cells (d = 10 at chi
+    # 0.3, 0.5: 3.1e6, 3.9e6 at level 2, their tail compressed and crumpled, peaks growing with the links) are left
+    # at 3 levels and marked escalation_capped; every other drag run takes <= 82,000 evaluations at level 2
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium",
-             "levels": 3, "escalate": 0.01, "extra_levels": 2},
+             "levels": 3, "escalate": 0.01, "extra_levels": 2, "escalate_max_rhs": 600_000},
     # bending: 4 levels (frac 0.08-0.01; was 3 to 0.02, whose small-beta cells at chi 0.1-0.2 sat before their
     # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
@@ -255,8 +261,10 @@ def escalate_from(mech: str, old_path: str, out=None) -> None:
     old = R.load_study(old_path)
     want = json.loads(R._study_key(mech, chis, numbers, acc, 0.5))
     have = json.loads(old.attrs["regimes_study"])
-    if have != {k: v for k, v in want.items() if k not in ("escalate", "extra_levels")}:
-        raise SystemExit(f"{old_path} is not this study without escalation: {have} against {want}")
+    esc = ("escalate", "extra_levels", "escalate_max_rhs")
+    if ({k: v for k, v in have.items() if k not in esc} != {k: v for k, v in want.items() if k not in esc}
+            or any(k in have and have[k] != want[k] for k in esc[:2])):
+        raise SystemExit(f"{old_path} is not this study (escalated or not, under any cap): {have} against {want}")
     every = dict(acc, levels=acc["levels"] + acc["extra_levels"])
     grading = R.MECHANISMS[mech][1]
     ds = R._empty(mech, chis, numbers, R._levels(grading, every, 0.5), R._levels("fold", every, 0.5),
@@ -265,6 +273,13 @@ def escalate_from(mech: str, old_path: str, out=None) -> None:
     assert np.allclose(ds.resolution.values[:nl], old.resolution.values, rtol=1e-12)
     for name in [v for v in old.data_vars if v.endswith("_level") and v in ds]:
         ds[name].values[..., :nl] = old[name].values
+    if "escalate_max_rhs" in acc:  # an escalated level copied must be one this cap lets the study run
+        from snapping.regimes_escalate import prefix
+
+        for row in ds.n_rhs_level.values.reshape(-1, ds.sizes["level"]):
+            n = prefix(row)
+            if n > acc["levels"] and np.any(row[acc["levels"] - 1:n - 1] > acc["escalate_max_rhs"]):
+                raise SystemExit(f"{old_path}: a cell escalated past the cap {acc['escalate_max_rhs']}: not this study")
     out = out or os.path.join(DATA, f"{mech}.nc")
     atomic_to_netcdf(R._finish(ds), out)
     copied = int(np.isfinite(ds.v_peak_level.values).sum() + np.isfinite(ds.v_peak_ideal_level.values).sum())
