@@ -304,6 +304,13 @@ def cost(mech: str, path=None) -> dict:
     for i, chi in enumerate(ds.chi.values):
         print(f"  chi {chi:g}: CPU {np.nansum(cpu[i]) + np.nansum(ic[i]):7.1f} s; per number "
               + " ".join(f"{x:.0f}" for x in np.nansum(cpu[i], axis=-1)))
+    if "levels_run" in ds:  # an escalating study: the levels each cell ran, and those the cost cap stopped
+        print(f"  levels run (escalated): cells {np.bincount(ds.levels_run.values.ravel()).tolist()} (count by levels), "
+              f"ideal {ds.levels_run_ideal.values.tolist()}")
+    if "escalation_capped" in ds:
+        cc = np.argwhere(ds.escalation_capped.values == 1)
+        print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level): "
+              + (", ".join(f"chi {ds.chi.values[i]:g} number {ds.number.values[j]:g}" for i, j in cc) or "none"))
     worst = {}
     for q in ("v_peak", "a_peak", "sigma_peak"):
         if q not in ds:
