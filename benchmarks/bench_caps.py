@@ -38,6 +38,7 @@ Usage::
     python benchmarks/bench_caps.py                      # N = 100 200 400 1000, every line
     python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
     python benchmarks/bench_caps.py --escalation nylon-monofilament fly-line --chi 0.1 --N 200
+    python benchmarks/bench_caps.py --answers ball-chain fly-line --chis 0.1 0.25 --N 200
     python benchmarks/bench_caps.py --order nylon-monofilament --chi 0.1 --levels 1 2 3
     python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0 1 2 --tols 1e-3 3e-3 1e-2
 """
@@ -208,6 +209,37 @@ def _escalation(names, chi: float, N: int) -> int:
     return 0
 
 
+def _answers(names, chis, N) -> int:
+    """Each line's design answer (``caps.cap(name, chi, N=N)``, the defaults) at each chi: a markdown table of
+    its wall and CPU seconds (the machine's load beside them), the links of each graded level (or the uniform
+    N), each peak's error bar (graded: the escalation's estimate; uniform: the change N/2 -> N), the capping
+    mechanism and the peak tension in newtons, ideal and real."""
+    caps.cap("bungee-cord", 0.25, N=12)  # compile the kernels (both methods)
+    caps.cap("nylon-monofilament", 0.1, N=8, check=False, alone=False, graded=False)
+    print("| line | chi | wall s | CPU s | load | links | error bar v, a, T | within 1% | cap | T ideal (N) | "
+          "T real (N) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for chi in chis:
+        for name in names:
+            load = os.getloadavg()[0]
+            r = caps.cap(name, chi, N=N)
+            g = r["graded"]
+            if g.get("used"):
+                links = "/".join(map(str, g["levels"])) + f" (graded; {g['stopped']})"
+                err = [g["relative_error"][q] for q in caps.QUANTITIES]
+            else:
+                links = f"{r['N']} uniform" + (f" (auto: {'/'.join(map(str, r['auto_N']))})" if r.get("auto_N") else "")
+                err = [abs(r["resolution"][q]) for q in caps.QUANTITIES] if r["resolution"] else [float("nan")] * 3
+            st = r["stretching"]
+            if st.get("run") and not all(st["resolved"].values()):
+                links += "; stretching factor not resolved: " + ", ".join(q for q, ok in st["resolved"].items()
+                                                                          if not ok)
+            print(f"| {name} | {chi:g} | {r['wall']:.1f} | {r['cpu']:.1f} | {load:.1f}-{os.getloadavg()[0]:.1f} | "
+                  f"{links} | {', '.join(f'{e:.2%}' for e in err)} | {'yes' if max(err) <= 0.01 else 'NO'} | "
+                  f"{r['cap']} | {r['ideal']['sigma_peak']:.4g} | {r['real']['sigma_peak']:.4g} |", flush=True)
+    return 0
+
+
 def _graded_tol() -> float:
     from snapping import caps_runs
 
@@ -232,7 +264,15 @@ def main(argv=None) -> int:
     p.add_argument("--escalation", nargs="+", choices=lines.names(),
                    help="the escalated graded answer of these lines at --chi on --N[0] links: each level, the "
                         "pair extrapolated, why it stopped, CPU; beside it the levels-0-1 answer (before)")
+    p.add_argument("--answers", nargs="+", choices=lines.names(),
+                   help="the design answer of each of these lines (caps.cap defaults) at each --chis on --N[0] links: "
+                        "wall and CPU s, links, each peak's error bar, the capping mechanism, T ideal and real")
+    p.add_argument("--chis", nargs="+", type=float, default=[0.1], help="the separations of --answers")
+    p.add_argument("--auto", action="store_true", help="--answers with N='auto' (links doubled from 100 until the "
+                                                        "tension moves by <= 1%%), not --N")
     a = p.parse_args(argv)
+    if a.answers:
+        return _answers(a.answers, a.chis, "auto" if a.auto else a.N[0])
     if a.profile:
         return _profile(a.profile, a.chi, a.levels, a.tols or [_graded_tol()])
     if a.order:

@@ -124,7 +124,7 @@ def test_grading_rule_runs_the_full_model_on_2N_when_the_bending_length_is_under
     runs = _FakeRuns(sp, 0.25, k)
     g = caps_runs.grading_for(runs, 100, list(on))
     assert g["used"] and g["collapse_run"] == "with bending" and g["halved"] == pytest.approx(0.76)
-    assert runs.log == [(bare, 100), (bare, 200), (on, 100), (on, 200)]
+    assert runs.log == [(bare, 100), (on, 100), (bare, 200), (on, 200)]  # the full run on N before bare on 2N
     # the full run's fold narrows too (0.59 -> 0.40): uniform links
     runs = _FakeRuns(sp, 0.25, {**k, (on, 200): 0.40 * 200})
     assert not caps_runs.grading_for(runs, 100, list(on))["used"]
@@ -132,7 +132,7 @@ def test_grading_rule_runs_the_full_model_on_2N_when_the_bending_length_is_under
     k = {(bare, 1000): 0.45 * 1000, (bare, 2000): 0.26 * 2000, (on, 1000): 0.59 * 1000, (on, 2000): 0.76 * 2000}
     runs = _FakeRuns(sp, 0.25, k)
     assert not caps_runs.grading_for(runs, 1000, list(on))["used"]
-    assert runs.log == [(bare, 1000), (bare, 2000), (on, 1000)]
+    assert runs.log == [(bare, 1000), (on, 1000), (bare, 2000)]
 
 
 def test_fly_line_graded_at_100_links():

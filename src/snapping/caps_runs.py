@@ -79,9 +79,12 @@ def problem(sp, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
     if "taper" in on and sp.has("taper"):
         ln, L = sp.line, sp.length
         lam = sp.mass / L
-        links = Links.from_density(np.full(N, 1.0 / N) if h is None else h,
-                                   lambda u: ln.mass_per_length * ln.ratio(L * (1.0 - u), L) ** 2
-                                   / lam, tip_mass=tip, kind="line", params={"line": ln.name})
+        def density(u):  # lambda0 r^2 / lambda, r^2 by Python's float power: the numbers of a scalar call, bit for bit
+            r = ln.ratio(L * (1.0 - u), L)
+            return ln.mass_per_length * np.reshape([x ** 2 for x in r.ravel().tolist()], r.shape) / lam
+
+        links = Links.from_density(np.full(N, 1.0 / N) if h is None else h, density, tip_mass=tip, kind="line",
+                                   params={"line": ln.name}, vectorized=True)
     elif h is not None:
         links = Links.graded(h, tip_mass=tip)
     else:
@@ -93,7 +96,7 @@ def problem(sp, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
         kw.update(diameter=sp.diameter, cd_normal=sp.cd_normal if sp.diameter is not None else None,
                   cd_tangential=sp.cd_tangential if sp.diameter is not None else None, air_density=sp.air_density,
                   tip_drag_area=sp.tip_drag_area)
-    body = Body.from_si(sp.length, sp.mass, sp.g, **kw) if kw else None
+    body = _on_nodes(Body.from_si(sp.length, sp.mass, sp.g, **kw), links.h) if kw else None
     if damping > 0.0 and "ei" in kw:
         from .simulate.stiffness import grid_damping
 
@@ -102,6 +105,24 @@ def problem(sp, chi: float, N: int, on=MECHANISMS, *, lumping: str = "paper",
                     **{k: getattr(body, k) for k in ("curvature", "drag_normal", "drag_tangential",
                                                      "drag_linear_normal", "drag_linear_tangential")})
     return Problem.catenary(chi, links=links, body=body if body is not None and body.active else None)
+
+
+_BODY_PROFILES = ("bending", "curvature", "damping", "drag_normal", "drag_tangential", "drag_linear_normal",
+                  "drag_linear_tangential")
+
+
+def _on_nodes(body, h):
+    """``body`` with each profile given as a function of s (a taper's) replaced by its values at the nodes
+    of the chain with links ``h`` (:meth:`snapping.simulate.Body.node_values`: the same numbers, bit for
+    bit), so that the run reads them once rather than calling the function at every node each time it
+    needs them (the fly line's answer at chi 0.1, 12 runs, called :meth:`Body.node_values` 358 times: 180,885
+    calls of the profile functions; with the taper's masses, 1.3-2.2 s of its 11-13 s, load ~4)."""
+    from .simulate import Body
+
+    if not any(callable(getattr(body, k)) for k in _BODY_PROFILES):
+        return body
+    kw = {k: body.node_values(k, h) if callable(getattr(body, k)) else getattr(body, k) for k in _BODY_PROFILES}
+    return Body(kw.pop("bending"), wind=body.wind, tip_drag=body.tip_drag, clamp=body.clamp, **kw)
 
 
 def method_for(problem_, tol: float, stiff_tol: float = None) -> tuple[str, float, float]:
@@ -215,11 +236,13 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
     """Whether the answer of :class:`Runs` ``runs`` on ``N`` links takes graded links
     (:func:`grading_rule`; ``present``: the line's mechanisms; ``graded``: "auto", True or False):
     only when the bending length is under :data:`GRADE_LINKS` links, the run without bending on N
-    links; when its fold stays under pi/2 at one node, the same on 2N links (does it narrow with them?);
-    when it does, the full run on N links (the uniform answer's own), and when that one's fold stays
-    under pi/2 too but the bending length is under one link, the full run on 2N links: a full run
-    whose fold does not narrow as the links halve is graded (the fly line at chi 0.25 on 100 links:
-    curvature peak x link 0.59 on 100, 0.76 on 200)."""
+    links; when its fold stays under pi/2 at one node, the full run on N links (the uniform answer's
+    own: graded when its fold reaches pi/2); when that one's stays under too, the run without bending
+    on 2N links (does its fold narrow with them? graded when not), and when it does but the bending
+    length is under one link, the full run on 2N links: a full run whose fold does not narrow as the
+    links halve is graded (the fly line at chi 0.25 on 100 links: curvature peak x link 0.59 on 100,
+    0.76 on 200). Graded when any of these says so, whatever the order they are asked in: the full
+    run on N is asked before the run without bending on 2N, which it makes moot when it collapses."""
     if graded is False or "bending" not in present:
         return {"used": False, "why": "off (graded=False)" if graded is False else "no bending"}
     lb = bending_length(runs.sp)
@@ -229,13 +252,17 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
     if 0.0 < lb < GRADE_LINKS / N:
         bare = tuple(m for m in present if m != "bending")
         kh = runs.get(bare, N)["kappa_peak"] / N
-        if kh < COLLAPSE:  # on links half as long: a fold above the links narrows with them (kappa h falls)
-            kh2 = runs.get(bare, 2 * N)["kappa_peak"] / (2 * N)
-            if kh2 < kh:  # it does: the full run (made anyway when not graded), its fold below the links?
-                kf = runs.get(tuple(present), N)["kappa_peak"] / N
-                if kf >= COLLAPSE:
-                    kh, kh2, where = kf, None, "with bending"
-                elif lb * N < 1.0:  # the bending length under one link: does the full run's fold narrow on 2N?
+        if kh < COLLAPSE:
+            # the full run (made anyway when not graded): its fold below the links? Asked before the run without
+            # bending on 2N links, which a full run that collapses makes moot (graded either way: the same
+            # answer, one run fewer; the fly line at chi 0.1: 0.4 s of CPU)
+            kf = runs.get(tuple(present), N)["kappa_peak"] / N
+            if kf >= COLLAPSE:
+                kh, kh2, where = kf, None, "with bending"
+            else:  # on links half as long: a fold above the links narrows with them (kappa h falls)
+                kh2 = runs.get(bare, 2 * N)["kappa_peak"] / (2 * N)
+                if kh2 < kh and lb * N < 1.0:  # it does, and the bending length is under one link: does the
+                    # full run's fold narrow on 2N?
                     kh, kh2, where = kf, runs.get(tuple(present), 2 * N)["kappa_peak"] / (2 * N), "with bending"
     used, why = grading_rule(lb, 1.0 / N, kh, where, halved=kh2)
     if used:

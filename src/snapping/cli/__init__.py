@@ -160,6 +160,9 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     args._explicit = _explicit_dests(argv)
     args._argv = list(sys.argv[1:] if argv is None else argv)  # (an interrupted run's resume command repeats it)
+    from ._interrupted import file_states
+
+    args._files_before = file_states(args)  # (an interruption outside a run's loop: what it left, file by file)
     import warnings
 
     restore = _on_sigterm_raise()
@@ -230,22 +233,9 @@ def _on_sigterm_raise():
 
 def _outside_run(args) -> str:
     """What an interruption outside a run's loop left behind (a run's loop says it itself)."""
-    import os
+    from ._interrupted import outside_run
 
-    out = getattr(args, "output", None)
-    if getattr(args, "_elastic_running", False):  # (the extensible line's solve, outside its checkpointed loop)
-        kept = (f"{out} is unchanged" if out and os.path.exists(out) else
-                f"nothing was written{f' ({out} does not exist)' if out else ''}")
-        ck = getattr(args, "checkpoint", None) or (args.resume if isinstance(args.resume, str) else None)
-        if ck is None:
-            return (f"during the extensible line's run, which keeps no checkpoint (no --checkpoint FILE) and cannot "
-                    f"be resumed: {kept}; run the command again")
-        had = (f"its checkpoint {ck} is kept as last saved: add --resume to the command to continue it"
-               if os.path.exists(ck) else f"no checkpoint was saved ({ck} does not exist): run the command again")
-        return f"during the extensible line's run, outside its step loop (where its checkpoint is saved): {kept}; {had}"
-    if args.command == "simulate" and out and not os.path.exists(out):
-        return f"before the run's first step: nothing was written ({out} does not exist); run the command again"
-    return "while starting up or finishing (outside a run's loop, where no checkpoint is taken)"
+    return outside_run(args)
 
 
 def _cli_words(msg: str) -> str:

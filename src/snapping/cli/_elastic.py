@@ -248,21 +248,38 @@ def _checkpoint_paths(args, method: str):
 
 def resume_command(args, path) -> str:
     """The command that continues this interrupted run: the one given, its --checkpoint and
-    --resume replaced by ``--checkpoint PATH --resume``."""
+    --resume replaced by ``--checkpoint PATH --resume``.
+
+    Built from the command line as argparse parsed it (parsed again from ``args._argv``, not from
+    its words), so any spelling argparse accepts is dropped or kept alike: an abbreviation
+    (``--checkp FILE``, ``--res``), ``--checkpoint=FILE``, ``--resume=FILE``, an option given
+    twice (the last counts). Every other option typed is kept (the resume checks the stored run
+    against them, and -o, --overwrite, --checkpoint-every, --json, --no-progress act again), in
+    the parser's order and its long spelling; a value that starts with '-' is written
+    ``--option=VALUE``."""
+    import argparse
     import shlex
 
-    argv, out, i = list(getattr(args, "_argv", None) or []), [], 0
-    while i < len(argv):
-        a = argv[i]
-        if a in ("--checkpoint", "--resume"):
-            takes = a == "--checkpoint" or (i + 1 < len(argv) and not argv[i + 1].startswith("-"))
-            i += 2 if takes else 1
+    from . import _explicit_dests, build_parser
+
+    argv = list(getattr(args, "_argv", None) or [])
+    parser = build_parser()
+    ns = parser.parse_args(argv)
+    typed = _explicit_dests(argv)
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[ns.command]
+    out = [ns.command]
+    for a in sub._actions:
+        if a.dest in ("help", "checkpoint", "resume") or a.dest not in typed or not a.option_strings:
             continue
-        if a.startswith(("--checkpoint=", "--resume=")):
-            i += 1
-            continue
-        out.append(a)
-        i += 1
+        opt = next((o for o in a.option_strings if o.startswith("--")), a.option_strings[0])
+        v = getattr(ns, a.dest)
+        if a.nargs == 0:  # (store_true: typed, so on)
+            out.append(opt)
+        elif a.nargs == "?" and v == a.const:
+            out.append(opt)
+        else:
+            text = str(v)
+            out.extend([f"{opt}={text}"] if text.startswith("-") or a.nargs == "?" else [opt, text])
     return "snapping " + shlex.join(out + ["--checkpoint", str(path), "--resume"])
 
 
@@ -300,7 +317,22 @@ def run_elastic(args, problem, elastic, times):
                       progress=False if getattr(args, "no_progress", False) else None)
         except ECK.CheckpointMismatch as exc:
             raise SnappingInputError(mismatch_words(exc, args)) from None
-        if out is not None:
+        if out is not None:  # (SIGINT/SIGTERM held while the finished run is written: then acted on)
             ds = r.dataset
-            _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
+            with ECK.Signals() as sigs:
+                _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
+            if sigs.signum is not None:
+                _reraise(sigs.signum)
     return r.summary(), r.dataset
+
+
+def _reraise(signum) -> None:
+    """The signal held while -o was written, raised now as its handler would have (SIGTERM: the
+    command's :class:`~snapping.cli._Terminated`; SIGINT: KeyboardInterrupt)."""
+    import signal
+
+    if signum == signal.SIGTERM:
+        from . import _Terminated
+
+        raise _Terminated()
+    raise KeyboardInterrupt

@@ -61,6 +61,7 @@ def _add_simulate(sub) -> None:
             "  snapping simulate --chi 0.3 --N 300 --method fast --gravity 0 --pin-motion pull:1,0\n"
             "  snapping simulate --chi 0.25 --N 300 --bending 1e-4 --drag-normal 2 --drag-tangential 0.04\n"
             "  snapping simulate --chi 0.3 --N 200 --bending 1e-3 --clamped 0 --wind 0.5,0 --t-end 1  # held out\n"
+            "  snapping simulate --chi 0.3 --N 40 --bending 1e-3 --drag-normal 2 --method rodas4 --drag-jacobian correct\n"
             "  snapping simulate --chi 0.25 --N 200 --length 2 --mass 0.02 --ei 1e-3 --diameter 1e-3  # SI body\n"
             "  snapping simulate --chi 0.25 --N 200 --line fly-line   # a real line (snapping.lines)\n"
             "\n"
@@ -103,6 +104,11 @@ def _add_simulate(sub) -> None:
                    choices=["fast", "dop853", "rodas4", "stiff", "euler-richardson", "euler-richardson-fixed",
                             "rodas4-links"],
                    help="time stepper (default: fast; every method is listed below)")
+    p.add_argument("--drag-jacobian", default=None, choices=["banded", "correct"],
+                   help="--method rodas4 (stiff) on a line with drag: its stage solves on the banded Jacobian, "
+                        "which leaves the drag out (banded, the default), or corrected once per stage for it "
+                        "(correct: one evaluation and one banded solve more per stage, far fewer steps when drag "
+                        "dominates); recorded in the run file and kept by --resume")
     p.add_argument("--dt0", type=float, default=None, help="initial (fixed method: constant) time step")
     p.add_argument("--t-end", type=float, default=None, help="end time (default: stop shortly after the snap)")
     p.add_argument("--stop-fraction", type=float, default=0.5,
@@ -192,6 +198,7 @@ def _cmd_simulate(args) -> int:
     elastic = elastic_from_args(args, scales)  # (None: the rigid-link chain)
     if elastic is None:
         check_rigid_checkpoint(args)
+    _check_drag_jacobian(args, elastic)
     if elastic is None and args.method == "rodas4-links":
         raise SnappingInputError("--method rodas4-links steps the extensible line only: give --ea, --stretching or "
                                  "--strain-table (the rigid chain's methods: fast, dop853, rodas4, stiff, "
@@ -247,6 +254,7 @@ def _cmd_simulate(args) -> int:
                 chords=args.chords if problem is None else None, output=args.output, progress=progress, max_link_error=args.max_link_error,
                 max_energy_drift=args.max_energy_drift, dt_min=args.dt_min, max_rejections=args.max_rejections,
                 checkpoint_every=args.checkpoint_every, overwrite=args.overwrite,
+                drag_jacobian=args.drag_jacobian or "banded",
             )
         summary, failed = result.summary(), None
     except simulate.RunInterrupted as exc:
@@ -307,6 +315,28 @@ def _cmd_simulate(args) -> int:
         print(f"snapping simulate: error: {failed}", file=sys.stderr)
         return 1
     return 0
+
+
+def _check_drag_jacobian(args, elastic) -> None:
+    """--drag-jacobian correct where it cannot apply, refused naming the option, its value and where
+    it does: the stage solves of --method rodas4 (stiff) on the rigid chain (or of --method fast where
+    it takes rodas4: the library's check). ``banded``, the default, is what every other run does."""
+    from .._validate import SnappingInputError
+    from .simulate3d import wants_3d
+
+    if getattr(args, "drag_jacobian", None) in (None, "banded"):
+        return
+    why = None
+    if elastic is not None:
+        why = "the extensible line (--ea/--stretching/--strain-table) has no drag (no body options are built for it)"
+    elif wants_3d(args):
+        why = "a 3D run (--dims 3, --perturb, --whirl) is stepped by DOP853, which has no stage solves"
+    elif args.resume is None and args.method in ("dop853", "euler-richardson", "euler-richardson-fixed"):
+        why = f"--method {args.method} is explicit and has no stage solves"
+    if why is not None:
+        raise SnappingInputError(f"--drag-jacobian {args.drag_jacobian}: {why}; the choices are banded (the "
+                                 f"default, every method) and correct (--method rodas4 or stiff on the rigid chain "
+                                 f"with a body, where drag enters its stage solves): leave out --drag-jacobian")
 
 
 def _simulate_elastic(args, problem, elastic, times, scales) -> int:
@@ -379,7 +409,7 @@ def _print_body(summary) -> None:
 # ------------------------------------------------------------------ --resume
 #: simulate options that define the run (with --resume: checked against the checkpoint)
 _RUN_OPTIONS = ("chi", "N", "tol", "method", "dt0", "t_end", "stop_fraction", "snapshot_times", "record_thin",
-                "chords", "max_link_error", "max_energy_drift", "dt_min", "max_rejections")
+                "chords", "max_link_error", "max_energy_drift", "dt_min", "max_rejections", "drag_jacobian")
 #: simulate options that define the problem: never with --resume (the checkpoint holds its problem)
 _PROBLEM_OPTIONS = ("tip_mass", "taper", "lumping", "supports", "shape", "pin_motion", "gravity", "bending", "damping",
                     "drag_normal", "drag_tangential", "drag_linear", "wind", "tip_drag", "clamp", "ei", "diameter",

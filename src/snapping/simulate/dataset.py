@@ -60,6 +60,7 @@ SUMMARY_KEYS = (
     "t_final", "dt_min_accepted", "n_steps", "n_rejected", "n_rhs", "wall_time", "snapping_version",
     "start", "tip_mass", "pin_motion", "gravity",  # (general problems only)
     "method_choice", "n_jacobians", "n_factorizations",  # (schema.METHOD_ATTRS: a body's method)
+    "drag_jacobian",  # (stored only when not the default, "banded")
     "min_tension", "t_compression",  # (files written before sigma_min existed have none)
     "start_rest",  # (problems with a body only)
 )

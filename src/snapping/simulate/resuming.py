@@ -65,12 +65,21 @@ class ResumeMismatch(V.SnappingInputError):
                          f"a resumed run continues the stored run; drop {name}, or start a new run")
 
 
+#: run inputs a file stores only when not their default (``inputs_from_attrs`` leaves them out)
+_UNSTORED_DEFAULTS = {"drag_jacobian": "banded"}
+
+
+def _stored(kw: dict, k: str):
+    """The stored run input ``k`` of ``kw`` (an unstored default: its default value)."""
+    return kw.get(k, _UNSTORED_DEFAULTS.get(k))
+
+
 def _mismatch(kw: dict, expected: dict) -> str | None:
     """The first key of ``expected`` whose value differs from the run inputs ``kw`` (None: all agree)."""
     for k, v in expected.items():
         if v is None or k in ("output", "progress", "checkpoint_every", "overwrite"):
             continue
-        have = kw.get(k)
+        have = _stored(kw, k)
         if k == "method":  # files name the method it stands for
             v = M.resolve(v) if v in D.METHODS else v
         if k == "snapshot_times":
@@ -189,7 +198,7 @@ def resume(path, *, output=None, progress: bool | None = False,
                                        f"({type(exc).__name__}: {exc})") from None
         bad = _mismatch(kw, dict(expect or {}))
         if bad is not None:
-            raise ResumeMismatch(bad, expect[bad], kw.get(bad), p)
+            raise ResumeMismatch(bad, expect[bad], _stored(kw, bad), p)
         need = check_memory(N, opts, chi=chi, method=kw["method"])
         out = check_writable(out, overwrite=True if own else overwrite, need_bytes=need["file_bytes"])
         inputs, eng = M.method(kw["method"]).setup(chi, N, kw["method"], opts, chords=kw["chords"],
