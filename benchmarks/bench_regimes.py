@@ -19,6 +19,7 @@ Usage::
     python benchmarks/bench_regimes.py --study end-mass --workers 1
     python benchmarks/bench_regimes.py --extend bending --seed benchmarks/results/bendconv_chi0.*.json
     python benchmarks/bench_regimes.py --cost end-mass
+    python benchmarks/bench_regimes.py --study drag --escalate-from old_drag.nc   # the 3-level file's runs, then --study
     python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
     python benchmarks/bench_regimes.py --study stretching --chis 0.1 --out lo.nc   # a part (some chi) ...
@@ -39,8 +40,21 @@ DATA = os.path.join(HERE, "..", "src", "snapping", "data", "regimes")
 
 #: the shipped studies: chi, numbers, and the regimes() settings
 STUDIES = {
-    "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-5, 1.0, 8), "accuracy": "medium"},
-    "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium"},
+    # end-mass and drag: 3 fold levels (-1 ... 1) as shipped before, escalated (branch dragesc): a cell (or the ideal
+    # at a chi) whose v/a/sigma_peak bar is over 1% runs one more level, up to 2 more (the ideal's own a_peak at
+    # chi 0.1 is +-5% on 3 levels, +-2% on 4); `--escalate-from OLD` seeds the file with the 3-level study's runs.
+    # A cell whose last level took more than 600,000 evaluations is not escalated (escalate_max_rhs; marked
+    # escalation_capped): end mass 0.0072 at chi 0.1 took 987,000 at level 3 (7,328 links, 217 s CPU), its level 4
+    # would take ~700 s; 0.0193 took 1,039,000 at level 2
+    # (the end-mass numbers: the shipped file's since d50abbc; this dict said geomspace(1e-5, 1, 8), not what shipped)
+    "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.array([1.93e-6, 1e-5, 5.18e-5, 2.68e-4, 1.39e-3,
+                                                                    7.2e-3, 0.0193, 0.0373]), "accuracy": "medium",
+                 "levels": 3, "escalate": 0.01, "extra_levels": 2, "escalate_max_rhs": 600_000},
+    # drag: the escalation capped at 600,000 evaluations a run (escalate_max_rhs): the heavy-drag cells (d = 10 at chi
+    # 0.3, 0.5: 3.1e6, 3.9e6 at level 2, their tail compressed and crumpled, peaks growing with the links) are left
+    # at 3 levels and marked escalation_capped; every other drag run takes <= 82,000 evaluations at level 2
+    "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium",
+             "levels": 3, "escalate": 0.01, "extra_levels": 2, "escalate_max_rhs": 600_000},
     # bending: 4 levels (frac 0.08-0.01; was 3 to 0.02, whose small-beta cells at chi 0.1-0.2 sat before their
     # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
@@ -226,6 +240,52 @@ def reuse(old_path: str, out: str) -> None:
     print(f"stretching: {copied} runs copied from {old_path} into {out} (c <= {STRETCH_TOL_C:g} and the ideal's)")
 
 
+def escalate_from(mech: str, old_path: str, out=None) -> None:
+    """Start the escalating study of ``mech`` (STUDIES: ``escalate``, ``extra_levels``) in ``out``
+    (default the shipped file) with the runs of ``old_path``, the same study without escalation (its
+    key equal to the new one less ``escalate`` and ``extra_levels``): every run it holds is one of the
+    new study's base levels (the same links, tolerance and method), copied; then ``--study MECH``
+    runs only the levels the error bars ask for."""
+    import json
+
+    from snapping import regimes as R
+    from snapping.sweep_files import atomic_to_netcdf
+
+    s = dict(STUDIES[mech])
+    chis, numbers = sorted(s.pop("chis")), _numbers(s.pop("numbers"), s.pop("exact", False))
+    acc = dict(R.ACCURACY[s.pop("accuracy")])
+    acc.update(s)
+    if "escalate" not in acc or mech in ("bending", "stretching"):
+        raise SystemExit(f"--escalate-from: {mech} is not an escalating drag/end-mass study in STUDIES")
+    acc["escalate"], acc["extra_levels"] = float(acc["escalate"]), int(acc["extra_levels"])
+    old = R.load_study(old_path)
+    want = json.loads(R._study_key(mech, chis, numbers, acc, 0.5))
+    have = json.loads(old.attrs["regimes_study"])
+    esc = ("escalate", "extra_levels", "escalate_max_rhs")
+    if ({k: v for k, v in have.items() if k not in esc} != {k: v for k, v in want.items() if k not in esc}
+            or any(k in have and have[k] != want[k] for k in esc[:2])):
+        raise SystemExit(f"{old_path} is not this study (escalated or not, under any cap): {have} against {want}")
+    every = dict(acc, levels=acc["levels"] + acc["extra_levels"])
+    grading = R.MECHANISMS[mech][1]
+    ds = R._empty(mech, chis, numbers, R._levels(grading, every, 0.5), R._levels("fold", every, 0.5),
+                  R._study_key(mech, chis, numbers, acc, 0.5), acc, 0.5)
+    nl = old.sizes["level"]
+    assert np.allclose(ds.resolution.values[:nl], old.resolution.values, rtol=1e-12)
+    for name in [v for v in old.data_vars if v.endswith("_level") and v in ds]:
+        ds[name].values[..., :nl] = old[name].values
+    if "escalate_max_rhs" in acc:  # an escalated level copied must be one this cap lets the study run
+        from snapping.regimes_escalate import prefix
+
+        for row in ds.n_rhs_level.values.reshape(-1, ds.sizes["level"]):
+            n = prefix(row)
+            if n > acc["levels"] and np.any(row[acc["levels"] - 1:n - 1] > acc["escalate_max_rhs"]):
+                raise SystemExit(f"{old_path}: a cell escalated past the cap {acc['escalate_max_rhs']}: not this study")
+    out = out or os.path.join(DATA, f"{mech}.nc")
+    atomic_to_netcdf(R._finish(ds), out)
+    copied = int(np.isfinite(ds.v_peak_level.values).sum() + np.isfinite(ds.v_peak_ideal_level.values).sum())
+    print(f"{mech}: {copied} runs copied from {old_path} into {out}; --study {mech} escalates")
+
+
 def cost(mech: str, path=None) -> dict:
     """What a study file's scan cost (CPU s, evaluations), by level and chi, and its error bars."""
     from snapping.regimes import load_study
@@ -244,6 +304,13 @@ def cost(mech: str, path=None) -> dict:
     for i, chi in enumerate(ds.chi.values):
         print(f"  chi {chi:g}: CPU {np.nansum(cpu[i]) + np.nansum(ic[i]):7.1f} s; per number "
               + " ".join(f"{x:.0f}" for x in np.nansum(cpu[i], axis=-1)))
+    if "levels_run" in ds:  # an escalating study: the levels each cell ran, and those the cost cap stopped
+        print(f"  levels run (escalated): cells {np.bincount(ds.levels_run.values.ravel()).tolist()} (count by levels), "
+              f"ideal {ds.levels_run_ideal.values.tolist()}")
+    if "escalation_capped" in ds:
+        cc = np.argwhere(ds.escalation_capped.values == 1)
+        print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level): "
+              + (", ".join(f"chi {ds.chi.values[i]:g} number {ds.number.values[j]:g}" for i, j in cc) or "none"))
     worst = {}
     for q in ("v_peak", "a_peak", "sigma_peak"):
         if q not in ds:
@@ -392,6 +459,8 @@ def main(argv=None) -> None:
     ap.add_argument("--merge", nargs="+", default=None, help="part study files to merge into the shipped --cost/--study MECH")
     ap.add_argument("--reuse", default=None, metavar="OLD",
                     help="start --out with the same runs of an earlier stretching study file OLD (before tol_c)")
+    ap.add_argument("--escalate-from", default=None, metavar="OLD",
+                    help="start --study MECH's escalating file (or --out) with the runs of OLD, its study unescalated")
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
                     "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
@@ -420,6 +489,8 @@ def main(argv=None) -> None:
         merge(a.study, a.merge)
     elif a.reuse:
         reuse(a.reuse, a.out)
+    elif a.study and a.escalate_from:
+        escalate_from(a.study, a.escalate_from, a.out)
     elif a.study:
         study(a.study, a.workers, [float(x) for x in a.chis.split(",")] if a.chis else None, a.out, a.levels)
     if a.extend:

@@ -340,7 +340,8 @@ def _finish(ds: xr.Dataset) -> xr.Dataset:
 def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: int | None = None,
             first: int | None = None, n0: int | None = None, ratio: float = 0.5, tol: float | None = None,
             damping: float | None = None, start: str = STRETCH_START, method: str | None = None, workers: int = 1, scheduler=None, out=None,
-            progress: bool = True, escalate: float | None = None, extra_levels: int | None = None) -> xr.Dataset:
+            progress: bool = True, escalate: float | None = None, extra_levels: int | None = None,
+            escalate_max_rhs: int | None = None) -> xr.Dataset:
     """Continuum-extrapolated peaks of the snap over chi x one mechanism's number.
 
     Parameters
@@ -385,6 +386,9 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         A cell whose v_peak, a_peak or sigma_peak error bar is above this fraction of its limit runs
         one more level, up to ``extra_levels`` (default 1) more (:mod:`snapping.regimes_escalate`; the
         ideal at that chi too). Both are in the study's key. None (the default): every cell runs ``levels``.
+    escalate_max_rhs : int, optional
+        With ``escalate``: a cell whose last level took more right-hand-side evaluations is not escalated
+        (marked ``escalation_capped``; in the study's key). None (the default): no cap.
 
     Returns
     -------
@@ -446,8 +450,11 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     if escalate is not None:
         acc["escalate"] = V.open_interval("escalate", escalate, 0.0, 1.0)
         acc["extra_levels"] = V.integer("extra_levels", 1 if extra_levels is None else extra_levels, 1, 4)
-    elif extra_levels is not None:
-        raise V.SnappingInputError(f"extra_levels={extra_levels!r}: give it with escalate (the error bar that asks for them)")
+        if escalate_max_rhs is not None:
+            acc["escalate_max_rhs"] = V.integer("escalate_max_rhs", escalate_max_rhs, 1)
+    elif extra_levels is not None or escalate_max_rhs is not None:
+        raise V.SnappingInputError(f"extra_levels={extra_levels!r}, escalate_max_rhs={escalate_max_rhs!r}: give "
+                                   f"them with escalate (the error bar that asks for more levels)")
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]
@@ -580,7 +587,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             while "escalate" in acc:  # the cells over the target run their next level, round by round
                 from .regimes_escalate import next_round
 
-                more = next_round(ds, acc["escalate"], acc["levels"], tried)
+                more = next_round(ds, acc["escalate"], acc["levels"], tried, acc.get("escalate_max_rhs"))
                 if not more:
                     break
                 add_calls(more)

@@ -27,7 +27,7 @@ import numpy as np
 
 from .continuum import extrapolate
 
-__all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "pending", "next_round",
+__all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "too_costly", "pending", "next_round",
            "mark_levels_run"]
 
 #: the peaks whose error bars decide an escalation
@@ -65,9 +65,25 @@ def over_target(res, rows: dict, base: int, target: float) -> bool:
     return False
 
 
-def pending(ds, target: float, base: int) -> list[tuple]:
+def too_costly(n_rhs_row, max_rhs) -> bool:
+    """Whether a cell's last done level (the leading finite values of ``n_rhs_row``) took more than
+    ``max_rhs`` right-hand-side evaluations: its next level (twice the links at least) is not run.
+    ``max_rhs`` None: no cap (False).
+
+    >>> too_costly([1e4, 3e5, 4e6, float("nan")], 1e6), too_costly([1e4, 3e5], 1e6), too_costly([4e6], None)
+    (True, False, False)
+    """
+    if max_rhs is None:
+        return False
+    row = np.asarray(n_rhs_row, dtype=float)
+    n = prefix(row)
+    return bool(n > 0 and row[n - 1] > max_rhs)
+
+
+def pending(ds, target: float, base: int, max_rhs=None) -> list[tuple]:
     """The runs an escalating study still owes: ``(chi index, number index or None for the ideal,
-    level index)``, each the next level of a cell (or ideal) whose base levels are all done."""
+    level index)``, each the next level of a cell (or ideal) whose base levels are all done.
+    ``max_rhs``: a cell whose last level took more evaluations is not escalated (:func:`too_costly`)."""
     nl = ds.sizes["level"]
     res = ds.resolution.values
     out = []
@@ -78,7 +94,8 @@ def pending(ds, target: float, base: int) -> list[tuple]:
             if n < base:
                 continue
             rows = {q: ds[f"{q}_level"].values[i, j] for q in ESCALATE_QUANTITIES}
-            if n < nl and over_target(res, rows, base, target):
+            if (n < nl and over_target(res, rows, base, target)
+                    and not (max_rhs is not None and too_costly(ds["n_rhs_level"].values[i, j], max_rhs))):
                 out.append((i, j, n))
                 n += 1
             want = max(want, n)
@@ -90,10 +107,10 @@ def pending(ds, target: float, base: int) -> list[tuple]:
     return out
 
 
-def next_round(ds, target: float, base: int, tried: set) -> list[tuple]:
+def next_round(ds, target: float, base: int, tried: set, max_rhs=None) -> list[tuple]:
     """The runs of the next round of escalation: :func:`pending` less those in ``tried`` (a failed
     run leaves its level owed; it is not tried again in the same call), added to ``tried``."""
-    more = [m for m in pending(ds, target, base) if m not in tried]
+    more = [m for m in pending(ds, target, base, max_rhs) if m not in tried]
     tried.update(more)
     return more
 
@@ -105,4 +122,18 @@ def mark_levels_run(ds, base: int) -> bool:
                                                     dtype=np.int8),
                         {"long_name": "levels the cell ran (the base, plus those its error bars asked for)"})
     ds["levels_run_ideal"] = ("chi", np.array([prefix(r) for r in ds["v_peak_ideal_level"].values], dtype=np.int8))
-    return bool(pending(ds, float(ds.attrs["escalate"]), base))
+    max_rhs = ds.attrs.get("escalate_max_rhs")
+    if max_rhs is not None:  # the cells over the target that the cap left at their levels (their cost)
+        target, res, nl = float(ds.attrs["escalate"]), ds.resolution.values, ds.sizes["level"]
+
+        def capped(i, j):
+            n = prefix(ds["v_peak_level"].values[i, j])
+            rows = {q: ds[f"{q}_level"].values[i, j] for q in ESCALATE_QUANTITIES}
+            return (base <= n < nl and too_costly(ds["n_rhs_level"].values[i, j], max_rhs)
+                    and over_target(res, rows, base, target))
+
+        ds["escalation_capped"] = (("chi", "number"), np.array(
+            [[capped(i, j) for j in range(ds.sizes["number"])] for i in range(ds.sizes["chi"])], dtype=np.int8),
+            {"long_name": f"1: the cell's error bars are over the target but its last level took more than "
+                          f"{int(max_rhs)} evaluations: not escalated (not converged to the target)"})
+    return bool(pending(ds, float(ds.attrs["escalate"]), base, max_rhs))
