@@ -29,17 +29,15 @@ Mechanisms (:data:`MECHANISMS`) and their resolutions:
 * ``end-mass``: a point mass ``M_end / (lambda L)`` at the free end (``tip_mass``); fold-following graded chains.
 * ``stretching``: the extensible line (:func:`snapping.simulate.elastic.solve`, from the start
   ``start``, default ``STRETCH_START`` = ``"matched"``: at rest at the catenary, stretched to the
-  rigid chain's tensions just after release, so that no release wave rings; ``"stretched"``, the
-  hanging equilibrium let go, was the study of stop 29) of wave speed c; the number scanned is the
-  *inverse* stretching number ``sqrt(g L)/c`` (so that number -> 0 is the inextensible
-  ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4 (``STRETCH_METHOD``:
+  rigid chain's tensions just after release, so that no release wave rings; or ``"stretched"``) of wave
+  speed c; the number scanned is the *inverse* stretching number ``sqrt(g L)/c`` (number -> 0 is the
+  inextensible ideal, as for the other mechanisms); fold-following graded levels. Run with RODAS4 (``STRETCH_METHOD``:
   in link coordinates by default, the shipped study's; ``method="rodas4"`` in node coordinates) and the
   elastic grid damping ``damping`` (the shortest longitudinal mode's damping ratio, a link damping
   ``zeta h sqrt(EA lambda)`` vanishing with h, so the continuum extrapolation removes it), its acceleration
   and tension peaks the snap's (``a_peak_snap``, ``sigma_peak_snap``: :mod:`snapping.simulate.snap_window`;
   the key says ``"peaks": "snap"``), the stop rule armed at ``STRETCH_STOP_FLOOR``
-  (:mod:`snapping.regimes_spec`): undamped, the release's ringing of the fold-graded tip links costs 6.8 M
-  evaluations for one coarse cell (chi = 0.3, c = 30, 108 links) and puts the acceleration peak at 2.9e6.
+  (:mod:`snapping.regimes_spec` says why each setting: undamped, the tip links ring).
 
 One task per (cell, level) run, on local processes (:func:`snapping._workers.run_all`) or a Dask
 cluster (``scheduler``). The study file ``out`` is rewritten (atomically) after every run: a rerun
@@ -354,7 +352,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         The mechanism's number (:mod:`snapping.dimensionless`), each > 0 (the ideal, 0, is
         always computed, fold-graded).
     accuracy : str
-        A preset of :data:`ACCURACY` (``coarse``: 3 fold-graded levels, 193-639 links at chi = 0.25; uniform 50-200).
+        A preset of :data:`ACCURACY` (``coarse``: 3 fold-graded levels, 193-639 links at chi = 0.25).
     levels, first, n0, tol
         Override the preset: refinement levels, the first fold-graded level (as
         :func:`snapping.continuum.level_parameters`), links of the first uniform level, the
@@ -366,14 +364,11 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         see the module; 0: none, the fast method's choice instead of RODAS4). Stretching: the
         elastic grid damping ratio of the shortest longitudinal mode (default ``STRETCH_DAMPING``, 4).
     start : {"matched", "stretched", "unstretched"}
-        Stretching only: the elastic line's start (:func:`snapping.simulate.elastic.solve`),
-        stored as the attribute ``elastic_start`` (and, other than ``"stretched"``, in the
-        study's key: a stop-29 file, run from ``"stretched"``, is resumed by that value).
+        Stretching only: the elastic line's start (:func:`snapping.simulate.elastic.solve`), attribute
+        ``elastic_start`` (in the study's key unless ``"stretched"``, so a stop-29 file resumes).
     method : {"rodas4", "rodas4-links"}, optional
-        Stretching only: the elastic line's method (default ``STRETCH_METHOD``, ``"rodas4-links"``, the
-        shipped study's: RODAS4 in link coordinates, steps not capped by c; ``"rodas4"``: node coordinates,
-        the study shipped before). Stored as the
-        attribute ``elastic_method`` and in the study's key (a file of the other method is refused).
+        Stretching only: the elastic line's method (default ``STRETCH_METHOD``, ``"rodas4-links"``: RODAS4 in
+        link coordinates; ``"rodas4"``: node coordinates). Attribute ``elastic_method``, in the study's key.
     workers : int
         Local worker processes (the sweep's, :mod:`snapping._workers`).
     scheduler : str or dask.distributed.Client, optional
@@ -447,14 +442,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
     elif method is not None:
         raise V.SnappingInputError(f"method={method!r}: the elastic method is for the stretching mechanism only, "
                                    f"not {mechanism!r}")
-    if escalate is not None:
-        acc["escalate"] = V.open_interval("escalate", escalate, 0.0, 1.0)
-        acc["extra_levels"] = V.integer("extra_levels", 1 if extra_levels is None else extra_levels, 1, 4)
-        if escalate_max_rhs is not None:
-            acc["escalate_max_rhs"] = V.integer("escalate_max_rhs", escalate_max_rhs, 1)
-    elif extra_levels is not None or escalate_max_rhs is not None:
-        raise V.SnappingInputError(f"extra_levels={extra_levels!r}, escalate_max_rhs={escalate_max_rhs!r}: give "
-                                   f"them with escalate (the error bar that asks for more levels)")
+    from .regimes_escalate import settings
+    acc.update(settings(escalate, extra_levels, escalate_max_rhs))
     workers = V.integer("workers", workers, 1)
     if isinstance(chis, (int, float)):
         chis = [chis]

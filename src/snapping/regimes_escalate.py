@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from . import _validate as V
 from .continuum import extrapolate
 
 __all__ = ["ESCALATE_QUANTITIES", "prefix", "extrapolate_prefix", "over_target", "too_costly", "pending", "next_round",
@@ -137,3 +138,23 @@ def mark_levels_run(ds, base: int) -> bool:
             {"long_name": f"1: the cell's error bars are over the target but its last level took more than "
                           f"{int(max_rhs)} evaluations: not escalated (not converged to the target)"})
     return bool(pending(ds, float(ds.attrs["escalate"]), base, max_rhs))
+
+
+def settings(escalate, extra_levels, escalate_max_rhs) -> dict:
+    """The escalation's entries of a study's key (validated; none without ``escalate``).
+
+    >>> settings(0.01, None, None)
+    {'escalate': 0.01, 'extra_levels': 1}
+    >>> settings(None, None, None)
+    {}
+    """
+    if escalate is None:
+        if extra_levels is not None or escalate_max_rhs is not None:
+            raise V.SnappingInputError(f"extra_levels={extra_levels!r}, escalate_max_rhs={escalate_max_rhs!r}: give "
+                                       f"them with escalate (the error bar that asks for more levels)")
+        return {}
+    out = {"escalate": V.open_interval("escalate", escalate, 0.0, 1.0),
+           "extra_levels": V.integer("extra_levels", 1 if extra_levels is None else extra_levels, 1, 4)}
+    if escalate_max_rhs is not None:
+        out["escalate_max_rhs"] = V.integer("escalate_max_rhs", escalate_max_rhs, 1)
+    return out
