@@ -162,3 +162,22 @@ def test_option_validated_stored_and_read_back(tmp_path):
     assert a.attrs["n_steps"] < b.attrs["n_steps"]  # (the drag's Jacobian in the stages: fewer steps)
     c = rerun(a).dataset
     np.testing.assert_array_equal(a.v_max.values, c.v_max.values)
+
+
+def test_correct_refused_where_nothing_to_correct_or_no_stage_solves():
+    """(review) 'correct' on a line without drag would double the work for nothing: refused, naming what is 0;
+    'fast' that steps the problem with dop853 is named as such (not as 'this run's method is fast')."""
+    for body in (Body(bending=1e-3), Body(bending=1e-3, damping=1e-4)):
+        with pytest.raises(SnappingInputError, match="has none .*drag_normal.*tip_drag all 0.*banded"):
+            run(Problem.catenary(0.3, 10, body=body), method="rodas4", t_end=0.01, drag_jacobian="correct")
+    for p in (Problem.catenary(0.3, 10, body=Body(drag_normal=1.0)), None):
+        args = (p,) if p is not None else (0.3, 8)
+        with pytest.raises(SnappingInputError, match="method='fast' steps this problem with 'dop853': give "
+                                                     "method='rodas4'"):
+            run(*args, method="fast", t_end=0.01, drag_jacobian="correct")
+    with pytest.raises(SnappingInputError, match="this run's method is 'dop853'"):
+        run(0.3, 8, method="dop853", t_end=0.01, drag_jacobian="correct")
+    for body in (Body(drag_normal=1.0), Body(tip_drag=0.5, bending=1e-4)):  # drag of either kind: accepted
+        r = run(Problem.catenary(0.3, 10, body=body), method="rodas4", t_end=0.01, drag_jacobian="correct",
+                progress=False)
+        assert r.dataset.attrs["drag_jacobian"] == "correct"

@@ -174,3 +174,14 @@ def test_shipped_bending_study_keeps_the_snaps_peaks():
     a = ds.a_peak_level.sel(chi=0.5, number=0.01).values
     a = a[np.isfinite(a)]
     assert a.size >= 4 and np.all(np.abs(np.diff(a)) <= 0.05 * a[1:]) and a[0] < 20.0
+
+
+def test_release_start_ignores_nan_and_a_late_peak_time():
+    """(review) a NaN speed record does not void the window (it was all-False, start 0, the release kept), and a
+    peak time past the recorded peak does not move the start after it: by hand, the last record before the
+    recorded peak (index 3) below half its speed."""
+    t = np.arange(7.0)
+    v = np.array([0.0, np.nan, 0.3, 1.0, 0.6, 0.2, 0.1])
+    assert release_start(t, v, 3.0) == 2
+    assert release_start(t, v, 6.5) == 2   # (searched past index 3 the start would be 6)
+    assert release_start(t, np.full(7, np.nan), 3.0) == 0

@@ -255,7 +255,9 @@ def grading_for(runs, N: int, present: list, graded="auto") -> dict:
         if kh < COLLAPSE:
             # the full run (made anyway when not graded): its fold below the links? Asked before the run without
             # bending on 2N links, which a full run that collapses makes moot (graded either way: the same
-            # answer, one run fewer; the fly line at chi 0.1: 0.4 s of CPU)
+            # decision, one run fewer; the fly line at chi 0.1: 0.4 s of CPU; the reported collapse is then the
+            # full run's). When neither collapses and the bare fold does not narrow on 2N, graded too, and this
+            # uniform full run was one run more than before (the nylon line at chi 0.2 on 100 links)
             kf = runs.get(tuple(present), N)["kappa_peak"] / N
             if kf >= COLLAPSE:
                 kh, kh2, where = kf, None, "with bending"

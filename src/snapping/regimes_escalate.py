@@ -149,9 +149,11 @@ def settings(escalate, extra_levels, escalate_max_rhs) -> dict:
     {}
     """
     if escalate is None:
-        if extra_levels is not None or escalate_max_rhs is not None:
-            raise V.SnappingInputError(f"extra_levels={extra_levels!r}, escalate_max_rhs={escalate_max_rhs!r}: give "
-                                       f"them with escalate (the error bar that asks for more levels)")
+        given = [f"{k}={v!r}" for k, v in (("extra_levels", extra_levels), ("escalate_max_rhs", escalate_max_rhs))
+                 if v is not None]
+        if given:
+            raise V.SnappingInputError(f"{', '.join(given)}: give {'it' if len(given) == 1 else 'them'} with escalate "
+                                       f"(the error bar that asks for more levels)")
         return {}
     out = {"escalate": V.open_interval("escalate", escalate, 0.0, 1.0),
            "extra_levels": V.integer("extra_levels", 1 if extra_levels is None else extra_levels, 1, 4)}

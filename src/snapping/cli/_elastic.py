@@ -252,7 +252,7 @@ def resume_command(args, path) -> str:
 
     Built from the command line as argparse parsed it (parsed again from ``args._argv``, not from
     its words), so any spelling argparse accepts is dropped or kept alike: an abbreviation
-    (``--checkp FILE``, ``--res``), ``--checkpoint=FILE``, ``--resume=FILE``, an option given
+    (``--res``, ``--resu FILE``), ``--checkpoint=FILE``, ``--resume=FILE``, an option given
     twice (the last counts). Every other option typed is kept (the resume checks the stored run
     against them, and -o, --overwrite, --checkpoint-every, --json, --no-progress act again), in
     the parser's order and its long spelling; a value that starts with '-' is written

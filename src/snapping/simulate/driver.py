@@ -152,11 +152,14 @@ def _validate_start(chi, N, method, chords, initial, problem):
     return chi, N
 
 
-def _check_drag_jacobian(opts, method: str) -> None:
-    """SnappingInputError for ``drag_jacobian`` other than the default on a method without stage solves."""
+def _check_drag_jacobian(opts, method: str, asked: str | None = None) -> None:
+    """SnappingInputError for ``drag_jacobian`` other than the default on a method without stage solves
+    (``asked``: the method asked for; 'fast', what it steps this problem with is said)."""
     if opts.drag_jacobian != "banded" and method not in ("rodas4", "stiff"):
+        how = (f"method='fast' steps this problem with {M.resolve(method)!r}: give method='rodas4' or"
+               if "fast" in (asked, method) else f"this run's method is {method!r}:")
         raise V.SnappingInputError(f"drag_jacobian={opts.drag_jacobian!r} is an option of method='rodas4' (stiff) "
-                                   f"only; this run's method is {method!r}: leave drag_jacobian='banded'")
+                                   f"only; {how} leave drag_jacobian='banded'")
 
 
 def run(
@@ -334,12 +337,13 @@ def run(
     """
     chi, N, chords, initial, problem = _resolve_problem(chi, N, chords, initial, problem, method)
     chi, N = _validate_start(chi, N, method, chords, initial, problem)
+    asked = method
     method, choice = _choose(method, problem, tol, t_end)
     opts = RunOptions(tol=default_tol(method) if tol is None else tol, dt0=dt0, t_end=t_end, stop_fraction=stop_fraction, t_end_max=t_end_max,
                       snapshot_times=snapshot_times, record_thin=record_thin, max_link_error=max_link_error,
                       max_energy_drift=max_energy_drift, dt_min=dt_min, max_rejections=max_rejections,
                       drag_jacobian=drag_jacobian)
-    _check_drag_jacobian(opts, method)
+    _check_drag_jacobian(opts, method, asked)
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     progress = check_progress(progress)
     method_ = M.method(method)
@@ -377,11 +381,12 @@ def check_inputs(chi=None, N=None, **options) -> dict:
     chi, N, chords, initial, problem = _resolve_problem(chi, N, kw["chords"], kw["initial"], kw["problem"],
                                                         kw["method"])
     chi, N = _validate_start(chi, N, kw["method"], chords, initial, problem)
+    asked = kw["method"]
     kw["method"], _ = _choose(kw["method"], problem, kw["tol"], kw["t_end"])
     if kw["tol"] is None:
         kw["tol"] = default_tol(kw["method"])
     opts = M.method(kw["method"]).complete(RunOptions.pick(kw), kw["method"])
-    _check_drag_jacobian(opts, kw["method"])
+    _check_drag_jacobian(opts, kw["method"], asked)
     check_checkpoint_every(kw["checkpoint_every"])
     check_progress(kw["progress"])
     need = check_memory(N, opts, chi=chi, method=kw["method"])

@@ -150,14 +150,24 @@ def taut_peaks(t, v, n_slack, cols: dict, run_peaks: dict, t_peak, fraction: flo
 def release_start(t, v, t_peak, fraction: float = RELEASE_FRACTION) -> int:
     """Index of the first recorded step of the snap without the release: the last step before the speed
     peak (before the first recorded time >= ``t_peak``) whose speed ``v`` is below ``fraction`` times the
-    peak (the largest of ``v``); 0 if none (or no peak time)."""
+    peak (the largest of ``v``, NaN ignored; searched no later than the recorded peak); 0 if none (or no
+    peak time).
+
+    >>> release_start([0, 1, 2, 3, 4, 5], [0.0, float("nan"), 0.4, 1.0, 0.6, 0.4], 3.0)
+    2
+    >>> release_start([0, 1, 2, 3], [0.0, 0.2, 1.0, 0.3], 9.0)   # (t_peak past the records)
+    1
+    """
     t, v = np.asarray(t, dtype=float), np.asarray(v, dtype=float)
     if t.size == 0:
         raise ValueError("no recorded steps")
     if not np.isfinite(t_peak):
         return 0
-    ip = int(np.searchsorted(t, t_peak, side="left"))
-    below = np.flatnonzero(v[:ip] < fraction * max(float(np.max(v)), 0.0))
+    if not np.any(np.isfinite(v)):
+        return 0
+    k = int(np.nanargmax(v))  # (the recorded peak: a t_peak past it, or past the records, does not move the start)
+    ip = min(int(np.searchsorted(t, t_peak, side="left")), k + 1)
+    below = np.flatnonzero(v[:ip] < fraction * max(float(v[k]), 0.0))
     return 0 if below.size == 0 else int(below[-1])
 
 

@@ -220,6 +220,10 @@ def setup(chi, N, method: str, opts, *, chords: str = "exact", initial=None, pro
     DP._warm_up()
     _warm_up()
     eng = Engine(y0, 0.0, mdl=problem.model(), **opts.engine_kwargs())
+    if opts.drag_jacobian == "correct" and eng.rp[RB.RP_DRAG] == 0.0:  # (nothing to correct: twice the work)
+        raise V.SnappingInputError("drag_jacobian='correct' corrects RODAS4's stage solves for air drag, and this "
+                                   "line has none (drag_normal, drag_tangential, drag_linear_normal, "
+                                   "drag_linear_tangential and tip_drag all 0): leave drag_jacobian='banded'")
     eng.rp[RB.RP_DCORR] = 1.0 if opts.drag_jacobian == "correct" else 0.0
     inputs["dt0"] = eng.dt0
     return inputs, eng
