@@ -281,9 +281,27 @@ def escalate_from(mech: str, old_path: str, out=None) -> None:
             if n > acc["levels"] and np.any(row[acc["levels"] - 1:n - 1] > acc["escalate_max_rhs"]):
                 raise SystemExit(f"{old_path}: a cell escalated past the cap {acc['escalate_max_rhs']}: not this study")
     out = out or os.path.join(DATA, f"{mech}.nc")
+    if os.path.exists(out):  # a file there keeps every run it holds, or it is not overwritten
+        lost = _runs_lost(R.load_study(out), ds)
+        if lost:
+            raise SystemExit(f"--escalate-from: {out} holds {lost} runs that {old_path} does not (an escalated "
+                             f"study's?): not overwritten; give --out another file or move it away")
     atomic_to_netcdf(R._finish(ds), out)
     copied = int(np.isfinite(ds.v_peak_level.values).sum() + np.isfinite(ds.v_peak_ideal_level.values).sum())
     print(f"{mech}: {copied} runs copied from {old_path} into {out}; --study {mech} escalates")
+
+
+def _runs_lost(cur, ds) -> int:
+    """How many of the runs (finite v_peak of a cell or the ideal at a level) of the study file ``cur``
+    the study ``ds`` would not hold, equal, if written over it."""
+    lost = 0
+    for name in ("v_peak_level", "v_peak_ideal_level"):
+        a = cur[name].values if name in cur else np.array([])
+        same = (cur.sizes.get("chi") == ds.sizes["chi"] and a.shape[:-1] == ds[name].shape[:-1]
+                and a.shape[-1] <= ds.sizes["level"])
+        b = ds[name].values[..., :a.shape[-1]] if same else None
+        lost += int(np.sum(np.isfinite(a) & ~(a == b))) if same else int(np.sum(np.isfinite(a)))
+    return lost
 
 
 def cost(mech: str, path=None) -> dict:
