@@ -63,7 +63,7 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, level_parameters
-from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
+from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, CHAIN_EXTRA_PEAKS, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
                            STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
@@ -195,7 +195,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     if a.get("status") != "completed":
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
                            f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
-    row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES}
+    row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES + (CHAIN_EXTRA_PEAKS if mechanism != "stretching" else ())}
     if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
         row.update({q: float(a[name]) for q, name in STRETCH_PEAK_ATTRS.items() if name in a})
         row.update({q: float(a[name]) for q, name in STRETCH_EXTRA_PEAKS.items() if name in a})
@@ -274,8 +274,10 @@ def bundled_study(mechanism: str) -> xr.Dataset:
 
 
 def _extra(mechanism) -> tuple:
-    """The peaks a study of ``mechanism`` keeps beside QUANTITIES (stretching: STRETCH_EXTRA_PEAKS)."""
-    return tuple(STRETCH_EXTRA_PEAKS) if mechanism == "stretching" else ()
+    """The peaks a study of ``mechanism`` keeps beside QUANTITIES (stretching: STRETCH_EXTRA_PEAKS; the
+    chain's mechanisms: ``kappa_peak_approach``, the run's curvature peak on the approach without the free
+    end's node layer, :data:`snapping.regimes_spec.CHAIN_EXTRA_PEAKS`)."""
+    return tuple(STRETCH_EXTRA_PEAKS) if mechanism == "stretching" else CHAIN_EXTRA_PEAKS
 
 
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
@@ -528,7 +530,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             bar.update(1)
             return
         i, j, k = t
-        if j is None:  # the ideal chain (inextensible: never slack): its taut snap's tension is its run's
+        if j is None and mechanism == "stretching":  # the ideal chain (inextensible: never slack): its taut snap's tension is its run's
             row = {**row, **{q: row["sigma_peak"] for q in _extra(mechanism)}}
         for q, v in row.items():
             name = f"{q}_ideal_level" if j is None else f"{q}_level"

@@ -9,7 +9,8 @@ from __future__ import annotations
 __all__ = ["MECHANISMS", "ACCURACY", "NUMBER_MAX", "STRETCH_METHOD", "STRETCH_METHODS", "STRETCH_STOP_FLOOR", "STRETCH_START",
            "STRETCH_DAMPING", "STRETCH_MAX_RHS",
            "STRETCH_TOL_C", "stretch_tol", "STRETCH_TIP_TIME", "STRETCH_MAX_RHS_LINKS", "stretch_tip_floor",
-           "STRETCH_SNAP_PEAKS", "BEND_SNAP_PEAKS", "BEND_PEAKS_KEY", "STRETCH_PEAK_ATTRS", "STRETCH_PEAKS_KEY", "STRETCH_EXTRA_PEAKS", "STRETCH_ESCALATE", "STRETCH_EXTRA_LEVELS"]
+           "STRETCH_SNAP_PEAKS", "BEND_SNAP_PEAKS", "BEND_PEAKS_KEY", "STRETCH_PEAK_ATTRS", "STRETCH_PEAKS_KEY", "STRETCH_EXTRA_PEAKS", "STRETCH_ESCALATE", "STRETCH_EXTRA_LEVELS",
+           "CHAIN_EXTRA_PEAKS"]
 
 #: mechanism -> (the number's name in snapping.dimensionless, grading of the levels, what it is)
 MECHANISMS = {
@@ -149,6 +150,13 @@ STRETCH_PEAKS_KEY = "snap"
 #: so it has no continuum limit on these levels (docs/guide/regimes.md "The taut snap's tension").
 #: The ideal chain's (inextensible: never slack) is its run's sigma_peak
 STRETCH_EXTRA_PEAKS = {"sigma_peak_taut": "sigma_peak_taut"}
+#: the chain mechanisms' studies keep beside QUANTITIES the runs' ``kappa_peak_approach``: the curvature peak
+#: while v_max rises to the snap, at the joints at least ``general.KAPPA_TIP_JOINTS`` links from the free end.
+#: The run's kappa_peak is the node next to the free end's (a node-index boundary layer, 1.29x the curvature
+#: a few joints in at every resolution) and the larger of two maxima, one before the speed peak and one after
+#: (the whirl); the second converges slowly and overtakes the first from the second level on, so the levels
+#: jump (ideal chi 0.2: 334.0, 340.5, 364.5, 369.2). docs/guide/regimes.md "The curvature peak".
+CHAIN_EXTRA_PEAKS = ("kappa_peak_approach",)
 
 #: stretching, the shipped scan (``benchmarks/stretch_scan.py``): a cell (or the ideal at a chi) whose
 #: v_peak, a_peak or sigma_peak error bar exceeds this fraction of its limit runs one more level

@@ -98,6 +98,9 @@ PIN_STEP_VARS: dict[str, dict[str, str]] = {
     "pin_vy": _v("velocity of the held end, e2 component"),
     "pin_work": _v("work done on the chain by the held end since t = 0 (energy - pin_work is conserved)"),
     "v_rel_max": _v("maximum node speed relative to the held end, max_j |v_j - v_pin| (what the stop rule judges)"),
+    "kappa_max_interior": _v("maximum absolute curvature over the joints at least KAPPA_TIP_JOINTS (8) links from the "
+                             "free end (kappa_max without the free end's node-index boundary layer: "
+                             "snapping.simulate.general.KAPPA_TIP_JOINTS)"),
 }
 
 #: Per accepted step, runs of a problem with a body only (:class:`snapping.simulate.Body`: bending
@@ -133,6 +136,11 @@ PROBLEM_ATTRS: dict[str, str] = {
     "gravity": "gravity along +e2 (1: the nondimensional g; 0: none)",
     "pin_motion": "motion of the held end: 'fixed', 'pull', 'flick' or 'table'",
     "start": "start shape: 'catenary', 'supports', 'curve' or 'nodes'",
+    "kappa_peak_approach": ("the snap's curvature peak on the approach: the largest kappa_max_interior over the steps "
+                            "at which v_max is at its running maximum (up to the speed peak), located on the dense "
+                            "output; NaN for a run resumed from a checkpoint written before it existed "
+                            "(docs/guide/regimes.md, 'The curvature peak')"),
+    "t_kappa_peak_approach": "time of kappa_peak_approach",
     "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
                       "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
                       "to the held end) from then on, after it has risen above its value then"),
@@ -323,7 +331,7 @@ CHECKPOINT_VARS: dict[str, dict[str, str]] = {
     "checkpoint_S": _v("current and next chain state of the compiled loop"),
     "checkpoint_peak_state": _v("state at the running peak of v_max"),
     "checkpoint_ctl": _v("control array of the compiled loop (t, dt, counters, drifts, targets)"),
-    "checkpoint_pk": _v("running peak trackers of v_max, a_max, sigma_max, kappa_max"),
+    "checkpoint_pk": _v("running peak trackers of v_max, a_max, sigma_max, kappa_max (a general chain: + kappa_max_interior on the approach)"),
     "checkpoint_meas": _v("measurements of the last accepted step"),
     "checkpoint_meas0": _v("measurements of the initial state"),
     "checkpoint_rinv0": _v("1 / (initial chord length)^2 per link"),

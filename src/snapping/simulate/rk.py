@@ -332,15 +332,17 @@ def after_attempt_with(N, err, h, last, ns, y1, TS, HS, DOK, c, s, sig, Z, rinv0
         ctl[Q_ERR_MAX_ACC] = err
     MD.model_measure(N, t, y1, c, s, sig, Z, rinv0, meas, mdl)
     # ---- running peaks (every accepted step)
-    for qi in range(4):
+    for qi in range(pk.shape[0]):
         if qi == 0:
             q = meas[K.M_VMAX]
         elif qi == 1:
             q = meas[K.M_AMAX]
         elif qi == 2:
             q = meas[K.M_SIGMAX]
-        else:
+        elif qi == 3:
             q = meas[K.M_KMAX]
+        else:  # (a general chain's fifth row) kappa_max_interior on the approach: while v_max is at its running peak
+            q = meas[G.M_KIN] if meas[K.M_VMAX] >= pk[0, PK_SBEST] else -np.inf
         if q > pk[qi, PK_SBEST]:
             pk[qi, PK_SBEST] = q
             pk[qi, PK_TBEFORE] = pk[qi, PK_TPREV]

@@ -77,6 +77,8 @@ PEAK_XTOL = 1e-10
 #: beta of the PI step-size controller (0: the classical I controller)
 PI_BETA = 0.0
 _PEAK_MEAS = (K.M_VMAX, K.M_AMAX, K.M_SIGMAX, K.M_KMAX)
+#: a general chain's peaks: + kappa_max_interior on the approach (``kappa_peak_approach``)
+_PEAK_MEAS_G = _PEAK_MEAS + (G.M_KIN,)
 
 
 def resolve_method(method: str) -> str:
@@ -176,8 +178,9 @@ class Engine(CheckpointMixin):
             c[R.Q_ARMED] = 1.0
             c[R.Q_VRBASE] = c[R.Q_VRPEAK] = self.meas[G.M_VREL]
         self.ctl = c
-        pk = np.full((4, R.NPKR), np.nan)
-        for qi, m in enumerate(_PEAK_MEAS):
+        # a general chain tracks a fifth peak, kappa_peak_approach (rk.after_attempt_with)
+        pk = np.full((5 if self.general else 4, R.NPKR), np.nan)
+        for qi, m in enumerate(_PEAK_MEAS_G[:pk.shape[0]]):
             pk[qi, R.PK_SBEST] = self.meas[m]
             pk[qi, R.PK_TPREV] = t0
             pk[qi, R.PK_TBEFORE] = t0
@@ -265,11 +268,11 @@ class Engine(CheckpointMixin):
         bits = int(self.ctl[R.Q_REFINE])
         self.ctl[R.Q_REFINE] = 0.0
         pk = self.pk
-        for qi in range(4):
+        for qi in range(pk.shape[0]):
             if not bits & (1 << qi):
                 continue
             ta, tb = float(pk[qi, R.PK_TA]), float(pk[qi, R.PK_TB])
-            m = _PEAK_MEAS[qi]
+            m = _PEAK_MEAS_G[qi]
             if not tb > ta:
                 continue
             res = minimize_scalar(lambda tt: -self.Z_at(tt)[1][m], bounds=(ta, tb), method="bounded",
@@ -388,6 +391,8 @@ class Engine(CheckpointMixin):
         results = {"status": status, "stop_reason": reason, "failure": failure, "failure_node": int(node)}
         if self.general:  # (schema.PROBLEM_ATTRS)
             results["t_pin_settled"] = float(c[R.Q_TSETTLE]) if c[R.Q_TSETTLE] >= 0.0 else float("nan")
+            results["kappa_peak_approach"] = float(pk[4, R.PK_BEST])
+            results["t_kappa_peak_approach"] = float(pk[4, R.PK_TBEST])
         for qi, name in enumerate(K.PEAK_QUANTITIES):
             if name != "kappa":
                 results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
@@ -467,14 +472,31 @@ class Engine(CheckpointMixin):
         get = checkpoint_getter(ds)
         for name, arr in (("checkpoint_Y0", self.Y0), ("checkpoint_Y1", self.Y1), ("checkpoint_stages", self.KK),
                           ("checkpoint_step_t", self.TS), ("checkpoint_step_h", self.HS),
-                          ("checkpoint_Z", self.Z), ("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas),
-                          ("checkpoint_meas0", self.meas0), *own):
+                          ("checkpoint_Z", self.Z), *own):
             arr[...] = get(name, arr.shape)
+        for name, arr in (("checkpoint_pk", self.pk), ("checkpoint_meas", self.meas), ("checkpoint_meas0", self.meas0)):
+            _restore_grown(get, name, arr)
         self._restore_ctl(get, R.NQ)
         self._restore_scales(ds, get)
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
         self._restore_history(ds, get, R.Q_NREC)
+
+def _restore_grown(get, name: str, arr: np.ndarray) -> None:
+    """Checkpoint variable ``name`` into ``arr``; a file written before a general chain's fifth peak row
+    (kappa_peak_approach) and its measurement (general.M_KIN) lacks them: the rest is restored in place,
+    the new ones are NaN (the run resumes; its kappa_peak_approach is NaN)."""
+    a = get(name, None)
+    if a.shape == arr.shape:
+        arr[...] = a
+    elif arr.ndim == 1 and a.shape == (arr.size - 1,) and arr.size > G.M_KIN:  # measurements: M_KIN was inserted
+        arr[:G.M_KIN], arr[G.M_KIN], arr[G.M_KIN + 1:] = a[:G.M_KIN], np.nan, a[G.M_KIN:]
+    elif arr.ndim == 2 and a.ndim == 2 and a.shape[1:] == arr.shape[1:] and a.shape[0] < arr.shape[0]:  # peak rows
+        arr[...] = np.nan
+        arr[:a.shape[0]] = a
+    else:
+        raise V.SnappingInputError(f"checkpoint variable {name!r} has shape {a.shape}, expected {arr.shape}")
+
 
 def _failure_message(code: int, eng: Engine, node: int = -1) -> str:
     t = eng.t
