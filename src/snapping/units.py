@@ -73,7 +73,7 @@ VARIABLE_KINDS: dict[str, str] = {
     "x": _L, "y": _L, "vx": _V, "vy": _V, "ax": _A, "ay": _A, "speed": _V, "accel": _A, "curvature": _K,
     "tension": _F,
     # the held end of a general run
-    "pin_x": _L, "pin_y": _L, "pin_vx": _V, "pin_vy": _V, "pin_work": _E, "v_rel_max": _V,
+    "pin_x": _L, "pin_y": _L, "pin_vx": _V, "pin_vy": _V, "pin_work": _E, "v_rel_max": _V, "kappa_max_interior": _K,
     # a run with a body (bending, drag)
     "bending_energy": _E, "dissipated": _E,
     # the extensible line (snapping.simulate.elastic)
@@ -93,7 +93,8 @@ VALUE_KINDS: dict[str, str] = {
     # inputs
     "chi": _1, "N": _1, "tol": _1, "dt0": _T, "t_end": _T, "stop_fraction": _1, "snapshot_times": _T,
     "record_thin": _1, "t_end_max": _T, "max_link_error": _1, "max_energy_drift": _E, "dt_min": _T,
-    "max_rejections": _1, "tip_mass": _M, "gravity": _A, "t_pin_settled": _T,
+    "max_rejections": _1, "tip_mass": _M, "gravity": _A, "t_pin_settled": _T, "kappa_peak_approach": _K,
+    "t_kappa_peak_approach": _T,
     # results
     "failure_node": _1, "t_snap_v": _T, "t_snap_a": _T, "t_snap_sigma": _T, "snap_reached": _1,
     "v_peak": _V, "a_peak": _A, "sigma_peak": _F, "kappa_peak": _K, "kappa_max_0": _K, "energy_drift": _E,
