@@ -330,6 +330,11 @@ def cost(mech: str, path=None) -> dict:
         print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level): "
               + (", ".join(f"chi {ds.chi.values[i]:g} number {ds.number.values[j]:g}" for i, j in cc) or "none"))
     worst = {}
+    for q in ("kappa_peak", "kappa_peak_approach"):  # (the curvature: error bar within 1% of the value, any order)
+        if q in ds:
+            rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
+            print(f"  {q}: {int(np.sum(rel <= 0.01))}/{rel.size} cells within 1%; ideal's error bars "
+                  + " ".join(f"{x:.2%}" for x in np.abs(ds[f"{q}_ideal_error"].values / ds[f"{q}_ideal"].values)))
     for q in ("v_peak", "a_peak", "sigma_peak"):
         if q not in ds:
             continue
