@@ -317,22 +317,8 @@ def run_elastic(args, problem, elastic, times):
                       progress=False if getattr(args, "no_progress", False) else None)
         except ECK.CheckpointMismatch as exc:
             raise SnappingInputError(mismatch_words(exc, args)) from None
-        if out is not None:  # (SIGINT/SIGTERM held while the finished run is written: then acted on)
+        if out is not None:  # (SIGINT/SIGTERM held while the finished run is written, then raised: ECK.Signals)
             ds = r.dataset
-            with ECK.Signals() as sigs:
+            with ECK.Signals():
                 _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
-            if sigs.signum is not None:
-                _reraise(sigs.signum)
     return r.summary(), r.dataset
-
-
-def _reraise(signum) -> None:
-    """The signal held while -o was written, raised now as its handler would have (SIGTERM: the
-    command's :class:`~snapping.cli._Terminated`; SIGINT: KeyboardInterrupt)."""
-    import signal
-
-    if signum == signal.SIGTERM:
-        from . import _Terminated
-
-        raise _Terminated()
-    raise KeyboardInterrupt
