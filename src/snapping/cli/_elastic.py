@@ -213,12 +213,11 @@ def _checkpoint_paths(args, method: str):
     --checkpoint-every needs a checkpoint; neither file is -o."""
     import os
 
+    from .._files import netcdf_suffix
     from .._validate import SnappingInputError
     from ..simulate import elastic_checkpoint as ECK
 
     ck, res = getattr(args, "checkpoint", None), args.resume
-    from .._files import netcdf_suffix
-
     for o, v in (("--checkpoint", ck), ("--resume", res)):
         if isinstance(v, str):  # (a checkpoint is a netCDF4 run file: never under a name that says another format)
             netcdf_suffix(v, name=o)
