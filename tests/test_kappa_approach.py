@@ -12,8 +12,8 @@ run's ``kappa_peak_approach`` (its peak while v_max rises to the snap).
 * a real run (the ideal chain, chi 0.3, fold level 1): kappa_peak_approach lies before the speed
   peak, below the run's kappa_peak (whose joint is the free end's first), and equals the largest
   interior curvature recomputed by :func:`snapping.simulate.chain.curvature_profile` (independent
-  Python) on snapshots at dense times around it; v/a/sigma unchanged by the tracker (the run's own
-  record's maxima);
+  Python) on snapshots at dense times around it (the snapshots change no peak); the record's
+  kappa_max_interior never above kappa_max;
 * the study's worker keeps it for the chain mechanisms, not for stretching; the shipped drag study holds it
   for every run, never above the run's kappa_peak.
 """
