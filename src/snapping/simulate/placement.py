@@ -23,11 +23,13 @@ curve), and the caller falls back to the walk, which raises the walk's errors.
 >>> from snapping import estimates
 >>> chi = 0.25
 >>> a = estimates.catenary_parameter(chi)
->>> x, y = place_on_catenary(chi, a, 1.0, np.full(8, 1 / 8))
->>> bool(np.allclose(np.hypot(np.diff(x), np.diff(y)), 1 / 8, rtol=0, atol=1e-15))
+>>> x, y = place_on_catenary(chi, a, 1.0, np.full(50, 1 / 50))
+>>> bool(np.allclose(np.hypot(np.diff(x), np.diff(y)), 1 / 50, rtol=0, atol=1e-15))
 True
 >>> float(x[-1]), float(y[-1])
 (0.0, 0.0)
+>>> place_on_catenary(chi, a, 1.0, np.full(8, 1 / 8)) is None   # coarse links: left to the walk
+True
 """
 
 from __future__ import annotations
