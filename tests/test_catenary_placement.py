@@ -48,9 +48,19 @@ def test_newton_placement_is_the_walk_to_roundoff(chi, kind, N, L):
     assert np.max(np.abs(y / L - (np.sqrt(a * a + 0.25) - np.sqrt(a * a + u * u)))) <= 1e-12
 
 
-def test_problem_catenary_uses_it_and_keeps_the_walk_start():
+def test_problem_catenary_uses_it_and_keeps_the_walk_start(monkeypatch):
     h = _links("graded", 400, 1.0)
+    calls = []
+    newton = placement.place_on_catenary
+
+    def counted(*a, **k):
+        out = newton(*a, **k)
+        calls.append(out is not None)
+        return out
+
+    monkeypatch.setattr(placement, "place_on_catenary", counted)
     p = Problem.catenary(0.1, links=Links.graded(h))
+    assert calls == [True]  # placed by Newton, not by the walk
     xw, yw = _walk(0.1, p.links.length, p.links.h)
     x, y = np.asarray(p.x), np.asarray(p.y)
     assert np.max(np.abs(x - xw)) <= 1e-12 and np.max(np.abs(y - yw)) <= 1e-12
