@@ -102,3 +102,24 @@ def test_taper_profiles_on_array_are_the_per_node_calls(name):
         per_node = np.asarray([float(v(float(x))) for x in snode])  # one call per node, as before
         assert np.array_equal(body.node_values(k, h), per_node)  # the same floats, bit for bit
     assert n_tapered == 3
+
+
+def _peaks(p, method="fast"):
+    from snapping.simulate import run
+
+    a = run(p, method=method, tol=1e-6, progress=False).dataset.attrs
+    return [float(a[q]) for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak")] + [int(a["n_rhs"])]
+
+
+@pytest.mark.parametrize("body", [False, True])
+def test_compiled_peak_refinement_is_z_at_bit_for_bit(monkeypatch, body):
+    # DOP853's refinement by one compiled call (meas_at) against the old path through Z_at: the same peaks
+    # and the same count of evaluations, bit for bit, on the paper's chain and on a body (drag, bending)
+    from snapping.simulate import Body
+    from snapping.simulate.methods import dop853
+
+    b = Body(1e-4, drag_normal=0.5) if body else None
+    p = Problem.catenary(0.3, 40, body=b)
+    new = _peaks(p)
+    monkeypatch.setattr(dop853.Engine, "meas_at", lambda self, t: self.Z_at(t)[1])
+    assert new == _peaks(p)
