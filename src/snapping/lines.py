@@ -212,7 +212,11 @@ class Line:
         def f(s):
             return v0 * self.ratio(L - s, L) ** power
 
+        def on_array(s):  # f at every s of an array, the same floats (the power by Python's float **)
+            return [v0 * r ** power for r in self.ratio(L - np.asarray(s, dtype=float), L).tolist()]
+
         f.__name__ = f"{self.name} {name}"
+        f.on_array = on_array
         return f
 
     # -- in the simulator
