@@ -354,7 +354,7 @@ def cost(mech: str, path=None) -> dict:
         print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level): "
               + (", ".join(f"chi {ds.chi.values[i]:g} number {ds.number.values[j]:g}" for i, j in cc) or "none"))
     worst = {}
-    for q in ("v_peak", "a_peak", "sigma_peak"):
+    for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak"):  # (kappa_peak: the stretching cells' since stretchk)
         if q not in ds:
             continue
         ok = resolved(ds[q].values, ds[f"{q}_error"].values, ds[f"{q}_order"].values)
