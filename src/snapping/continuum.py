@@ -425,7 +425,7 @@ def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Datas
              "grading": "fold", "ratio": ratio, "tol": tol, "wall_time_total": wall}
     verdicts = []
     for q in QUANTITIES:
-        if np.all(np.isnan(data[q][1])):  # not measured (the extensible line's curvature)
+        if np.all(np.isnan(data[q][1])):  # not measured (the extensible line's curvature before branch stretchk)
             attrs.update({f"{q}_limit": np.nan, f"{q}_error": np.nan, f"{q}_order": np.nan, f"{q}_digits": 0})
             continue
         e = extrapolate(data["frac"][1], data[q][1]) if len(rows) >= 2 else \
