@@ -150,3 +150,60 @@ def test_elastic_sigint_while_writing_o_is_held_until_it_is_whole(elastic_checkp
     ds = xr.load_dataset(out)
     assert ds.attrs["status"] == "completed"
     assert not any(n.endswith(".part") or n.endswith(".lock") for n in os.listdir(tmp_path))
+
+
+# --- lead: a signal the run noted after its loop's last poll (while its -o was written) ---
+
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM"])
+def test_rigid_signal_while_the_finished_run_is_written_is_acted_on_once_it_is_whole(tmp_path, monkeypatch, capsys,
+                                                                                      signame):
+    """The rigid run's handlers note SIGINT/SIGTERM until the finished run's file is written; one
+    that came then was dropped (exit 0, as if never sent). Now: the file whole and complete, then
+    exit 130/143 with the words for a signal after the run."""
+    out, sig = tmp_path / "run.nc", getattr(signal, signame)
+    real = driver.save
+
+    def save(ds, path, **kw):
+        if ds.attrs["status"] == "completed":
+            signal.raise_signal(sig)  # (noted by the run's handler, still in place)
+        return real(ds, path, **kw)
+
+    monkeypatch.setattr(driver, "save", save)
+    rc = main([*RIGID, "-o", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 128 + int(sig), err
+    verb = "interrupted by SIGINT" if signame == "SIGINT" else "terminated by SIGTERM"
+    line = err.strip().splitlines()[-1]
+    assert line.startswith(f"snapping simulate: {verb} after the run: {out} holds the run this command wrote"), line
+    ds = xr.load_dataset(out)
+    assert ds.attrs["status"] == "completed" and float(ds.attrs["t_final"]) == 0.2
+    _only(tmp_path, "run.nc")
+
+
+def test_library_run_raises_a_late_sigint_after_saving(tmp_path, monkeypatch):
+    """simulate.run: SIGINT while the completed run is saved -> KeyboardInterrupt after the save."""
+    from snapping import simulate
+
+    out, real = tmp_path / "r.nc", driver.save
+    monkeypatch.setattr(driver, "save", lambda ds, path, **kw: (signal.raise_signal(signal.SIGINT), real(ds, path, **kw))[1])
+    with pytest.raises(KeyboardInterrupt):
+        simulate.run(0.3, 12, t_end=0.2, output=str(out), progress=False)
+    assert xr.load_dataset(out).attrs["status"] == "completed"
+
+
+def test_signals_block_raises_a_noted_signal_nothing_acted_on():
+    """ECK.Signals (the extensible line's loop and its -o write): a signal noted in a block that
+    ends normally is raised on exit, after the handlers are put back; one the block acted on (it
+    raised) is not raised again."""
+    with pytest.raises(KeyboardInterrupt) as e:
+        with ECK.Signals() as s:
+            signal.raise_signal(signal.SIGINT)
+            assert s.signum == signal.SIGINT  # (noted, not raised, inside)
+    assert type(e.value) is KeyboardInterrupt and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    with pytest.raises(ValueError):  # (acted on: only the block's own exception)
+        with ECK.Signals():
+            signal.raise_signal(signal.SIGINT)
+            raise ValueError("acted on")
+    with ECK.Signals() as s:  # (none noted: nothing raised)
+        pass
+    assert s.signum is None

@@ -213,12 +213,11 @@ def _checkpoint_paths(args, method: str):
     --checkpoint-every needs a checkpoint; neither file is -o."""
     import os
 
+    from .._files import netcdf_suffix
     from .._validate import SnappingInputError
     from ..simulate import elastic_checkpoint as ECK
 
     ck, res = getattr(args, "checkpoint", None), args.resume
-    from .._files import netcdf_suffix
-
     for o, v in (("--checkpoint", ck), ("--resume", res)):
         if isinstance(v, str):  # (a checkpoint is a netCDF4 run file: never under a name that says another format)
             netcdf_suffix(v, name=o)
@@ -317,22 +316,8 @@ def run_elastic(args, problem, elastic, times):
                       progress=False if getattr(args, "no_progress", False) else None)
         except ECK.CheckpointMismatch as exc:
             raise SnappingInputError(mismatch_words(exc, args)) from None
-        if out is not None:  # (SIGINT/SIGTERM held while the finished run is written: then acted on)
+        if out is not None:  # (SIGINT/SIGTERM held while the finished run is written, then raised: ECK.Signals)
             ds = r.dataset
-            with ECK.Signals() as sigs:
+            with ECK.Signals():
                 _files.write_atomic(out, lambda tmp: ds.to_netcdf(tmp), overwrite=True, dataset=ds)
-            if sigs.signum is not None:
-                _reraise(sigs.signum)
     return r.summary(), r.dataset
-
-
-def _reraise(signum) -> None:
-    """The signal held while -o was written, raised now as its handler would have (SIGTERM: the
-    command's :class:`~snapping.cli._Terminated`; SIGINT: KeyboardInterrupt)."""
-    import signal
-
-    if signum == signal.SIGTERM:
-        from . import _Terminated
-
-        raise _Terminated()
-    raise KeyboardInterrupt

@@ -29,7 +29,7 @@ from . import kernels as K
 from . import methods as M
 from .chain import ChainState
 from .dataset import Run, build_dataset, check_writable, inputs_from_attrs, save, seal
-from .errors import FAILURES, RET_SIGNAL, RunInterrupted, SimulationError
+from .errors import FAILURES, RET_SIGNAL, RunInterrupted, SimulationError, deliver_late
 from .options import RunOptions, check_checkpoint_every, check_memory, check_progress
 
 __all__ = ["run", "rerun", "check_inputs", "integrate_fixed", "METHODS", "CHECKPOINT_EVERY", "DEFAULT_METHOD",
@@ -540,6 +540,8 @@ def _drive_locked(eng, inputs: dict, *, output, progress, checkpoint_every, wall
     finally:
         for sig, h in handlers.items():
             signal.signal(sig, h)
+    if got["signum"] is not None:  # noted after the loop's last poll or while the file was written: acted on now
+        deliver_late(got["signum"])
     if status == "failed":
         where = f"; what was computed is saved in {path}" if path else ""
         cls = FAILURES.get(code, SimulationError)

@@ -31,7 +31,7 @@ from .. import _files
 from .. import _validate as V
 from .dataset import check_writable, save, seal, verify_digest
 from .elastic_dataset import dataset as _dataset
-from .errors import RunInterrupted
+from .errors import RunInterrupted, deliver_late
 from ._netcdf import open_netcdf
 
 __all__ = ["VERSION", "PREFIX", "METHODS", "write", "read", "state_vars", "check_paths", "held", "Poller",
@@ -155,7 +155,9 @@ _chunk_hook = None
 
 class Signals:
     """SIGINT and SIGTERM noted (``signum``) instead of raised while a checkpointed run steps,
-    as :func:`snapping.simulate.driver._drive_locked` does; the handlers are put back on exit."""
+    as :func:`snapping.simulate.driver._drive_locked` does; the handlers are put back on exit, and
+    a signal noted that nothing acted on (the block ended without an exception) is raised then
+    (:func:`~snapping.simulate.errors.deliver_late`)."""
 
     def __init__(self):
         self.signum, self.handlers = None, {}
@@ -183,11 +185,13 @@ class Signals:
                 self.signum = int(r)
         return self.signum
 
-    def __exit__(self, *exc):
+    def __exit__(self, exc_type, exc, tb):
         import signal
 
         for sig, h in self.handlers.items():
             signal.signal(sig, h)
+        if exc_type is None and self.signum is not None:  # noted and not acted on (after the last poll): now
+            deliver_late(self.signum)
         return False
 
 

@@ -94,6 +94,16 @@ class RejectionError(SimulationError):
     kind = "rejections"
 
 
+def deliver_late(signum) -> None:
+    """Raise now a SIGINT or SIGTERM that a run noted after its last check (in its last steps, or
+    while it wrote its file, which is then whole): through the handler in place again once the
+    run's own is put back (Python's SIGINT handler: ``KeyboardInterrupt``; the command line's
+    SIGTERM handler: its exit 143), so a signal is acted on late, never dropped."""
+    import signal
+
+    signal.raise_signal(int(signum))
+
+
 class RunInterrupted(KeyboardInterrupt):
     """A run stopped at a step boundary on SIGINT or SIGTERM (a ``KeyboardInterrupt``).
 
