@@ -20,6 +20,8 @@ Usage::
     python benchmarks/bench_regimes.py --extend bending --seed benchmarks/results/bendconv_chi0.*.json
     python benchmarks/bench_regimes.py --cost end-mass
     python benchmarks/bench_regimes.py --study drag --escalate-from old_drag.nc   # the 3-level file's runs, then --study
+    python benchmarks/bench_regimes.py --study stretching --rerun-cells OLD.nc --out new.nc  # OLD's ideal runs only, then
+    python benchmarks/bench_regimes.py --study stretching --out new.nc                      # ... its cells run again
     python benchmarks/bench_regimes.py --damping-check --chi 0.3 --beta 1e-4
     python benchmarks/bench_regimes.py --report --figures docs/guide     # the analysis and the maps
     python benchmarks/bench_regimes.py --study stretching --chis 0.1 --out lo.nc   # a part (some chi) ...
@@ -240,6 +242,28 @@ def reuse(old_path: str, out: str) -> None:
     print(f"stretching: {copied} runs copied from {old_path} into {out} (c <= {STRETCH_TOL_C:g} and the ideal's)")
 
 
+def rerun_cells(mech: str, old_path: str, out: str) -> None:
+    """Start ``out`` as the study of ``old_path`` (the same key: ``--study MECH --out OUT`` resumes
+    it) with its ideal runs (every level it ran) and none of its cells' runs: the cells are run
+    again (branch stretchk: the stretching study's cells then record kappa_peak, NaN in a file
+    made before; the ideal chain's runs had it and are the same computations)."""
+    from snapping import regimes as R
+    from snapping.sweep_files import atomic_to_netcdf
+
+    old = R.load_study(old_path)
+    if old.attrs["mechanism"] != mech:
+        raise SystemExit(f"{old_path} is a {old.attrs['mechanism']} study, not {mech}")
+    if out is None or os.path.lexists(out):
+        raise SystemExit(f"--rerun-cells: give a new --out (got {out!r}): the shipped file is not overwritten")
+    ds = old.copy(deep=True)
+    cells = [v for v in ds.data_vars if v.endswith("_level") and "ideal" not in v]
+    for name in cells:
+        ds[name].values[...] = np.nan
+    atomic_to_netcdf(R._finish(ds), out)
+    print(f"{mech}: {out} holds the {int(np.isfinite(ds.v_peak_ideal_level.values).sum())} ideal runs of {old_path} "
+          f"and no cell run ({len(cells)} cell variables emptied); --study {mech} --out {out} runs the cells")
+
+
 def escalate_from(mech: str, old_path: str, out=None) -> None:
     """Start the escalating study of ``mech`` (STUDIES: ``escalate``, ``extra_levels``) in ``out``
     (default the shipped file) with the runs of ``old_path``, the same study without escalation (its
@@ -333,9 +357,9 @@ def cost(mech: str, path=None) -> dict:
     for q in ("kappa_peak", "kappa_peak_approach"):  # (the curvature: error bar within 1% of the value, any order)
         if q in ds:
             rel = np.abs(ds[f"{q}_error"].values / ds[q].values)
-            print(f"  {q}: {int(np.sum(rel <= 0.01))}/{rel.size} cells within 1%; ideal's error bars "
+            print(f"  {q}: {int(np.sum(rel <= 0.01))}/{rel.size} cells within 1% (any order); ideal's error bars "
                   + " ".join(f"{x:.2%}" for x in np.abs(ds[f"{q}_ideal_error"].values / ds[f"{q}_ideal"].values)))
-    for q in ("v_peak", "a_peak", "sigma_peak"):
+    for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak"):  # (kappa_peak: the stretching cells' since stretchk)
         if q not in ds:
             continue
         ok = resolved(ds[q].values, ds[f"{q}_error"].values, ds[f"{q}_order"].values)
@@ -484,6 +508,8 @@ def main(argv=None) -> None:
                     help="start --out with the same runs of an earlier stretching study file OLD (before tol_c)")
     ap.add_argument("--escalate-from", default=None, metavar="OLD",
                     help="start --study MECH's escalating file (or --out) with the runs of OLD, its study unescalated")
+    ap.add_argument("--rerun-cells", default=None, metavar="OLD",
+                    help="start --study MECH's --out (a new file) with OLD's ideal runs only: the cells run again")
     ap.add_argument("--cost", choices=sorted(STUDIES))
     ap.add_argument("--extend", choices=sorted(STUDIES), help="refine the shipped study to STUDIES' levels, "
                     "reusing its runs (and --seed FILES of benchmarks/bench_bendconv.py)")
@@ -512,6 +538,8 @@ def main(argv=None) -> None:
         merge(a.study, a.merge)
     elif a.reuse:
         reuse(a.reuse, a.out)
+    elif a.study and a.rerun_cells:
+        rerun_cells(a.study, a.rerun_cells, a.out)
     elif a.study and a.escalate_from:
         escalate_from(a.study, a.escalate_from, a.out)
     elif a.study:

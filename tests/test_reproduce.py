@@ -17,12 +17,18 @@ TINY = Plan(name="tiny", shapes_chi=(0.5, 0.25), shapes_N=40, speed_chi=(0.25,),
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
+    from snapping.simulate import run
+
     out = tmp_path_factory.mktemp("tiny")
-    return out, reproduce(out, TINY, workers=2, progress=False, log=lambda *a: None).read_text()
+    # one of the plan's runs made here first, directly (checked below against the reproduction's file):
+    # the paper's method compiled here once, the two workers load it from numba's cache (cold: else
+    # each worker compiles it)
+    direct = run(0.25, 20, **TINY.options(TINY.tol)).dataset
+    return out, reproduce(out, TINY, workers=2, progress=False, log=lambda *a: None).read_text(), direct
 
 
 def test_tiny_reproduction_writes_report_and_figures(tiny, monkeypatch):
-    tmp_path, text = tiny
+    tmp_path, text, direct = tiny
     # t* row: the exact value, agreeing with the paper's 1.19814
     assert f"| {ideal.t_star_str(15)} | ≈ 1.19814 | agrees |" in text
     assert "typo in the paper (sign)" in text
@@ -44,6 +50,10 @@ def test_tiny_reproduction_writes_report_and_figures(tiny, monkeypatch):
     from snapping.reproduce import _path
 
     u = load_run(_path(tmp_path, TINY, 0.25, 40, 1e-8))  # the paper's chain at the plan's largest N, tol
+    # the reproduction's runs are the runs of simulate.run with the plan's options (deterministic: bit for bit)
+    v = load_run(_path(tmp_path, TINY, 0.25, 20, TINY.tol))
+    for q in ("v_peak", "a_peak", "sigma_peak", "t_snap_v"):
+        assert v.attrs[q] == direct.attrs[q], q
     # the reproduction runs the paper's method and chain, not the library's defaults, and says so
     assert (u.attrs["method"], u.attrs["chords"]) == ("euler-richardson", "arclength")
     assert "method euler-richardson (the paper's), chords arclength" in text
@@ -188,7 +198,7 @@ def test_verdict_rules_on_the_papers_own_numbers():
 
 
 def test_wall_time_table_times_the_fits_and_each_figure_apart(tiny):
-    _, text = tiny
+    _, text, _ = tiny
     table = text.split("## Wall time")[1]
     for part in ("runs", "fits (Fig. 3/4 runs)", "fig1_shapes", "fig1e_pin_force", "fig2_profiles",
                  "fig2d_peak_speed_vs_N", "fig3_maxima", "fig3_local_slopes", "fig4_delta", "stability (3D)", "total"):

@@ -14,10 +14,12 @@ OPTS = {"tol": 1e-7}
 
 def test_sweep_runs_combines_and_skips_finished(tmp_path):
     grid = S.Grid(chi=[0.4, 0.7], N=[8, 12], options=OPTS)
+    # the direct run first: its kernels compiled here once, the two workers load them from numba's
+    # cache (a cold cache: else each worker compiles them, ~40 s of CPU each)
+    direct = simulate.run(0.7, 12, **OPTS).dataset
     paths = S.run_sweep(grid, tmp_path, workers=2, progress=False)
     assert len(paths) == 4 and all(S.is_complete_run(p) for p in paths)
     # each file is the same run as a direct call (runs are deterministic)
-    direct = simulate.run(0.7, 12, **OPTS).dataset
     ds = simulate.load_run(grid.path(tmp_path, 0.7, 12))
     assert ds.attrs["v_peak"] == direct.attrs["v_peak"]
     np.testing.assert_array_equal(ds["v_max"].values, direct["v_max"].values)
@@ -115,6 +117,9 @@ def test_sweep_in_ensembles_matches_single_runs(tmp_path):
     """--ensemble K: several chi of one N in one kernel; each member's peaks as its single run's."""
     opts = {"method": "fast", "chords": "exact", "tol": 1e-8}
     grid = S.Grid(chi=[0.3, 0.4, 0.5], N=[20, 30], options=opts)
+    # one ensemble here first, its members checked as the sweep's below: the ensemble kernel compiled
+    # here once, the two workers load it from numba's cache (cold: else each compiles it, ~40 s of CPU)
+    here = simulate.run_ensemble([0.3, 0.5], 20, **opts)
     paths = S.run_sweep(grid, tmp_path / "ens", workers=2, progress=False, ensemble=2)
     assert all(S.is_complete_run(p) for p in paths)
     for chi in grid.chi:
@@ -123,6 +128,8 @@ def test_sweep_in_ensembles_matches_single_runs(tmp_path):
             single = simulate.run(chi, N, **opts).dataset.attrs
             for q in ("v_peak", "a_peak", "sigma_peak", "t_snap_v"):
                 assert ens[q] == pytest.approx(single[q], rel=1e-8), (chi, N, q)
+                if N == 20 and chi != 0.4:
+                    assert here[[0.3, 0.5].index(chi)].attrs[q] == pytest.approx(single[q], rel=1e-8), (chi, q)
             assert ens["link_drift"] < 1e-14
     # a rerun redoes only the missing member, alone
     os.remove(paths[1])

@@ -108,7 +108,7 @@ def _si(sp: LineSpec, nd: dict) -> dict:
     return {q: float(nd[q]) * u[q] for q in QUANTITIES}
 
 
-def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quantity: str = "sigma_peak",
+def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float = 1e-6, quantity: str = "sigma_peak",
         check: bool = True, alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL,
         graded="auto", stretch_method: str = STRETCH_METHOD, **params) -> dict:
     """The snap of a real line from runs of the real model, the ideal chain's beside it, and
@@ -120,10 +120,13 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         A catalogue line, a Line, a :class:`LineSpec`, or None (the ``params`` alone).
     chi : float
         End separation over the length, in (0, 1).
-    N : int or "auto"
+    N : int, "auto" or None
         Links of the runs (2 to 20000); ``"auto"``: doubled from 100 (:data:`AUTO_N`) until the
         full run's ``quantity`` moves by at most 1% (:data:`RESOLVED`; then ``resolved`` True
-        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False).
+        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False). None (the
+        default): 200. A line of discrete links (a ball chain: :attr:`snapping.lines.Line.pitch`)
+        is answered on its own links for None and ``"auto"`` (``own_links``; no N/2 check, no
+        graded links: a chain is its links, 1% in N has no meaning), on ``N`` links if given.
     tol : float
         The fast method's (DOP853's) tolerance.
     quantity : str
@@ -182,8 +185,14 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
         raise V.SnappingInputError(f"damping={damping!r} is out of range: the grid damping ratio must lie in [0, 100]")
     if not (graded == "auto" or graded is True or graded is False):
         raise V.SnappingInputError(f"graded={graded!r} is not one of 'auto', True, False")
+    own = sp.own_links()
+    if N is None or (own is not None and isinstance(N, str) and N == "auto"):
+        N = 200 if own is None else own
     if not (isinstance(N, str) and N == "auto"):
         N = V.integer("N", N, 2, 20000)
+    on_own = own is not None and N == own
+    if on_own:
+        check, graded = False, False
     from tqdm.auto import tqdm
 
     bar = tqdm(desc=f"{sp.name or 'line'}, chi={chi:g}", unit="run", leave=False, disable=None)  # (off without a terminal)
@@ -195,6 +204,13 @@ def cap(line=None, chi: float = 0.25, *, N: int = 200, tol: float = 1e-6, quanti
             r = _answer(runs, N, quantity, check and N >= 4, alone, graded)
     finally:
         bar.close()
+    if own is not None:
+        r["own_links"] = {"links": own, "pitch": sp.pitch, "used": on_own,
+                          "why": (f"a chain of {own} discrete links (pitch {sp.pitch * 1e3:.4g} mm): answered on them, "
+                                  f"no limit in N sought" if on_own else
+                                  f"a chain of {own} discrete links answered on N = {N} as asked")}
+        if on_own:
+            r["resolved"] = True  # (its links are the line's: exact in N)
     r.update({"runs": runs.log, "n_rhs": sum(x["n_rhs"] for x in runs.log), "wall": time.perf_counter() - t0,
               "cpu": time.process_time() - c0})
     return r
@@ -336,7 +352,7 @@ def _auto(runs: Runs, quantity: str, alone: bool, graded="auto") -> dict:
     return r
 
 
-def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int = 200, tol: float = 1e-6,
+def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int | None = None, tol: float = 1e-6,
            max_tension=None, max_speed=None, max_acceleration=None, quantity: str = "sigma_peak",
            alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL, graded="auto",
            **params) -> dict:
@@ -345,13 +361,14 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
     (the mechanism that capped the snap at that chi, decided on ``quantity``: :func:`cap`'s rule),
     ``graded`` (:func:`cap`'s: the real peaks from graded links, extrapolated, with their error),
-    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it."""
+    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it. ``N``: the
+    links of every run (None: 200, a line of discrete links its own, as :func:`cap`)."""
     sp = _as_spec(line, params)
     chis = _check_chis(chis)
     if isinstance(N, str) and N == "auto":
         raise V.SnappingInputError("N='auto' is cap's (one separation): design runs every chi on the same links: "
                                    "give N an integer in [2, 20000]")
-    N = V.integer("N", N, 2, 20000)
+    N = V.integer("N", (200 if sp.own_links() is None else sp.own_links()) if N is None else N, 2, 20000)
     if quantity not in QUANTITIES:
         raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
     limits = {}
@@ -397,6 +414,8 @@ def format_answer(r: dict) -> list[str]:
     if r.get("auto_N") and r.get("graded", {}).get("used"):
         out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each "
                    f"mechanism alone")
+    elif r.get("own_links"):
+        out.append(f"  links: {r['own_links']['why']}")
     elif r.get("auto_N"):
         out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
                    f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")

@@ -45,6 +45,13 @@ class LineSpec:
     end_mass: float = 0.0
     tip_drag_area: float = 0.0
     line: object = None  # the snapping.lines.Line with a taper, or None
+    pitch: float | None = None  # a line of discrete links (snapping.lines.Line.pitch): its link length, m
+
+    def own_links(self) -> int | None:
+        """A line of discrete links: its round(length/pitch) links (None: a continuous line)."""
+        from .lines import own_links
+
+        return own_links(self.pitch, self.length)
 
     def has(self, mechanism: str) -> bool:
         """Whether the line has this mechanism at all."""
@@ -141,6 +148,7 @@ def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None
     if not isinstance(ln, lines.Line):
         raise V.SnappingInputError(f"line={line!r} is neither a catalogue name ({', '.join(lines.names())}) nor a Line")
     L = ln.length if length is None else float(length)
+    ln.own_links(L)  # (a line of discrete links: its length holds 2 to 20000 of them, else refused)
     if mass is not None:
         if ln.taper is not None:
             raise V.SnappingInputError(f"mass={mass!r}: line {ln.name} is tapered, its mass follows from its "
@@ -153,7 +161,7 @@ def spec(line=None, *, length=None, mass=None, g: float = 9.81, ei=None, ea=None
                     ln.cd_tangential if cd_tangential is None else float(cd_tangential), air_density,
                     ln.tip_mass if end_mass is None else float(end_mass),
                     ln.tip_drag_area if tip_drag_area is None else float(tip_drag_area),
-                    ln if ln.taper is not None else None)
+                    ln if ln.taper is not None else None, ln.pitch)
 
 
 #: the largest end mass, as a ratio to the line's mass

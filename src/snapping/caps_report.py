@@ -25,8 +25,6 @@ __all__ = ["catalogue", "catalogue_table", "studies", "report_section", "section
 
 #: the catalogue's links per mode (the ball chain always on its 229)
 CATALOGUE_N = {"quick": 100, "full": 400}
-#: a line's own number of links, where it has one
-OWN_LINKS = {"ball-chain": 229}
 #: an answer is resolved when its tension moves by at most this much from N/2 to N
 RESOLVED = 0.01
 #: the live studies when no study file is shipped: mode -> (mechanism, chis, numbers, levels, first level)
@@ -38,13 +36,13 @@ LIVE = {"tiny": [("end-mass", (0.5,), (1.0,), 2, -4)],
 
 def catalogue(chi: float = 0.25, N: int = 200, *, tol: float = 1e-6, check: bool = True, names=None) -> list[dict]:
     """:func:`snapping.caps.cap` for each catalogue line (``names``: all) at ``chi``, on ``N``
-    links (``"auto"``: :func:`snapping.caps.cap`'s; a line with links of its own, the ball chain:
-    on those)."""
+    links (``"auto"``: :func:`snapping.caps.cap`'s; a line of discrete links, the ball chain:
+    on its own, :attr:`snapping.lines.Line.pitch`)."""
     from . import caps, lines
 
     out = []
     for name in names or lines.names():
-        n = OWN_LINKS.get(name, N)
+        n = None if lines.get(name).pitch is not None else N
         out.append(caps.cap(name, chi, N=n, tol=tol, check=check and n != "auto"))
     return out
 
@@ -53,6 +51,8 @@ def resolved_words(r: dict) -> str:
     """The resolution verdict of one answer (its tension from N/2 to N; on graded links, the
     extrapolation's error estimate)."""
     g = r.get("graded") or {}
+    if (r.get("own_links") or {}).get("used"):
+        return f"its own {r['own_links']['links']} links (a chain of discrete links: no limit in N)"
     if g.get("used"):
         e = g["relative_error"]["sigma_peak"]
         return (f"{'resolved' if e <= RESOLVED else f'not resolved to {RESOLVED:.0%}'} on graded links "

@@ -296,7 +296,7 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         The extensible line's links (:class:`snapping.simulate.elastic.Elastic` with numbers): the
         levels are uniform chains of ``n0 / ratio**k`` links as with a body, each run through
         :func:`snapping.simulate.elastic.solve` (:mod:`snapping.sweep_elastic`); ``kappa_peak``
-        is not measured (NaN).
+        is the run's (the chain's discrete curvature on the rest lengths, branch stretchk).
     elastic_start : {"stretched", "matched", "unstretched"}, optional
         The extensible line's start (:func:`snapping.simulate.elastic.solve`'s ``start``;
         default ``"stretched"``), recorded in the Dataset's ``elastic_start`` attribute.
@@ -425,7 +425,7 @@ def _dataset(chi, params, rows, lumping, free_end, tol, ratio, wall) -> xr.Datas
              "grading": "fold", "ratio": ratio, "tol": tol, "wall_time_total": wall}
     verdicts = []
     for q in QUANTITIES:
-        if np.all(np.isnan(data[q][1])):  # not measured (the extensible line's curvature)
+        if np.all(np.isnan(data[q][1])):  # not measured (the extensible line's curvature before branch stretchk)
             attrs.update({f"{q}_limit": np.nan, f"{q}_error": np.nan, f"{q}_order": np.nan, f"{q}_digits": 0})
             continue
         e = extrapolate(data["frac"][1], data[q][1]) if len(rows) >= 2 else \

@@ -64,7 +64,7 @@ __all__ = ["Line", "CATALOGUE", "get", "names"]
 
 #: the units of each SI field of a Line
 UNITS = {"mass_per_length": "kg m-1", "diameter": "m", "ei": "N m2", "ea": "N", "cd_normal": "1",
-         "cd_tangential": "1", "tip_drag_area": "m2", "tip_mass": "kg", "length": "m"}
+         "cd_tangential": "1", "tip_drag_area": "m2", "tip_mass": "kg", "length": "m", "pitch": "m"}
 #: the profiles of :meth:`Line.profile` (the diameter ratio's powers 1, 2, 4)
 PROFILES = ("diameter", "mass_per_length", "ei")
 #: the keywords of :meth:`snapping.simulate.Body.from_si` that :meth:`Line.body` passes on as overrides
@@ -110,6 +110,10 @@ class Line:
         ``"m"`` (x in metres) or ``"fraction"`` (x as a fraction of the length).
     tip_mass, tip_drag_area : float
         A tip body at the free end (a fly, a cracker): kg and its drag area C_d A in m^2.
+    pitch : float or None
+        A line of discrete links (a ball chain): its link length, m; its answers run on its own
+        round(length/pitch) links (:meth:`own_links`), where 1% in the links has no meaning (a
+        chain is its links). None: a continuous line.
     sources : tuple of str
         The references (keys of the module's text, with what each gives).
     estimates : dict
@@ -129,6 +133,7 @@ class Line:
     taper_units: str = "m"
     tip_mass: float = 0.0
     tip_drag_area: float = 0.0
+    pitch: float | None = None
     sources: tuple = ()
     estimates: dict = field(default_factory=dict)
 
@@ -144,6 +149,9 @@ class Line:
                 raise V.SnappingInputError(f"{k}={v!r} is out of range: must be finite and >= 0 ({UNITS[k]})")
         if self.ea is not None:
             V.positive("ea", self.ea)
+        if self.pitch is not None:
+            V.positive("pitch", self.pitch)
+            self.own_links()  # (its length holds 2 to 20000 links)
         if self.taper_units not in ("m", "fraction"):
             raise V.SnappingInputError(f"taper_units={self.taper_units!r} is not one of ('m', 'fraction')")
         if self.taper is not None:
@@ -155,6 +163,11 @@ class Line:
             if x.size < 2 or not (np.all(np.diff(x) > 0) and x[0] >= 0 and np.all(np.isfinite(r)) and np.all(r > 0)):
                 raise V.SnappingInputError(f"taper={self.taper!r} must be stations (x, ratio) with x increasing "
                                            f"from >= 0 and ratios > 0")
+
+    def own_links(self, length: float | None = None) -> int | None:
+        """The number of links of ``length`` m (default :attr:`length`) of a line of discrete links,
+        round(length/pitch); None for a continuous line (no :attr:`pitch`)."""
+        return own_links(self.pitch, self.length if length is None else length)
 
     # -- the profile
     def ratio(self, x, length: float | None = None):
@@ -199,7 +212,11 @@ class Line:
         def f(s):
             return v0 * self.ratio(L - s, L) ** power
 
+        def on_array(s):  # f at every s of an array, the same floats (the power by Python's float **)
+            return [v0 * r ** power for r in self.ratio(L - np.asarray(s, dtype=float), L).tolist()]
+
         f.__name__ = f"{self.name} {name}"
+        f.on_array = on_array
         return f
 
     # -- in the simulator
@@ -274,6 +291,22 @@ class Line:
         return replace(self, **changes)
 
 
+def own_links(pitch, length: float) -> int | None:
+    """round(length/pitch): the links of a line of discrete links of ``pitch`` m (None: a
+    continuous line), refused outside 2 to 20000 links naming both values.
+
+    >>> own_links(1.022 / 229, 1.022), own_links(None, 3.0)
+    (229, None)
+    """
+    if pitch is None:
+        return None
+    n = round(float(length) / float(pitch))
+    if not 2 <= n <= 20000:
+        raise V.SnappingInputError(f"pitch={pitch!r} m with length={length!r} m is out of range: a line of discrete "
+                                   f"links holds 2 to 20000 of them (length/pitch = {float(length) / float(pitch):.6g})")
+    return int(n)
+
+
 _HOERNER = "[Hoerner1965] C_n = 1.2, a long cylinder in subcritical cross-flow"
 _CT = ("C_t = 0.01: an estimate (skin friction of a long slender cylinder in axial flow is 0.005 to 0.02; "
        "the default of snapping.units.CD_TANGENTIAL)")
@@ -293,7 +326,7 @@ def _wf5_lambda0() -> float:
 CATALOGUE: dict[str, Line] = {ln.name: ln for ln in (
     Line("ball-chain", "steel ball chain of the falling-chain experiments (Tomaszewski et al. 2006)",
          mass_per_length=0.0208 / 1.022, diameter=3.0e-3, ei=0.0, cd_normal=0.25, cd_tangential=0.08, ea=None,
-         length=1.022,
+         length=1.022, pitch=1.022 / 229,
          sources=("[Tomaszewski2006]: length 1.022 m, mass 20.8 g, 229 links (the paper's chain)",
                   "[Hoerner1965]: a sphere's C_d = 0.47"),
          estimates={

@@ -101,17 +101,18 @@ def run_point(params: dict, path) -> str:
 
 
 def file_bytes(params: dict) -> int:
-    """A generous size of a grid point's run file: the per-step record (about 300 steps of 19
+    """A generous size of a grid point's run file: the per-step record (about 300 steps of 21
     doubles) and the profiles of the snapshots (12 variables of N + 1 values each)."""
     n_snap = 4 + len(np.atleast_1d(params.get("snapshot_times", ())))
-    return int(8 * (3000 * 19 + n_snap * 12 * (int(params["N"]) + 1)) + 100_000)
+    return int(8 * (3000 * 21 + n_snap * 12 * (int(params["N"]) + 1)) + 100_000)
 
 
 def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "stretched") -> dict:
     """One level of :func:`snapping.continuum.converge` for the extensible line: the line of links
-    ``h`` from the catenary of ``chi`` to the snap, its peaks and cost (``kappa_peak`` and
-    ``link_drift`` NaN: not measured), from the elastic ``start``. A completed run of the same
-    level and start at ``path`` is reused."""
+    ``h`` from the catenary of ``chi`` to the snap, its peaks (``kappa_peak``: the run's largest
+    curvature, the chain's, on the rest lengths) and cost (``link_drift`` NaN: not measured), from
+    the elastic ``start``. A completed run of the same level and start at ``path`` is reused (not one
+    written before the runs recorded kappa_peak: it is run again)."""
     import json
     import os
     import time
@@ -126,6 +127,7 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "str
         try:
             old = load_run(path)
             if (old.attrs.get("status") == "completed" and old.attrs.get("model") == "elastic"
+                    and "kappa_peak" in old.attrs  # (a run from before the line recorded its curvature)
                     and np.array_equal(old.link_length.values, h) and float(old.attrs["tol"]) == tol
                     and old.attrs.get("start", "stretched") == start
                     and np.array_equal(old.node_mass.values[:-1], problem.links.m)

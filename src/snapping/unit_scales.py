@@ -16,6 +16,7 @@ Example
 
 from __future__ import annotations
 
+import functools
 import re
 from dataclasses import dataclass, field
 
@@ -94,6 +95,22 @@ def _check_kind(kind: str) -> str:
 
 
 # ------------------------------------------------------------------------- scales
+def _derive(length: float, mass: float, g: float, kind: str) -> float:
+    """:meth:`Scales._derive` of the scales ``(length, mass, g)``."""
+    ureg = registry()
+    a, b, c = _exponents(kind)
+    q = ((length * ureg.meter) ** a * (mass * ureg.kilogram) ** b
+         * (g * ureg.meter / ureg.second ** 2) ** c)
+    return float(q.to(_unit(KIND_UNITS[kind])).magnitude)
+
+
+@functools.lru_cache(maxsize=64)
+def _factors_of(length: float, mass: float, g: float) -> dict:
+    """Every kind's factor of the scales ``(length, mass, g)``, derived by pint once per scales (a
+    design answer makes ~10 bodies of one line: 99 conversions, ~0.2 s, each the same floats)."""
+    return {k: _derive(length, mass, g, k) for k in KIND_UNITS}
+
+
 @dataclass(frozen=True)
 class Scales:
     """The SI value of the library's unit of each kind of quantity, for a chain of
@@ -121,16 +138,13 @@ class Scales:
     def __post_init__(self):
         for name, x in zip(("length", "mass", "g"), V.si_scales(self.length, self.mass, self.g)):
             object.__setattr__(self, name, x)
-        object.__setattr__(self, "_factors", {k: self._derive(k) for k in KIND_UNITS})
+        object.__setattr__(self, "_factors", dict(_factors_of(self.length, self.mass, self.g)))
 
     def _derive(self, kind: str) -> float:
         """L^a M^b g^c (exponents from :func:`_exponents`), converted by pint to the kind's SI
         unit: a wrong exponent would raise pint's DimensionalityError here."""
-        ureg = registry()
-        a, b, c = _exponents(kind)
-        q = ((self.length * ureg.meter) ** a * (self.mass * ureg.kilogram) ** b
-             * (self.g * ureg.meter / ureg.second ** 2) ** c)
-        return float(q.to(_unit(KIND_UNITS[kind])).magnitude)
+        return _derive(self.length, self.mass, self.g, kind)
+
 
     def factor(self, kind: str) -> float:
         """The SI value of one library unit of ``kind`` (a key of :data:`KIND_UNITS`)."""

@@ -362,6 +362,11 @@ def _si_profile(name, v, factor, length):
             return factor * float(_v(s * length))
 
         f.__name__ = f"{getattr(v, '__name__', 'function')} (SI) x {factor:.6g}"
+        if callable(getattr(v, "on_array", None)):  # a catalogue line's taper: every node in one call
+            def on_array(s, _v=v):
+                return [factor * float(x) for x in _v.on_array(np.asarray(s, dtype=float) * length)]
+
+            f.on_array = on_array
         return f
     if np.ndim(v) == 0:
         x = V.real(name, v)

@@ -34,7 +34,7 @@ def add_real_options(p, resolve: bool = True) -> None:
     if resolve:
         g.add_argument("--resolve", action="store_true",
                        help="double the links from 100 (to 1600 at most) until the peak of --quantity moves by at "
-                            "most 1%% (instead of --links)")
+                            "most 1%% (instead of --links; a chain of discrete links, --line ball-chain: its own)")
     g.add_argument("--quantity", default="sigma_peak", choices=("sigma_peak", "v_peak", "a_peak"),
                    help="the peak that decides the capping mechanism (default the tension)")
 
@@ -112,7 +112,7 @@ def cmd_real_estimate(args) -> int:
     sp = _spec(args)
     if args.resolve and links is not None:
         raise SnappingInputError("--resolve chooses the links itself: give --resolve or --links, not both")
-    N = "auto" if args.resolve else (200 if links is None else links)
+    N = "auto" if args.resolve else links  # (None: 200 links, a line of discrete links its own: caps.cap)
     r = caps.cap(sp, _chi(args, sp), N=N, quantity=args.quantity)
     if args.json:
         print_json({**r, "dimensionless_numbers": r["numbers"]})
@@ -135,7 +135,7 @@ def cmd_real_design(args) -> int:
     links = _links(args)
     sp = _spec(args)
     kw = {} if args.chis is None else {"chis": args.chis}
-    d = caps.design(sp, N=200 if links is None else links, max_tension=args.max_tension,
+    d = caps.design(sp, N=links, max_tension=args.max_tension,
                     max_speed=args.max_speed, max_acceleration=args.max_acceleration,
                     quantity=getattr(args, "quantity", "sigma_peak"), **kw)
     if args.json:

@@ -265,7 +265,10 @@ class Body:
         snode[:N] = np.cumsum(h[::-1])[::-1]
         if callable(v):
             try:
-                a = np.asarray([float(v(float(x))) for x in snode], dtype=float)
+                if callable(getattr(v, "on_array", None)):  # the same numbers, one call for every node
+                    a = np.asarray(v.on_array(snode), dtype=float)
+                else:
+                    a = np.asarray([float(v(float(x))) for x in snode], dtype=float)
             except Exception as exc:  # noqa: BLE001 - the user's function failed
                 raise V.SnappingInputError(f"{name}(s) failed or did not return a number ({type(exc).__name__}: "
                                            f"{str(exc)[:120]})") from None

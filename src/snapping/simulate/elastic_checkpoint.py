@@ -78,8 +78,9 @@ def held(checkpoint, resume):
         check_paths(checkpoint, resume)
         yield
 
-#: layout version of the ``ckpt_`` variables
-VERSION = 1
+#: layout version of the ``ckpt_`` variables (2: the record's kappa_max, s_kappa_max columns; a
+#: version-1 checkpoint is refused by name)
+VERSION = 2
 PREFIX = "ckpt_"
 
 

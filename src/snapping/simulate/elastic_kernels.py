@@ -25,7 +25,8 @@ from numba import njit
 
 #: number of measures written by :func:`measure` (see ``MEASURE_NAMES``)
 MEASURE_NAMES = ("v_max", "iv", "a_max", "ia", "sigma_max", "isig", "sigma_min", "imin", "v_end", "a_end",
-                 "pin_force_x", "pin_force_y", "kinetic", "gravity", "elastic_energy", "strain_max", "n_slack")
+                 "pin_force_x", "pin_force_y", "kinetic", "gravity", "elastic_energy", "strain_max", "n_slack",
+                 "kappa_max", "ik")
 NMEAS = len(MEASURE_NAMES)
 
 
@@ -253,7 +254,8 @@ def measure(N, z, pin, h, m, ea, damp, tabe, tabt, tabw, g, snode, dz, T, E, ED,
     their node or link index), the smallest tension, the free end's speed and
     acceleration, the force of the line on the held end, kinetic, gravity
     (``g sum m_i (s_i - y_i)``, zero hanging at rest unstretched) and elastic energies,
-    the largest strain and the number of slack links. ``dz`` receives :func:`rhs`."""
+    the largest strain, the number of slack links, the largest curvature and its node
+    (:func:`curvature_max`). ``dz`` receives :func:`rhs`."""
     rhs(N, z, pin, h, 1.0 / m, ea, damp, tabe, tabt, g, dz, T, E, ED, FV)
     measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out)
 
@@ -322,3 +324,44 @@ def measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out
     out[14] = ue
     out[15] = emax
     out[16] = nslack
+    kap, ik = curvature_max(N, z, pin, h)
+    out[17] = kap
+    out[18] = ik
+
+
+@njit(cache=True, error_model="numpy")
+def curvature_max(N, z, pin, h):
+    """``(kappa, i)``: the largest discrete curvature over the line and its node, the chain's
+    (:func:`snapping.simulate.chain.curvature_profile`, ``general.general_measure``): at node
+    ``i = j + 1`` (1..N-1) the turning angle ``phi`` in [0, pi] between links j and j+1 over the
+    mean of their *rest* lengths, ``2 phi/(h_j + h_{j+1})``: the bending strain per unit
+    material length (the inextensible chain's lengths are its rest lengths; the stretched
+    line's geometric curvature is this over the joint's stretch ``1 + e``). ``(0.0, 0)`` with
+    one link (no joint). ``phi = atan2(|d_j x d_j+1|, d_j . d_j+1)`` only where its bound
+    ``pi/2 sin(phi)`` (``cos(phi) > 0``) can beat the best so far."""
+    kbest = -1.0
+    ik = -1
+    dxp = (z[4] if N > 1 else pin[0]) - z[0]
+    dyp = (z[5] if N > 1 else pin[1]) - z[1]
+    lp = dxp * dxp + dyp * dyp
+    for j in range(N - 1):
+        x2 = z[4 * j + 8] if j + 2 < N else pin[0]
+        y2 = z[4 * j + 9] if j + 2 < N else pin[1]
+        dxn = x2 - z[4 * j + 4]
+        dyn = y2 - z[4 * j + 5]
+        ln = dxn * dxn + dyn * dyn
+        C = dxp * dxn + dyp * dyn
+        Sn = abs(dxp * dyn - dyp * dxn)
+        hb = 2.0 / (h[j] + h[j + 1])
+        bound = 0.5 * math.pi * Sn * hb
+        if not (C > 0.0 and kbest >= 0.0 and bound * bound <= kbest * kbest * lp * ln):
+            kap = math.atan2(Sn, C) * hb
+            if kap > kbest:
+                kbest = kap
+                ik = j + 1
+        dxp = dxn
+        dyp = dyn
+        lp = ln
+    if ik < 0:
+        return 0.0, 0
+    return kbest, ik

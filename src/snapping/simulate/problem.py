@@ -164,7 +164,7 @@ class Problem:
             x, y = st.x, st.y
         else:
             from .. import estimates
-            from . import shapes
+            from . import placement, shapes
             from .chain import CHORDS, _catenary_xy, few_links_start
 
             if chords not in CHORDS:
@@ -178,6 +178,8 @@ class Problem:
                     return L * cx, L * cy
 
                 few = few_links_start(chi * L, links.h)  # (at most FEW_LINKS links: held at both ends)
+                if few is None:  # every node at once (Newton), the walk's points to round-off; else the walk
+                    few = placement.place_on_catenary(chi, a, L, links.h)
                 x, y = shapes.place_on_curve(cat, links.h) if few is None else few
             else:  # nodes at their arclength on the curve (chords a little shorter than h_j)
                 s = np.clip(np.concatenate([np.cumsum(links.h[::-1])[::-1], [0.0]]) / L, 0.0, 1.0)

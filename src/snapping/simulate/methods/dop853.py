@@ -43,6 +43,7 @@ from .. import angles as AG
 from .. import general as G
 from .. import models as MD
 from .. import kernels as K
+from .. import dense_measure as DM
 from .. import rk as R
 from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0, SPEED_LEVEL_FACTOR, CheckpointMixin,
                               checkpoint_getter)
@@ -116,6 +117,7 @@ class Engine(CheckpointMixin):
         t_eval = float(np.nextafter(t0, np.inf)) if t0 in G.breakpoints(self.mdl) else t0
         self.w = AG.Work(N)
         self.rw = AG.Work(N)  # scratch of peak searches and snapshots
+        self._mscratch = None  # meas_at's arrays (made on first use)
         self.Z = np.zeros((K.NROWS, N + 1))
         self.rinv0 = np.full(N, float(N) * float(N))
         self.nmeas = G.NMEAS_G if self.general else K.NMEAS
@@ -234,8 +236,8 @@ class Engine(CheckpointMixin):
         self.drain()
         return np.concatenate(self.chunks) if self.chunks else np.zeros((0, self.nrec))
 
-    def state_at(self, t: float) -> np.ndarray:
-        """The angle state at time t within the last two accepted steps (dense output)."""
+    def _dense_slot(self, t: float) -> tuple[int, float]:
+        """The step slot holding time t (its dense output built) and t's fraction of it."""
         for slot in (int(self.ctl[R.Q_SLOT]), 1 - int(self.ctl[R.Q_SLOT])):
             t0, h = self.TS[slot], self.HS[slot]
             if h > 0.0 and t0 - 1e-14 * max(1.0, abs(t0)) <= t <= t0 + h * (1 + 1e-12) + 1e-300:
@@ -245,11 +247,30 @@ class Engine(CheckpointMixin):
                                   self.ytmp, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
                     self.ctl[R.Q_NRHS] += R.NSX - R.NS - 1
                     self.DOK[slot] = 1.0
-                out = np.empty(self.Y0.shape[1])
-                x = min(1.0, max(0.0, (t - t0) / h))
-                R.dense_eval(self.N, x, self.Y0[slot], self.F[slot], out)
-                return out
+                return slot, min(1.0, max(0.0, (t - t0) / h))
         raise RuntimeError(f"t={t!r} is outside the stored steps")  # pragma: no cover - internal
+
+    def state_at(self, t: float) -> np.ndarray:
+        """The angle state at time t within the last two accepted steps (dense output)."""
+        slot, x = self._dense_slot(t)
+        out = np.empty(self.Y0.shape[1])
+        R.dense_eval(self.N, x, self.Y0[slot], self.F[slot], out)
+        return out
+
+    def meas_at(self, t: float) -> np.ndarray:
+        """:meth:`Z_at`'s diagnostics at time t in one compiled call (:func:`dense_measure.measure_at`:
+        the same floats); a scratch array, overwritten by the next call. DOP853's dense output only
+        (an engine that overrides :meth:`state_at` is refined by :meth:`Z_at`)."""
+        slot, x = self._dense_slot(t)
+        if getattr(self, "_mscratch", None) is None:
+            n = self.Y0.shape[1]
+            self._mscratch = (np.empty(n), np.empty(n), np.zeros((K.NROWS, self.N + 1)), np.zeros(self.nmeas))
+        y, f, Z, meas = self._mscratch
+        w = self.rw
+        DM.measure_at(self.N, t, x, self.Y0[slot], self.F[slot], y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, Z,
+                      self.rinv0, meas, self.mdl)
+        self.ctl[R.Q_NRHS] += 1
+        return meas
 
     def Z_at(self, t: float):
         """The position-form state Z and its diagnostics at time t (one evaluation)."""
@@ -268,6 +289,8 @@ class Engine(CheckpointMixin):
         bits = int(self.ctl[R.Q_REFINE])
         self.ctl[R.Q_REFINE] = 0.0
         pk = self.pk
+        # DOP853's dense output in one compiled call; an engine with its own (RODAS4's) by Z_at
+        measure = self.meas_at if type(self).state_at is Engine.state_at else (lambda tt: self.Z_at(tt)[1])
         for qi in range(pk.shape[0]):
             if not bits & (1 << qi):
                 continue
@@ -275,7 +298,7 @@ class Engine(CheckpointMixin):
             m = _PEAK_MEAS_G[qi]
             if not tb > ta:
                 continue
-            res = minimize_scalar(lambda tt: -self.Z_at(tt)[1][m], bounds=(ta, tb), method="bounded",
+            res = minimize_scalar(lambda tt: -measure(tt)[m], bounds=(ta, tb), method="bounded",
                                   options={"xatol": PEAK_XTOL * (tb - ta) + 1e-15 * abs(tb)})
             tq = float(res.x)
             q = float(-res.fun)
