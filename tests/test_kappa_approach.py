@@ -27,7 +27,7 @@ import pytest
 
 from snapping import regimes as R
 from snapping.continuum import level_parameters
-from snapping.simulate import Links, Problem, run
+from snapping.simulate import Links, run
 from snapping.simulate import general as G
 from snapping.simulate import kernels as K
 from snapping.simulate.chain import curvature_profile
