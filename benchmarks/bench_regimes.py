@@ -298,9 +298,10 @@ def escalate_from(mech: str, old_path: str, out=None) -> None:
     for name in [v for v in old.data_vars if v.endswith("_level") and v in ds]:
         ds[name].values[..., :nl] = old[name].values
     if "escalate_max_rhs" in acc:  # an escalated level copied must be one this cap lets the study run
-        from snapping.regimes_escalate import prefix
+        from snapping.regimes_escalate import integration_rhs, prefix
 
-        for row in ds.n_rhs_level.values.reshape(-1, ds.sizes["level"]):
+        extra = ds.n_rhs_approach_level.values if "n_rhs_approach_level" in ds else None
+        for row in integration_rhs(ds.n_rhs_level.values, extra).reshape(-1, ds.sizes["level"]):  # (the cap's count)
             n = prefix(row)
             if n > acc["levels"] and np.any(row[acc["levels"] - 1:n - 1] > acc["escalate_max_rhs"]):
                 raise SystemExit(f"{old_path}: a cell escalated past the cap {acc['escalate_max_rhs']}: not this study")

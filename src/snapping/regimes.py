@@ -63,7 +63,7 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, level_parameters
-from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, CHAIN_EXTRA_PEAKS, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
+from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, CHAIN_COST_PARTS, CHAIN_EXTRA_PEAKS, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
                            STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
 
@@ -203,6 +203,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
         from .simulate.snap_window import run_snap_peaks
         row.update({q: v for q, v in run_snap_peaks(ds).items() if q in BEND_SNAP_PEAKS})
     row.update({"n_links": problem.links.N, "n_rhs": int(a["n_rhs"]), "cpu_time": time.process_time() - cpu})
+    row.update({q: float(a[q]) for q in CHAIN_COST_PARTS if q in a})  # (regimes_spec.CHAIN_COST_PARTS)
     return row
 
 
@@ -283,7 +284,7 @@ def _extra(mechanism) -> tuple:
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
     nc, nn, nl = len(chis), len(numbers), len(levels)
     data = {}
-    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time"):
+    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time") + (() if mechanism == "stretching" else CHAIN_COST_PARTS):
         data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
         data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
     data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))

@@ -157,6 +157,10 @@ STRETCH_EXTRA_PEAKS = {"sigma_peak_taut": "sigma_peak_taut"}
 #: (the whirl); the second converges slowly and overtakes the first from the second level on, so the levels
 #: jump (ideal chi 0.2: 334.0, 340.5, 364.5, 369.2). docs/guide/regimes.md "The curvature peak".
 CHAIN_EXTRA_PEAKS = ("kappa_peak_approach",)
+#: ... and, of each run's n_rhs, the evaluations that located kappa_peak_approach (``<name>_level``): the
+#: escalation's cost cap judges the integration's own cost, n_rhs less these, the work it judged before the
+#: fifth peak existed (:func:`snapping.regimes_escalate.integration_rhs`; branch emkappa)
+CHAIN_COST_PARTS = ("n_rhs_approach",)
 
 #: stretching, the shipped scan (``benchmarks/stretch_scan.py``): a cell (or the ideal at a chi) whose
 #: v_peak, a_peak or sigma_peak error bar exceeds this fraction of its limit runs one more level

@@ -141,6 +141,9 @@ PROBLEM_ATTRS: dict[str, str] = {
                             "output; NaN for a run resumed from a checkpoint written before it existed "
                             "(docs/guide/regimes.md, 'The curvature peak')"),
     "t_kappa_peak_approach": "time of kappa_peak_approach",
+    "n_rhs_approach": ("of n_rhs, the right-hand-side evaluations that located kappa_peak_approach (n_rhs less them: "
+                       "the integration's own cost, as before that peak existed; what a regime study's escalation "
+                       "cap judges); NaN for a run resumed from a checkpoint written before it existed"),
     "t_pin_settled": ("time from which the held end's acceleration no longer changes (NaN: a fixed held end); "
                       "with a moving held end the stop rule and snap_reached judge v_rel_max (the speed relative "
                       "to the held end) from then on, after it has risen above its value then"),

@@ -94,7 +94,7 @@ VALUE_KINDS: dict[str, str] = {
     "chi": _1, "N": _1, "tol": _1, "dt0": _T, "t_end": _T, "stop_fraction": _1, "snapshot_times": _T,
     "record_thin": _1, "t_end_max": _T, "max_link_error": _1, "max_energy_drift": _E, "dt_min": _T,
     "max_rejections": _1, "tip_mass": _M, "gravity": _A, "t_pin_settled": _T, "kappa_peak_approach": _K,
-    "t_kappa_peak_approach": _T,
+    "t_kappa_peak_approach": _T, "n_rhs_approach": _1,
     # results
     "failure_node": _1, "t_snap_v": _T, "t_snap_a": _T, "t_snap_sigma": _T, "snap_reached": _1,
     "v_peak": _V, "a_peak": _A, "sigma_peak": _F, "kappa_peak": _K, "kappa_max_0": _K, "energy_drift": _E,

@@ -36,7 +36,6 @@ sums of links, carry an extra round-off up to about N ulp).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ... import _validate as V
 from .. import angles as AG
@@ -44,6 +43,7 @@ from .. import general as G
 from .. import models as MD
 from .. import kernels as K
 from .. import dense_measure as DM
+from .. import peak_refine as PR
 from .. import rk as R
 from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0, SPEED_LEVEL_FACTOR, CheckpointMixin,
                               checkpoint_getter)
@@ -128,6 +128,7 @@ class Engine(CheckpointMixin):
         self.rec = np.zeros((RECORD_CHUNK, self.nrec))
         self.tol = tol
         self.n_extra = 0
+        self.n_rhs_approach = 0  # of n_rhs, the fifth peak's location (a general chain's; peak_refine)
         # initial state: slot 0 holds it as the end of a zero-length step
         self.Y1[0] = y0
         w = self.w
@@ -247,6 +248,9 @@ class Engine(CheckpointMixin):
                                   self.ytmp, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
                     self.ctl[R.Q_NRHS] += R.NSX - R.NS - 1
                     self.DOK[slot] = 1.0
+                    PR.note_dense(self, slot, True)
+                elif self.general:
+                    PR.note_dense(self, slot, False)
                 return slot, min(1.0, max(0.0, (t - t0) / h))
         raise RuntimeError(f"t={t!r} is outside the stored steps")  # pragma: no cover - internal
 
@@ -285,29 +289,9 @@ class Engine(CheckpointMixin):
         return Z, meas
 
     def refine(self) -> None:
-        """Locate the peaks flagged by the compiled loop on the dense output."""
-        bits = int(self.ctl[R.Q_REFINE])
-        self.ctl[R.Q_REFINE] = 0.0
-        pk = self.pk
-        # DOP853's dense output in one compiled call; an engine with its own (RODAS4's) by Z_at
-        measure = self.meas_at if type(self).state_at is Engine.state_at else (lambda tt: self.Z_at(tt)[1])
-        for qi in range(pk.shape[0]):
-            if not bits & (1 << qi):
-                continue
-            ta, tb = float(pk[qi, R.PK_TA]), float(pk[qi, R.PK_TB])
-            m = _PEAK_MEAS_G[qi]
-            if not tb > ta:
-                continue
-            res = minimize_scalar(lambda tt: -measure(tt)[m], bounds=(ta, tb), method="bounded",
-                                  options={"xatol": PEAK_XTOL * (tb - ta) + 1e-15 * abs(tb)})
-            tq = float(res.x)
-            q = float(-res.fun)
-            if q > pk[qi, R.PK_BEST]:
-                pk[qi, R.PK_BEST] = q
-                pk[qi, R.PK_TBEST] = tq
-            if qi == 0 and (self.peak_state is None or self.peak_state[0] != pk[0, R.PK_TBEST]):
-                tq = float(pk[0, R.PK_TBEST])
-                self.peak_state = (tq, self.Z_at(tq)[0])
+        """Locate the peaks flagged by the compiled loop on the dense output (:func:`peak_refine.refine`;
+        the fifth peak's evaluations counted apart too, ``n_rhs_approach``)."""
+        PR.refine(self, _PEAK_MEAS_G, PEAK_XTOL, one_call=type(self).state_at is Engine.state_at)
 
     def _set_targets(self) -> None:
         c = self.ctl
@@ -416,6 +400,8 @@ class Engine(CheckpointMixin):
             results["t_pin_settled"] = float(c[R.Q_TSETTLE]) if c[R.Q_TSETTLE] >= 0.0 else float("nan")
             results["kappa_peak_approach"] = float(pk[4, R.PK_BEST])
             results["t_kappa_peak_approach"] = float(pk[4, R.PK_TBEST])
+            na = self.n_rhs_approach
+            results["n_rhs_approach"] = int(na) if na == na else float("nan")
         for qi, name in enumerate(K.PEAK_QUANTITIES):
             if name != "kappa":
                 results[f"t_snap_{name}"] = float(pk[qi, R.PK_TBEST])
@@ -504,6 +490,7 @@ class Engine(CheckpointMixin):
         peak_t = float(get("checkpoint_peak_t", ()))
         self.peak_state = None if np.isnan(peak_t) else (peak_t, get("checkpoint_peak_state", self.Z.shape))
         self._restore_history(ds, get, R.Q_NREC)
+        self.n_rhs_approach = float(ds.attrs.get("n_rhs_approach", np.nan))  # (NaN: a checkpoint from before it)
 
 def _restore_grown(get, name: str, arr: np.ndarray) -> None:
     """Checkpoint variable ``name`` into ``arr``; a file written before a general chain's fifth peak row
