@@ -140,3 +140,26 @@ def test_n_rhs_less_the_fifth_peaks_is_the_run_without_it(monkeypatch, chi, mech
     assert with_it["n_rhs"] - with_it["n_rhs_approach"] == without["n_rhs"]
     for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak"):  # the same run otherwise
         assert with_it[q] == without[q]
+
+
+def _within(ds, q) -> int:
+    lim, err = ds[q].values, ds[q + "_error"].values
+    return int(np.sum(np.abs(err) <= 0.01 * np.abs(lim)))
+
+
+def test_shipped_end_mass_study_escalates_the_cell_the_fifth_peak_had_capped():
+    """The shipped file (`bench_regimes.py --study end-mass --workers 1`, this branch): chi 0.1 M 0.0072
+    took more than the cap at level 2 in all (the fifth peak's location included) but less in its
+    integration, and ran its fourth level, as before the fifth peak; the counts within 1%."""
+    ds = R.bundled_study("end-mass")
+    i, j = 0, int(np.flatnonzero(np.isclose(ds.number.values, 7.2e-3))[0])
+    assert float(ds.chi[i]) == 0.1 and int(ds.attrs["escalate_max_rhs"]) == 600_000
+    n, extra = ds.n_rhs_level.values[i, j], ds.n_rhs_approach_level.values[i, j]
+    assert n[2] > 600_000 > n[2] - extra[2]  # 604,213 in all, 588,330 of them the integration's
+    assert ds.levels_run.values[i, j] == 4 and ds.escalation_capped.values[i, j] == 1  # (level 3: 978,005)
+    ran = np.isfinite(ds.n_rhs_level.values)
+    assert np.array_equal(ran, np.isfinite(ds.n_rhs_approach_level.values))  # every run has its count
+    assert np.all((ds.n_rhs_approach_level.values[ran] >= 0) & (ds.n_rhs_approach_level.values[ran]
+                                                                 < ds.n_rhs_level.values[ran]))
+    counts = [_within(ds, q) for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_peak_approach")]
+    assert counts == [31, 31, 32, 19, 27]
