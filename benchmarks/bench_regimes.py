@@ -47,7 +47,8 @@ STUDIES = {
     # chi 0.1 is +-5% on 3 levels, +-2% on 4); `--escalate-from OLD` seeds the file with the 3-level study's runs.
     # A cell whose last level took more than 600,000 evaluations is not escalated (escalate_max_rhs; marked
     # escalation_capped): end mass 0.0072 at chi 0.1 took 987,000 at level 3 (7,328 links, 217 s CPU), its level 4
-    # would take ~700 s; 0.0193 took 1,039,000 at level 2
+    # would take ~700 s; 0.0193 took 1,039,000 at level 2. The cap counts the integration's evaluations: n_rhs less
+    # n_rhs_approach, those that located kappa_peak_approach (branch emkappa; regimes_escalate.integration_rhs)
     # (the end-mass numbers: the shipped file's since d50abbc; this dict said geomspace(1e-5, 1, 8), not what shipped)
     "end-mass": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.array([1.93e-6, 1e-5, 5.18e-5, 2.68e-4, 1.39e-3,
                                                                     7.2e-3, 0.0193, 0.0373]), "accuracy": "medium",
@@ -352,7 +353,8 @@ def cost(mech: str, path=None) -> dict:
               f"ideal {ds.levels_run_ideal.values.tolist()}")
     if "escalation_capped" in ds:
         cc = np.argwhere(ds.escalation_capped.values == 1)
-        print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level): "
+        print(f"  escalation capped (over {ds.attrs['escalate_max_rhs']} evaluations at the last level, the integration's: "
+              f"n_rhs less n_rhs_approach): "
               + (", ".join(f"chi {ds.chi.values[i]:g} number {ds.number.values[j]:g}" for i, j in cc) or "none"))
     worst = {}
     for q in ("kappa_peak", "kappa_peak_approach"):  # (the curvature: error bar within 1% of the value, any order)

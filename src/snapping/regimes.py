@@ -385,8 +385,8 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
         one more level, up to ``extra_levels`` (default 1) more (:mod:`snapping.regimes_escalate`; the
         ideal at that chi too). Both are in the study's key. None (the default): every cell runs ``levels``.
     escalate_max_rhs : int, optional
-        With ``escalate``: a cell whose last level took more right-hand-side evaluations is not escalated
-        (marked ``escalation_capped``; in the study's key). None (the default): no cap.
+        With ``escalate``: a cell whose last level took more right-hand-side evaluations in its integration
+        (n_rhs less ``n_rhs_approach``) is not escalated (``escalation_capped``; in the study's key). None: no cap.
 
     Returns
     -------

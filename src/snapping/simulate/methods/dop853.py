@@ -289,8 +289,7 @@ class Engine(CheckpointMixin):
         return Z, meas
 
     def refine(self) -> None:
-        """Locate the peaks flagged by the compiled loop on the dense output (:func:`peak_refine.refine`;
-        the fifth peak's evaluations counted apart too, ``n_rhs_approach``)."""
+        """Locate the flagged peaks on the dense output (:func:`peak_refine.refine`; + ``n_rhs_approach``)."""
         PR.refine(self, _PEAK_MEAS_G, PEAK_XTOL, one_call=type(self).state_at is Engine.state_at)
 
     def _set_targets(self) -> None:
