@@ -83,10 +83,10 @@ def test_a_study_file_without_the_counts_caps_on_n_rhs(fake):
 
 
 class _Eng:
-    """The attributes :func:`peak_refine.note_dense` reads (two step slots)."""
+    """The attributes :func:`peak_refine.note_dense` reads (two step slots, their dense outputs built)."""
 
     def __init__(self):
-        self.TS, self.HS, self.n_rhs_approach, self._refining_approach = np.array([0.0, 0.1]), np.full(2, 0.1), 0, False
+        self.DOK, self.n_rhs_approach, self._refining_approach = np.ones(2), 0, False
 
 
 def test_a_dense_output_the_fifth_peak_built_goes_back_when_the_others_use_it():
@@ -95,24 +95,25 @@ def test_a_dense_output_the_fifth_peak_built_goes_back_when_the_others_use_it():
     e.n_rhs_approach += PR.DENSE_EVALS  # (refine counts what the build added to n_rhs)
     PR.note_dense(e, 1, True)
     PR.note_dense(e, 1, False)  # the fifth peak again: still its own
-    assert e.n_rhs_approach == PR.DENSE_EVALS
+    assert e.n_rhs_approach == PR.DENSE_EVALS and e.DOK[1] == PR.BUILT_FOR_APPROACH
     e._refining_approach = False
+    PR.note_dense(e, 0, False)  # another slot: nothing
+    assert e.n_rhs_approach == PR.DENSE_EVALS
     PR.note_dense(e, 1, False)  # v's refinement (or a snapshot) uses it: before the fifth peak, v built it
-    assert e.n_rhs_approach == 0
+    assert e.n_rhs_approach == 0 and e.DOK[1] == 1.0
     PR.note_dense(e, 1, False)  # once only
     assert e.n_rhs_approach == 0
     assert PR.DENSE_EVALS == 3  # DOP853's dense output: stages 13-15 of 16 (Hairer's DOP853)
 
 
-def test_a_slot_overwritten_since_keeps_the_fifth_peaks_count():
+def test_a_slot_built_by_the_others_is_never_the_fifth_peaks():
     e = _Eng()
+    PR.note_dense(e, 0, True)  # built by v's refinement: its own
     e._refining_approach = True
-    e.n_rhs_approach = PR.DENSE_EVALS
-    PR.note_dense(e, 0, True)
+    PR.note_dense(e, 0, False)  # used by the fifth peak's: free for it
     e._refining_approach = False
-    e.TS[0], e.HS[0] = 0.2, 0.05  # the slot now holds a later step (its dense output not the one built)
     PR.note_dense(e, 0, False)
-    assert e.n_rhs_approach == PR.DENSE_EVALS
+    assert e.n_rhs_approach == 0 and e.DOK[0] == 1.0
 
 
 def _cell_run(monkeypatch, skip_fifth: bool, chi, mechanism, number):
@@ -163,3 +164,32 @@ def test_shipped_end_mass_study_escalates_the_cell_the_fifth_peak_had_capped():
                                                                  < ds.n_rhs_level.values[ran]))
     counts = [_within(ds, q) for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "kappa_peak_approach")]
     assert counts == [31, 31, 32, 19, 27]
+
+
+def test_a_resumed_run_keeps_the_count(tmp_path):
+    """Interrupted where a dense output the fifth peak built is still held (``DOK`` 2, checkpointed) and
+    mid-run, then resumed: n_rhs and n_rhs_approach are the uninterrupted run's (the ideal at chi 0.1,
+    level 0: 20,515 and 2,150)."""
+    from test_checkpoint import _StopAt
+
+    from snapping.simulate import RunInterrupted, resume, run
+    from snapping.simulate import driver as stepper
+
+    p = R.cell_problem(0.1, None, 0.0, R._levels("fold", {"levels": 3, "first": -1}, 0.5)[0])
+    held = []
+    stepper._chunk_hook = lambda eng: held.append(PR.BUILT_FOR_APPROACH in eng.DOK) and None
+    try:
+        ref = run(p, method="fast", tol=1e-7, progress=False).dataset.attrs
+        ks = [k + 1 for k, h in enumerate(held) if h]
+        assert ks, "no return with the fifth peak's dense output held"
+        for k in (ks[0], len(held) // 2):
+            stepper._chunk_hook = _StopAt(k)
+            with pytest.raises(RunInterrupted):
+                run(p, method="fast", tol=1e-7, progress=False, output=tmp_path / "r.nc", checkpoint_every=None,
+                    overwrite=True)
+            stepper._chunk_hook = None
+            a = resume(tmp_path / "r.nc").dataset.attrs
+            assert (a["n_rhs"], a["n_rhs_approach"], a["kappa_peak_approach"]) == (
+                ref["n_rhs"], ref["n_rhs_approach"], ref["kappa_peak_approach"])
+    finally:
+        stepper._chunk_hook = None

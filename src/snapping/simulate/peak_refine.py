@@ -23,28 +23,29 @@ from scipy.optimize import minimize_scalar
 
 from . import rk as R
 
-__all__ = ["APPROACH_ROW", "DENSE_EVALS", "refine", "note_dense"]
+__all__ = ["APPROACH_ROW", "DENSE_EVALS", "BUILT_FOR_APPROACH", "refine", "note_dense"]
 
 #: the peak table's row of kappa_peak_approach (a general chain's fifth peak)
 APPROACH_ROW = 4
 #: evaluations of one step's dense output (DOP853's extra stages)
 DENSE_EVALS = R.NSX - R.NS - 1
+#: a step slot's ``DOK`` when the fifth peak's refinement built its dense output (1: built otherwise; 0: not)
+BUILT_FOR_APPROACH = 2.0
 
 
 def note_dense(eng, slot: int, built: bool) -> None:
     """Account a use of step ``slot``'s dense output (``built``: it was built just now, its
     :data:`DENSE_EVALS` evaluations counted in ``n_rhs``): built while the fifth peak is refined, it is
-    the fifth peak's; built by it and used now by anything else, it goes back to the rest."""
-    key = (float(eng.TS[slot]), float(eng.HS[slot]))
-    mine = getattr(eng, "_approach_dense", None)
-    if mine is None:
-        mine = eng._approach_dense = [None, None]
+    the fifth peak's (``DOK[slot]`` :data:`BUILT_FOR_APPROACH`, checkpointed with the slot; the step loop
+    sets it to 0 when the slot takes a new step); built by it and used now by anything else, its
+    evaluations go back to the rest, once."""
+    mine = getattr(eng, "_refining_approach", False)
     if built:
-        mine[slot] = key if getattr(eng, "_refining_approach", False) else None
-    elif mine[slot] is not None and not getattr(eng, "_refining_approach", False):
-        if mine[slot] == key:  # (the same step: the slot was not overwritten since)
-            eng.n_rhs_approach -= DENSE_EVALS
-        mine[slot] = None
+        if mine:
+            eng.DOK[slot] = BUILT_FOR_APPROACH
+    elif eng.DOK[slot] == BUILT_FOR_APPROACH and not mine:
+        eng.n_rhs_approach -= DENSE_EVALS
+        eng.DOK[slot] = 1.0
 
 
 def refine(eng, peak_meas, xtol: float, one_call: bool) -> None:
