@@ -11,6 +11,12 @@ acceleration ripple (RMS of ``a_end`` minus its 0.03-wide running mean over 0.9 
 < 1.1), steps and CPU seconds (``time.process_time``). Then a least-squares line of a_peak against
 ``eta_max^(-1/2)`` over the runs given.
 
+``--quench K T:ZQ [T:ZQ ...]`` instead of RUNs: level K run to t = T at the grid damping ratio ZQ, then on
+from that state (:meth:`snapping.simulate.Problem.nodes`, positions and velocities) at the study's ratio 1;
+printed: the largest acceleration after t = 0.8, its time and node, v_peak and the ripple as above. ``T:1``
+is the control (the same run, restarted); a heavy ZQ (8) before T damps the bending waves already present
+at T: if the crest goes, they made it.
+
 Two runs with the same eta_max on different links (``L2:0.5`` and ``L3:2``: eta is proportional to
 zeta h^2) separate the links' effect from the damping's. docs/guide/regimes.md ("Why chi = 0.5, beta =
 0.01 misses in a_peak") gives the commands and numbers.
@@ -63,12 +69,45 @@ def one(chi: float, beta: float, spec: str) -> dict:
             "rip2": ripple(ds, 1.0, 1.1), "steps": int(t.size), "cpu": cpu}
 
 
+def quench(chi: float, beta: float, k: int, T: float, zq: float) -> dict:
+    from snapping.regimes import cell_problem, eta_grid
+    from snapping.simulate import Body, Problem, run
+
+    level, _ = parse(f"L{k}")
+    p1 = cell_problem(chi, "bending", beta, level, damping=zq)
+    cpu = time.process_time()
+    d1 = run(p1, method="rodas4", tol=1e-7, t_end=T, progress=False).dataset
+    s = d1.isel(snapshot=[str(x) for x in d1.snapshot_kind.values].index("final"))
+    t0 = float(s.t_snapshot)
+    body = Body(bending=beta, damping=eta_grid(p1.links.h, beta, 1.0))
+    p2 = Problem.nodes(s.x.values, s.y.values, links=p1.links, vx=s.vx.values, vy=s.vy.values, name="quenched",
+                       body=body)
+    d2 = run(p2, method="rodas4", tol=1e-7, progress=False).dataset
+    cpu = time.process_time() - cpu
+    d2 = d2.assign_coords(t=d2.t + t0)
+    t, a = d2.t.values, d2.a_max.values
+    i = np.flatnonzero(t > 0.8)[np.argmax(a[t > 0.8])]
+    return {"spec": f"L{k} {T:g}:{zq:g}", "a": float(a[i]), "t_a": float(t[i]), "s_a": float(d2.s_a_max.values[i]),
+            "v": float(d2.attrs["v_peak"]), "t_v": float(d2.attrs["t_snap_v"]) + t0, "rip1": ripple(d2, 0.9, 1.0),
+            "t0": t0, "cpu": cpu}
+
+
 def main(argv=None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     chi, beta, specs = float(argv[0]), float(argv[1]), argv[2:]
     import os
 
     print(f"chi {chi:g} beta {beta:g}; load {os.getloadavg()[0]:.1f}")
+    if specs and specs[0] == "--quench":
+        k = int(specs[1])
+        print(f"{'run':>12} {'t0':>7} {'a after 0.8':>11} {'t_a':>8} {'s_a':>6} {'v_peak':>9} {'t_v':>8} {'rip.9-1':>7} "
+              f"{'cpu s':>6}")
+        for tz in specs[2:]:
+            T, zq = (float(x) for x in tz.split(":"))
+            r = quench(chi, beta, k, T, zq)
+            print(f"{r['spec']:>12} {r['t0']:7.4f} {r['a']:11.6g} {r['t_a']:8.5f} {r['s_a']:6.4f} {r['v']:9.6f} "
+                  f"{r['t_v']:8.5f} {r['rip1']:7.3f} {r['cpu']:6.1f}", flush=True)
+        return
     print(f"{'run':>9} {'links':>5} {'eta_max':>9} {'a_peak':>11} {'t_a':>8} {'s_a':>6} {'v_peak':>9} {'t_v':>8} "
           f"{'sigma':>9} {'rip.9-1':>7} {'rip1-1.1':>8} {'steps':>6} {'cpu s':>6}")
     rows = []
