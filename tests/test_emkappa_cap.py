@@ -21,7 +21,7 @@ import pytest
 from snapping import regimes as R
 from snapping import regimes_escalate as X
 from snapping.continuum import QUANTITIES
-from snapping.simulate import peak_refine as PR
+from snapping.simulate import dense_peaks as PR
 from snapping.simulate import rk as RK
 
 
@@ -83,7 +83,7 @@ def test_a_study_file_without_the_counts_caps_on_n_rhs(fake):
 
 
 class _Eng:
-    """The attributes :func:`peak_refine.note_dense` reads (two step slots, their dense outputs built)."""
+    """The attributes :func:`dense_peaks.note_dense` reads (two step slots, their dense outputs built)."""
 
     def __init__(self):
         self.DOK, self.n_rhs_approach, self._refining_approach = np.ones(2), 0, False
@@ -120,13 +120,13 @@ def _cell_run(monkeypatch, skip_fifth: bool, chi, mechanism, number):
     from snapping.simulate.methods import dop853
 
     if skip_fifth:  # the run as before the fifth peak: its flag cleared, never located
-        real = PR.refine
+        real = PR.DenseOutputPeaks.refine
 
         def refine(eng, *a, **k):
             eng.ctl[RK.Q_REFINE] = float(int(eng.ctl[RK.Q_REFINE]) & ~(1 << PR.APPROACH_ROW))
             real(eng, *a, **k)
 
-        monkeypatch.setattr(dop853.PR, "refine", refine)
+        monkeypatch.setattr(dop853.Engine, "refine", refine)
     lv = R._levels("fold", {"levels": 3, "first": -1}, 0.5)
     return R._run_task(chi, mechanism, number, lv[0], 1e-7)
 

@@ -75,7 +75,7 @@ def integration_rhs(n_rhs_row, approach_row=None) -> np.ndarray:
     +15% on a crumpled heavy-drag cell) that say nothing about what the next level's integration will
     cost; counted, they moved end mass chi 0.1 M 0.0072 (588,503 at its fourth level) over the 600,000
     cap, so a study measuring one more peak ran one level fewer. Less them, every run's count is the one
-    it had before, to the evaluation (:mod:`snapping.simulate.peak_refine`), and the cap decides as before.
+    it had before, to the evaluation (:mod:`snapping.simulate.dense_peaks`), and the cap decides as before.
 
     >>> integration_rhs([600_100.0, float("nan")], [200.0, float("nan")]).tolist()
     [599900.0, nan]

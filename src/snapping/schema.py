@@ -354,7 +354,7 @@ CHECKPOINT_VARS_DOP853: dict[str, dict[str, str]] = {
     "checkpoint_step_t": _v("start times of the two stored steps"),
     "checkpoint_step_h": _v("sizes of the two stored steps"),
     "checkpoint_dense_ok": _v("1 where the dense output of a stored step has been built (2: built while locating "
-                              "kappa_peak_approach, simulate.peak_refine), else 0"),
+                              "kappa_peak_approach, simulate.dense_peaks), else 0"),
     "checkpoint_Z": _v("positions, velocities, accelerations and tensions of the current state"),
     "checkpoint_peak_t": _v("time of the located peak of v_max (NaN: none yet)"),
     **{k: CHECKPOINT_VARS[k] for k in ("checkpoint_peak_state", "checkpoint_ctl", "checkpoint_pk", "checkpoint_meas",
