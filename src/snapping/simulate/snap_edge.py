@@ -28,19 +28,26 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["window_edge", "EDGE_XTOL", "EDGE_MAXITER"]
+__all__ = ["window_edge", "EDGE_XTOL", "EDGE_ULPS", "EDGE_VTOL", "EDGE_MAXITER"]
 
 #: the edge's time is located to this fraction of its step (the measures' error from it is this
-#: times their change over the step: below 1e-12 of sigma at chi 0.3, c 442.7)
-EDGE_XTOL = 1e-12
+#: times their change over the step: 1e-10 of sigma's rise over the step, 3e-12 of sigma at chi 0.3,
+#: c 442.7), and never to less than ``EDGE_ULPS`` spacings of the floats at the edge's time (a step
+#: of 1e-4 at t ~ 1 would ask for less than one: the search would run to ``EDGE_MAXITER``)
+EDGE_XTOL = 1e-10
+EDGE_ULPS = 8
+#: ... or until v_max is within this fraction of the threshold (1e-12: the edge's time then errs by
+#: 1e-12 v / |dv/dt|, 1e-15 of the step at chi 0.3, c 442.7; the false position's last trials, once
+#: the bracket's far end no longer moves, would otherwise bisect down to the time tolerance)
+EDGE_VTOL = 1e-12
 #: at most this many integrations to the trial times (the Illinois method takes 5-10)
 EDGE_MAXITER = 60
 
 
-def _illinois(g, a: float, b: float, ga: float, gb: float, xtol: float, maxiter: int):
+def _illinois(g, a: float, b: float, ga: float, gb: float, xtol: float, ftol: float, maxiter: int):
     """A root of ``g`` in ``[a, b]`` with ``ga = g(a) >= 0 > gb = g(b)`` (the Illinois false position):
-    (t, the last trial's payload) with ``g(t) >= 0``, ``|b - a| <= xtol`` or ``g(t) == 0``; ``g`` returns
-    (value, payload) or None (the integration failed: then None)."""
+    (t, its trial's payload) with ``|g(t)| <= ftol``, else the bracket's left end once ``|b - a| <= xtol``
+    (``g >= 0`` there); ``g`` returns (value, payload) or None (the integration failed: then None)."""
     pa = None
     side = 0
     for _ in range(maxiter):
@@ -53,7 +60,7 @@ def _illinois(g, a: float, b: float, ga: float, gb: float, xtol: float, maxiter:
         if got is None:
             return None
         gx, px = got
-        if gx == 0.0:
+        if abs(gx) <= ftol:
             return x, px
         if gx > 0.0:
             a, ga, pa = x, gx, px
@@ -112,7 +119,8 @@ def window_edge(t, v, peak_state, v_peak: float, restep, measure, fraction: floa
     if end[0] >= 0.0:  # (round-off: the replayed end is not below: the edge is the step's end)
         return float(t[k]), k, end[1]
     got = _illinois(g, float(t0), float(t[k]), float(m0[0] - thr), float(end[0]),
-                    EDGE_XTOL * float(t[k] - t0), EDGE_MAXITER)
+                    max(EDGE_XTOL * float(t[k] - t0), EDGE_ULPS * float(np.spacing(abs(t[k])))), EDGE_VTOL * thr,
+                    EDGE_MAXITER)
     if got is None:
         return None
     te, mm = got

@@ -66,6 +66,15 @@ The snap's peaks are computed from the run's per-step records: where the run's r
 (``a_peak``, ``sigma_peak``) falls inside the window it is taken as is (so the snap's peaks
 equal the run's whenever the run's peaks belong to the snap, bit for bit); otherwise the
 largest recorded step value inside the window (step ends, not refined).
+
+**The window's exact end** (branch window): an elastic run ends the 0.9 window where v_max falls to
+0.9 of its (refined) peak, located on the integrator's states (:mod:`snapping.simulate.snap_edge`,
+``t_snap_edge``), and ``snap_peaks(..., edge=)`` takes the records before that step and the value at
+the edge, not the recorded step past it: where the tension still rises at the window's end, that
+step overshot the edge by up to a step's rise (chi 0.3, c 442.7, fold level -1: 19.08 against 18.86),
+a jitter between levels that kept two study cells over 1%. ``t_snap_end`` stays the recorded step.
+The release window's start and the taut window's end (a slack link) stay recorded steps: the
+former is not where any peak lies, the latter is taken at its end only where it is the 0.9 window's.
 """
 
 from __future__ import annotations
