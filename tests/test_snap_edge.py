@@ -169,3 +169,46 @@ def test_shipped_stretching_study_sigma_at_the_exact_edge():
         assert float(s.sigma_peak_error) <= 0.01 * float(s.sigma_peak), (chi, c)
     s = ds.sel(chi=0.3).sel(number=1.0 / 442.71632328565266, method="nearest")
     assert float(s.sigma_peak_level.values[0]) == pytest.approx(18.8559088083, rel=1e-8)
+
+
+@pytest.mark.parametrize("t0", [0.0, 1000.0])
+def test_edge_search_stops_within_a_few_integrations(t0):
+    """The search stops once v_max is within EDGE_VTOL of the threshold, or the bracket within EDGE_ULPS float
+    spacings of t (at t ~ 1000 a step's 1e-10 is below 8 of them): a handful of integrations, not
+    EDGE_MAXITER (60; a real run at chi 0.3, c 442.7 took 59 with a time tolerance under one spacing)."""
+    tr = TR + t0
+    n = []
+
+    def restep(a, y, b):
+        n.append(1)
+        return _rot(a, y, b)
+
+    def measure(t, z):
+        return _measure(t - t0, z)
+
+    t_edge, k, mm = window_edge(tr, MR[:, 0], (tr[IP], ZR[IP]), 1.0, restep, measure, 0.9)
+    assert t_edge - t0 == pytest.approx(T_EDGE, abs=1e-12 + 16 * np.spacing(t0 + 1.0))
+    assert len(n) - (k - 1 - IP) <= 10, len(n)
+
+
+
+def test_real_run_edge_search_takes_a_few_integrations(monkeypatch):
+    """On a real run v_max carries the round-off of a fresh integration per trial: the search stops at
+    EDGE_VTOL of the threshold or EDGE_ULPS float spacings of t, in a few integrations (chi 0.3, c 442.7,
+    279 links: 59 with a time tolerance of 1e-12 of the step, under one float spacing; 13 since)."""
+    import snapping.simulate.elastic_solve as ESv
+
+    got = []
+
+    def wrapped(t, v, ps, vp, restep, measure, fraction):
+        calls = []
+        out = window_edge(t, v, ps, vp, lambda *a: calls.append(a) or restep(*a), measure, fraction)
+        got.append((out, calls))
+        return out
+
+    monkeypatch.setattr(ESv, "window_edge", wrapped)
+    ds = _solve("rodas4-links", 1e-6)
+    (out, calls), = got
+    t0 = ds.t.values[out[1] - 1]
+    trials = [c for c in calls if c[0] == t0]
+    assert ds.attrs["t_snap_edge"] == out[0] and 2 <= len(trials) <= 10, len(trials)
