@@ -201,7 +201,7 @@ def test_every_cell_is_resolved_to_one_percent(shipped):
 def test_snap_peaks_resolved_and_capped(shipped):
     """The snap's acceleration and tension (branch snappeaks): each cell's limit and bar are the
     Richardson extrapolation of its levels by hand (the escalated cells' five); within 1% in 31 and
-    30 of 32 cells (24 and 24 on four levels for all; the run's peaks gave 23 and 17); the ideal's columns are the bending study's independent runs (the same
+    31 of 32 cells (30 in sigma before branch window ended the window at its exact edge) (24 and 24 on four levels for all; the run's peaks gave 23 and 17); the ideal's columns are the bending study's independent runs (the same
     links at tol 1e-7) within 1e-6; and stretching caps the snap's acceleration: no cell's a_peak is
     above the ideal's beyond twice its bar + 1e-3 (the run's peaks, taken in the recoil, were up to
     7.4 times it: chi 0.3, c 442), and the stiffest line at chi 0.5 (c = 220 v_ideal) has both
@@ -217,7 +217,8 @@ def test_snap_peaks_resolved_and_capped(shipped):
                 v, e = float(shipped[q].values[i, j]), float(shipped[f"{q}_error"].values[i, j])
                 assert v == pytest.approx(lim, rel=1e-12) and e == pytest.approx(err, rel=1e-9, abs=1e-15), (q, chi, j)
                 n_ok += e <= 0.01 * v
-        assert n_ok >= {"a_peak": 31, "sigma_peak": 30}[q], (q, n_ok)  # (branch stretch1pct's escalated scan)
+        # (branch stretch1pct's escalated scan: 31, 30; branch window's exact window end: sigma 31)
+        assert n_ok >= {"a_peak": 31, "sigma_peak": 31}[q], (q, n_ok)
         r = shipped[f"{q}_ratio"].sel(chi=0.5).values[0]
         assert abs(r - 1.0) < 5e-3, (q, r)
     r, re = shipped.a_peak_ratio.values, shipped.a_peak_ratio_error.values
@@ -388,8 +389,11 @@ def test_escalated_cells_are_those_over_one_percent_on_four_levels(shipped):
             assert int(shipped.levels_run.values[i, j]) == (5 if over else 4), (chi, j)
             assert np.isfinite(shipped.v_peak_level.values[i, j, 4]) == over
             any_cell |= over
-        assert int(shipped.levels_run_ideal.values[i]) == (5 if any_cell else 4), chi
-    assert int((shipped.levels_run.values == 5).sum()) == 13
+        # (five where a cell ran five; the file of branch window resumed the ideal's runs of the one before,
+        # whose chi 0.5 ideal had a fifth level for a cell that no longer needs one: kept, not dropped)
+        assert int(shipped.levels_run_ideal.values[i]) >= (5 if any_cell else 4), chi
+    # 13 cells before branch window; 8 since: the sigma levels at the window's exact edge converge
+    assert int((shipped.levels_run.values == 5).sum()) == 8
 
 
 def test_taut_tension_column(shipped):
@@ -401,4 +405,5 @@ def test_taut_tension_column(shipped):
     assert np.array_equal(ok, np.isfinite(s)) and np.all(t[ok] >= s[ok] * (1 - 1e-12))
     np.testing.assert_array_equal(shipped.sigma_peak_taut_ideal_level.values, shipped.sigma_peak_ideal_level.values)
     d = np.diff(t[0, 6])
-    assert np.all(d > 0) and np.all(d[1:] / d[:-1] > 0.5), d
+    d = d[np.isfinite(d)]  # (four levels since branch window: the cell's sigma no longer escalates it)
+    assert d.size >= 3 and np.all(d > 0) and np.all(d[1:] / d[:-1] > 0.5), d

@@ -273,11 +273,15 @@ ELASTIC_RESULT_ATTRS: dict[str, str] = {
     "strain_peak": "largest link strain over the recorded steps",
     "t_first_slack": "time of the first recorded step with a slack link (NaN: none)",
     "a_peak_snap": ("peak of the maximum acceleration over the snap: from the start until v_max, after its peak, "
-                    "falls below 0.9 of it (t_snap_end); a_peak itself where it lies in that window, else the "
-                    "largest recorded step (snapping.simulate.snap_window)"),
+                    "falls to 0.9 of it (t_snap_edge); a_peak itself where it lies in that window, else the "
+                    "largest of the recorded steps before the edge and the value at the edge "
+                    "(snapping.simulate.snap_window, snap_edge)"),
     "sigma_peak_snap": ("peak of the maximum tension over the snap (as a_peak_snap): excludes the slack fold and "
                         "recoil after the snap, which the run's sigma_peak may hold"),
     "t_snap_end": "end of the snap's window: the first recorded step after the speed peak with v_max < 0.9 v_peak",
+    "t_snap_edge": ("the snap window's exact end: the time after the speed peak at which v_max falls to 0.9 v_peak, "
+                    "on the states integrated from its recorded step's start (NaN: v_max never falls that far; "
+                    "snapping.simulate.snap_edge)"),
     "sigma_peak_taut": ("peak of the maximum tension over the taut snap: from the start until the line first goes "
                         "slack after the speed peak, never before t_snap_end (t_taut_end); sigma_peak itself where it "
                         "lies in that window, else the largest recorded step (snapping.simulate.snap_window)"),

@@ -29,7 +29,7 @@ from . import elastic_stage as ES
 #: peaks in this order)
 KCOL = np.array([0, 2, 4])
 
-__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "grid", "measure"]
+__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "restep_call", "grid", "measure"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -277,3 +277,21 @@ def refine_segments(stepper, best, keep, samples: int, window: int):
                         stepper.ctl[ER.C_AUTO], stepper.pinpar, stepper.pintab, ln.h, ln._invm, ln.m, ln.ea, ln.damp,
                         ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, True, PR0)
     return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)
+
+
+def restep_call(stepper, method: str, n_restep: list):
+    """``restep(t0, y0, t1)`` (the node state at ``t1`` integrated from ``(t0, y0)``, None if that fails) of a
+    RODAS4 run's ``stepper`` as one compiled call (:func:`restep`, :func:`restep_links`: the same numbers as a
+    fresh stepper's), its evaluations added to ``n_restep[0]``; None for other methods (branch window: the
+    snap window's edge, :mod:`snapping.simulate.snap_edge`)."""
+    if method not in ("rodas4", "rodas4-links"):
+        return None
+    fn = restep_links if method == "rodas4-links" else restep
+    args = (stepper.tol, stepper.ctl[ER.C_AUTO], stepper.pinpar, stepper.pintab, *stepper.args())
+
+    def call(t0, y0, t1):
+        y = np.empty(np.shape(y0))
+        ok, nf = fn(stepper.N, float(t0), np.ascontiguousarray(y0, dtype=float), float(t1), *args, y)
+        n_restep[0] += int(nf)
+        return y if ok else None
+    return call

@@ -54,7 +54,8 @@ from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
-from .snap_window import snap_peaks, taut_peaks
+from .snap_edge import window_edge
+from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
@@ -558,11 +559,17 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
         "wall_time": wall, "wave_speed": line.wave_speed, "stop_speed_floor": float(floor),
         "t_stop_armed": float(t_armed),
     }
+    edge = window_edge(times, rec[:, STEP_NAMES.index("v_max")], peak_state, ref["v"][0],
+                       ERF.restep_call(solver, method, n_restep) or restep, line.measure, SNAP_FRACTION)
     snap = snap_peaks(times, rec[:, STEP_NAMES.index("v_max")],
-                      {k: rec[:, STEP_NAMES.index(f"{k}_max")] for k in ("a", "sigma")}, ref, ref["v"][1])
-    results.update(a_peak_snap=snap["a"], sigma_peak_snap=snap["sigma"], t_snap_end=snap["t_snap_end"])
+                      {k: rec[:, STEP_NAMES.index(f"{k}_max")] for k in ("a", "sigma")}, ref, ref["v"][1],
+                      edge=None if edge is None else (edge[0], edge[1], {"a": edge[2][2], "sigma": edge[2][4]}))
+    results.update(a_peak_snap=snap["a"], sigma_peak_snap=snap["sigma"], t_snap_end=snap["t_snap_end"],
+                   t_snap_edge=snap["t_snap_edge"], n_rhs=int(solver.nfev) + n_restep[0])
     taut = taut_peaks(times, rec[:, STEP_NAMES.index("v_max")], rec[:, STEP_NAMES.index("n_slack")],
                       {"sigma": rec[:, STEP_NAMES.index("sigma_max")]}, ref, ref["v"][1])
+    if edge is not None and taut["t_taut_end"] == snap["t_snap_end"]:  # (the taut window is the 0.9 one: its end)
+        taut["sigma"] = snap["sigma"]
     results.update(sigma_peak_taut=taut["sigma"], t_taut_end=taut["t_taut_end"])
     cols = {k: rec[:, STEP_NAMES.index(k)] for k in ("sigma_max", "dt", "n_slack", "sigma_min")}
     ring, ok, note = EC.peak_guard(np.asarray(times), cols, wave_speed=line.wave_speed, length=float(np.sum(line.h)),
