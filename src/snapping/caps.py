@@ -376,7 +376,7 @@ def auto_hopeless(grading: dict) -> str:
     links it would try reach the scale that holds the fold (the climbing rope at chi 0.05 and 0.1:
     0.31 links on 1600, where its tension still moved 35% from 800; 10.8 s of CPU for nothing).
 
-    >>> auto_hopeless({"used": False, "too_fine": 5552, "bending_length": 1.91e-4})[:44]
+    >>> auto_hopeless({"used": False, "too_fine": 5552, "bending_length": 1.91e-4})[:45]
     'the fold collapses onto the links and graded '
     >>> auto_hopeless({"used": False, "too_fine": 5552, "bending_length": 0.02}), auto_hopeless({"used": False})
     ('', '')
@@ -461,7 +461,7 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
         n_rhs += r["n_rhs"]
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],
-                     "stretching": r["stretching"], "N": r["N"], "resolved": _row_resolved(r),
+                     "stretching": r["stretching"], "N": r.get("N", N), "resolved": _row_resolved(r),
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
     ok = [r["chi"] for r in rows if r["admissible"]]
