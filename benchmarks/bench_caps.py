@@ -39,6 +39,7 @@ Usage::
     python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
     python benchmarks/bench_caps.py --escalation nylon-monofilament fly-line --chi 0.1 --N 200
     python benchmarks/bench_caps.py --answers ball-chain fly-line --chis 0.1 0.25 --N 200
+    python benchmarks/bench_caps.py --answers climbing-rope bungee-cord --chis 0.1 0.25 --default-N   # caps.cap's N=None
     python benchmarks/bench_caps.py --order nylon-monofilament --chi 0.1 --levels 1 2 3
     python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0 1 2 --tols 1e-3 3e-3 1e-2
 """
