@@ -1,6 +1,6 @@
 """The diagnostics on DOP853's dense output at one time, in one compiled call.
 
-:meth:`snapping.simulate.methods.dop853.Engine.refine` locates each flagged peak with a bounded
+:meth:`snapping.simulate.dense_peaks.DenseOutputPeaks.refine` locates each flagged peak with a bounded
 scalar minimization whose every evaluation was four Python-level steps (the dense output, the right
 side for the tensions, fresh ``Z`` and ``meas`` arrays, the measures: ~100 us each, 10,050 of them in
 the fly line's answer at chi 0.1, ~1 s of its CPU under the profiler). :func:`measure_at` makes the

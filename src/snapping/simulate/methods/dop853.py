@@ -36,14 +36,13 @@ sums of links, carry an extra round-off up to about N ulp).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ... import _validate as V
 from .. import angles as AG
 from .. import general as G
 from .. import models as MD
 from .. import kernels as K
-from .. import dense_measure as DM
+from ..dense_peaks import _PEAK_MEAS_G, DenseOutputPeaks
 from .. import rk as R
 from .._engine_common import (AFTER_PEAK_FRACTIONS, RECORD_CHUNK, SPEED_LEVEL_0, SPEED_LEVEL_FACTOR, CheckpointMixin,
                               checkpoint_getter)
@@ -73,13 +72,8 @@ CHECKPOINT_VARS = _checkpoint_names()
 
 #: node-evaluations per call into the compiled loop (sets how often the progress bar moves)
 NODE_EVALS_PER_CALL = 20_000_000
-#: relative width (of the bracketing interval) to which peaks are located
-PEAK_XTOL = 1e-10
 #: beta of the PI step-size controller (0: the classical I controller)
 PI_BETA = 0.0
-_PEAK_MEAS = (K.M_VMAX, K.M_AMAX, K.M_SIGMAX, K.M_KMAX)
-#: a general chain's peaks: + kappa_max_interior on the approach (``kappa_peak_approach``)
-_PEAK_MEAS_G = _PEAK_MEAS + (G.M_KIN,)
 
 
 def resolve_method(method: str) -> str:
@@ -91,7 +85,7 @@ def resolve_method(method: str) -> str:
     return FAST if method == "fast" else method
 
 
-class Engine(CheckpointMixin):
+class Engine(DenseOutputPeaks, CheckpointMixin):
     """State and buffers of a DOP853 angle-form run (see :func:`rk.advance_rk`)."""
 
     def __init__(self, y0, t0, *, tol, dt0, t_end, stop_fraction, thin, max_link_error, snapshot_times,
@@ -235,79 +229,6 @@ class Engine(CheckpointMixin):
     def records(self) -> np.ndarray:
         self.drain()
         return np.concatenate(self.chunks) if self.chunks else np.zeros((0, self.nrec))
-
-    def _dense_slot(self, t: float) -> tuple[int, float]:
-        """The step slot holding time t (its dense output built) and t's fraction of it."""
-        for slot in (int(self.ctl[R.Q_SLOT]), 1 - int(self.ctl[R.Q_SLOT])):
-            t0, h = self.TS[slot], self.HS[slot]
-            if h > 0.0 and t0 - 1e-14 * max(1.0, abs(t0)) <= t <= t0 + h * (1 + 1e-12) + 1e-300:
-                if self.DOK[slot] == 0.0:
-                    w = self.rw
-                    R.dense_build(self.N, t0, h, self.Y0[slot], self.Y1[slot], self.KK[slot], self.F[slot],
-                                  self.ytmp, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
-                    self.ctl[R.Q_NRHS] += R.NSX - R.NS - 1
-                    self.DOK[slot] = 1.0
-                return slot, min(1.0, max(0.0, (t - t0) / h))
-        raise RuntimeError(f"t={t!r} is outside the stored steps")  # pragma: no cover - internal
-
-    def state_at(self, t: float) -> np.ndarray:
-        """The angle state at time t within the last two accepted steps (dense output)."""
-        slot, x = self._dense_slot(t)
-        out = np.empty(self.Y0.shape[1])
-        R.dense_eval(self.N, x, self.Y0[slot], self.F[slot], out)
-        return out
-
-    def meas_at(self, t: float) -> np.ndarray:
-        """:meth:`Z_at`'s diagnostics at time t in one compiled call (:func:`dense_measure.measure_at`:
-        the same floats); a scratch array, overwritten by the next call. DOP853's dense output only
-        (an engine that overrides :meth:`state_at` is refined by :meth:`Z_at`)."""
-        slot, x = self._dense_slot(t)
-        if getattr(self, "_mscratch", None) is None:
-            n = self.Y0.shape[1]
-            self._mscratch = (np.empty(n), np.empty(n), np.zeros((K.NROWS, self.N + 1)), np.zeros(self.nmeas))
-        y, f, Z, meas = self._mscratch
-        w = self.rw
-        DM.measure_at(self.N, t, x, self.Y0[slot], self.F[slot], y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, Z,
-                      self.rinv0, meas, self.mdl)
-        self.ctl[R.Q_NRHS] += 1
-        return meas
-
-    def Z_at(self, t: float):
-        """The position-form state Z and its diagnostics at time t (one evaluation)."""
-        y = self.state_at(t)
-        w = self.rw
-        f = np.empty_like(y)
-        MD.model_rhs(self.N, t, y, f, w.c, w.s, w.S, w.cp, w.dp, w.sig, self.mdl)
-        self.ctl[R.Q_NRHS] += 1
-        Z = np.zeros((K.NROWS, self.N + 1))
-        meas = np.zeros(self.nmeas)
-        MD.model_measure(self.N, t, y, w.c, w.s, w.sig, Z, self.rinv0, meas, self.mdl)
-        return Z, meas
-
-    def refine(self) -> None:
-        """Locate the peaks flagged by the compiled loop on the dense output."""
-        bits = int(self.ctl[R.Q_REFINE])
-        self.ctl[R.Q_REFINE] = 0.0
-        pk = self.pk
-        # DOP853's dense output in one compiled call; an engine with its own (RODAS4's) by Z_at
-        measure = self.meas_at if type(self).state_at is Engine.state_at else (lambda tt: self.Z_at(tt)[1])
-        for qi in range(pk.shape[0]):
-            if not bits & (1 << qi):
-                continue
-            ta, tb = float(pk[qi, R.PK_TA]), float(pk[qi, R.PK_TB])
-            m = _PEAK_MEAS_G[qi]
-            if not tb > ta:
-                continue
-            res = minimize_scalar(lambda tt: -measure(tt)[m], bounds=(ta, tb), method="bounded",
-                                  options={"xatol": PEAK_XTOL * (tb - ta) + 1e-15 * abs(tb)})
-            tq = float(res.x)
-            q = float(-res.fun)
-            if q > pk[qi, R.PK_BEST]:
-                pk[qi, R.PK_BEST] = q
-                pk[qi, R.PK_TBEST] = tq
-            if qi == 0 and (self.peak_state is None or self.peak_state[0] != pk[0, R.PK_TBEST]):
-                tq = float(pk[0, R.PK_TBEST])
-                self.peak_state = (tq, self.Z_at(tq)[0])
 
     def _set_targets(self) -> None:
         c = self.ctl
