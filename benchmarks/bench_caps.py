@@ -39,6 +39,7 @@ Usage::
     python benchmarks/bench_caps.py --N 1000 --lines bullwhip nylon-monofilament
     python benchmarks/bench_caps.py --escalation nylon-monofilament fly-line --chi 0.1 --N 200
     python benchmarks/bench_caps.py --answers ball-chain fly-line --chis 0.1 0.25 --N 200
+    python benchmarks/bench_caps.py --answers climbing-rope bungee-cord --chis 0.1 0.25 --default-N   # caps.cap's N=None
     python benchmarks/bench_caps.py --order nylon-monofilament --chi 0.1 --levels 1 2 3
     python benchmarks/bench_caps.py --profile nylon-monofilament --chi 0.1 --levels 0 1 2 --tols 1e-3 3e-3 1e-2
 """
@@ -217,8 +218,8 @@ def _answers(names, chis, N) -> int:
     caps.cap("bungee-cord", 0.25, N=12)  # compile the kernels (both methods)
     caps.cap("nylon-monofilament", 0.1, N=8, check=False, alone=False, graded=False)
     print("| line | chi | wall s | CPU s | load | links | error bar v, a, T | within 1% | cap | T ideal (N) | "
-          "T real (N) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "T real (N) | evaluations |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for chi in chis:
         for name in names:
             load = os.getloadavg()[0]
@@ -230,13 +231,16 @@ def _answers(names, chis, N) -> int:
             else:
                 links = f"{r['N']} uniform" + (f" (auto: {'/'.join(map(str, r['auto_N']))})" if r.get("auto_N") else "")
                 err = [abs(r["resolution"][q]) for q in caps.QUANTITIES] if r["resolution"] else [float("nan")] * 3
+            own = (r.get("own_links") or {}).get("used")
+            if own:
+                links = f"{r['N']} own (a chain of discrete links)"
             st = r["stretching"]
             if st.get("run") and not all(st["resolved"].values()):
                 links += "; stretching factor not resolved: " + ", ".join(q for q, ok in st["resolved"].items()
                                                                           if not ok)
             print(f"| {name} | {chi:g} | {r['wall']:.1f} | {r['cpu']:.1f} | {load:.1f}-{os.getloadavg()[0]:.1f} | "
-                  f"{links} | {', '.join(f'{e:.2%}' for e in err)} | {'yes' if max(err) <= 0.01 else 'NO'} | "
-                  f"{r['cap']} | {r['ideal']['sigma_peak']:.4g} | {r['real']['sigma_peak']:.4g} |", flush=True)
+                  f"{links} | {', '.join(f'{e:.2%}' for e in err)} | {'own links' if own else 'yes' if max(err) <= 0.01 else 'NO'} | "
+                  f"{r['cap']} | {r['ideal']['sigma_peak']:.4g} | {r['real']['sigma_peak']:.4g} | {r['n_rhs']} |", flush=True)
     return 0
 
 
@@ -270,9 +274,10 @@ def main(argv=None) -> int:
     p.add_argument("--chis", nargs="+", type=float, default=[0.1], help="the separations of --answers")
     p.add_argument("--auto", action="store_true", help="--answers with N='auto' (links doubled from 100 until the "
                                                         "tension moves by <= 1%%), not --N")
+    p.add_argument("--default-N", action="store_true", help="--answers with caps.cap's default links (N=None), not --N")
     a = p.parse_args(argv)
     if a.answers:
-        return _answers(a.answers, a.chis, "auto" if a.auto else a.N[0])
+        return _answers(a.answers, a.chis, "auto" if a.auto else None if a.default_N else a.N[0])
     if a.profile:
         return _profile(a.profile, a.chi, a.levels, a.tols or [_graded_tol()])
     if a.order:

@@ -1,6 +1,6 @@
 """A line of discrete links (``snapping.lines.Line.pitch``; the ball chain): its answers run on its
 own round(length/pitch) links by default and for N="auto" (a chain is its links: 1% in N has no
-meaning), on N links when N is given; a continuous line keeps 200 links (lead)."""
+meaning), on N links when N is given; a continuous line is resolved (N="auto", since designres)."""
 
 from __future__ import annotations
 
@@ -55,9 +55,9 @@ def test_auto_and_given_links_on_a_discrete_line():
     assert d["N"] == 40
 
 
-def test_a_continuous_line_keeps_200_links():
+def test_a_continuous_line_is_resolved_by_default():
     r = caps.cap(None, 0.5, length=1.0, mass=0.1, alone=False, check=False)
-    assert r["N"] == 200 and "own_links" not in r
+    assert r["auto_N"][0] == 100 and r["N"] == r["auto_N"][-1] and "own_links" not in r  # (200 before designres)
 
 
 def test_cli_estimate_answers_the_ball_chain_on_its_links(capsys):

@@ -71,6 +71,7 @@ def test_cap_applies_agreeing_factors_and_names_stretching(monkeypatch):
     for q, f in (("v_peak", 0.802), ("a_peak", 0.401), ("sigma_peak", 0.300)):
         assert r["real"][q] == pytest.approx(r["full"][q] * f, rel=1e-14)
     assert all(r["stretching"]["resolved"].values()) and "NOT applied" not in r["stretching"]["why"]
+    assert "do not hold stretching" not in r["stretching"]["why"]  # (designres: said only when left out)
     assert r["cap"] == "stretching"  # the line has nothing else: 0.3 of the ideal's tension
 
 

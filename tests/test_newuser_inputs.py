@@ -107,8 +107,8 @@ def test_design_checks_every_chi_before_any_run(chis, words, monkeypatch):
 
 def test_design_checks_n_and_quantity_before_any_run(monkeypatch):
     monkeypatch.setattr(caps, "cap", lambda *a, **k: pytest.fail("a run was made before the check"))
-    with pytest.raises(SnappingInputError, match=r"N='auto' is cap's"):
-        caps.design("bungee-cord", chis=[0.2], max_tension=1.0, N="auto")
+    with pytest.raises(SnappingInputError, match=r"N='many'"):  # (N="auto": each chi resolved, since designres)
+        caps.design("bungee-cord", chis=[0.2], max_tension=1.0, N="many")
     with pytest.raises(SnappingInputError, match=r"N=1 is out of range: must be an integer in \[2, 20000\]"):
         caps.design("bungee-cord", chis=[0.2], max_tension=1.0, N=1)
     with pytest.raises(SnappingInputError, match=r"quantity='T' is not one of"):

@@ -92,7 +92,7 @@ from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIF
                         stretch_factor)
 from .caps_runs import grading_for as _grading
 
-__all__ = ["LineSpec", "spec", "cap", "design", "decide", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
+__all__ = ["LineSpec", "spec", "cap", "design", "decide", "auto_hopeless", "auto_graded", "AUTO_GRADED_LINKS", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
 #: the full run's peak speed (the speed the line reaches) over the wave speed above which the stretching is run
@@ -123,8 +123,10 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
     N : int, "auto" or None
         Links of the runs (2 to 20000); ``"auto"``: doubled from 100 (:data:`AUTO_N`) until the
         full run's ``quantity`` moves by at most 1% (:data:`RESOLVED`; then ``resolved`` True
-        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False). None (the
-        default): 200. A line of discrete links (a ball chain: :attr:`snapping.lines.Line.pitch`)
+        and ``auto_N`` the links tried; not resolved at 1600: ``resolved`` False), or graded
+        from the first (:func:`snapping.caps_runs.grading_rule`), or not doubled where no uniform
+        links up to 1600 can resolve the fold (:func:`auto_hopeless`: ``auto_why``). None (the
+        default): ``"auto"`` (since ``designres``; 200 before). A line of discrete links (a ball chain: :attr:`snapping.lines.Line.pitch`)
         is answered on its own links for None and ``"auto"`` (``own_links``; no N/2 check, no
         graded links: a chain is its links, 1% in N has no meaning), on ``N`` links if given.
     tol : float
@@ -187,7 +189,7 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
         raise V.SnappingInputError(f"graded={graded!r} is not one of 'auto', True, False")
     own = sp.own_links()
     if N is None or (own is not None and isinstance(N, str) and N == "auto"):
-        N = 200 if own is None else own
+        N = "auto" if own is None else own  # (since designres; 200 links before)
     if not (isinstance(N, str) and N == "auto"):
         N = V.integer("N", N, 2, 20000)
     on_own = own is not None and N == own
@@ -258,7 +260,8 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                "strain_peak": sl[1]["strain_peak"],
                                "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
                                       f"{stretching['v_over_c_ideal']:.3g}): run (elastic over rigid on "
-                                      f"{sl[0]['N']} and {sl[1]['N']} links); " + stretch_words(sl, ok)})
+                                      f"{sl[0]['N']} and {sl[1]['N']} links); " + stretch_words(sl, ok)
+                                      + ("" if all(ok.values()) else unresolved_stretching_words(ratio))})
             if alone:
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -310,6 +313,18 @@ def stretch_words(levels: list, resolved: dict) -> str:
     return "; ".join(words)
 
 
+def unresolved_stretching_words(v_over_c: float) -> str:
+    """What leaving an unresolved stretching factor out means, said beside it: the answer's error bars
+    are the inextensible runs' and do not hold stretching, whose effect at the speed the line reaches
+    (``v_over_c``) the elastic guide measured (peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2).
+    Why the factor does not settle: it is the ideal chain's (the elastic model has no bending or drag),
+    whose snap and v/c grow with the links (the bungee cord at chi 0.25, tension ratio 0.913, 0.715,
+    0.654, 0.638 on 30-240 links)."""
+    return (f" (so the error bars above do not hold stretching: at v/c = {v_over_c:.2g} it is not negligible -- the "
+            f"elastic guide measured peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2; the factor is the ideal "
+            f"chain's, whose v/c grows with its links, not this line's)")
+
+
 def decide(factor: float, real: float, alone: dict, acts: bool = True, tried: bool = True) -> str:
     """The capping mechanism (the module's rule): ``"none"`` when the real/ideal ``factor`` is
     at least :data:`snapping.regimes_analysis.LEVEL` (or nothing acts), else the mechanism of
@@ -329,8 +344,21 @@ def _auto(runs: Runs, quantity: str, alone: bool, graded="auto") -> dict:
     resolution the last two full runs' (each run made once). An answer that takes graded links on
     the first of them (:func:`_grading`) is that answer, resolved when its error is within 1%."""
     on = tuple(m for m in MECHANISMS[:-1] if runs.sp.has(m))
-    if _grading(runs, AUTO_N[0], list(on), graded)["used"]:
+    first = _grading(runs, AUTO_N[0], list(on), graded)
+    if first["used"]:
         r = _answer(runs, AUTO_N[0], quantity, False, alone, graded)
+        r["auto_N"] = [AUTO_N[0]]
+        r["resolved"] = r["graded"]["relative_error"][quantity] <= RESOLVED
+        return r
+    why = auto_hopeless(first)
+    if why:  # no uniform links up to AUTO_N[-1] resolve it, graded ones are too fine: not doubled (said)
+        r = _answer(runs, AUTO_N[0], quantity, True, alone, graded)
+        r.update(auto_N=[AUTO_N[0]], resolved=False, auto_why=why)
+        return r
+    why = auto_graded(runs, first, graded)
+    if why:  # uniform links up to AUTO_N[-1] cannot reach the bending length: graded, though the rule kept them
+        r = _answer(runs, AUTO_N[0], quantity, False, alone, True)
+        r["graded"]["why"] = why
         r["auto_N"] = [AUTO_N[0]]
         r["resolved"] = r["graded"]["relative_error"][quantity] <= RESOLVED
         return r
@@ -352,6 +380,60 @@ def _auto(runs: Runs, quantity: str, alone: bool, graded="auto") -> dict:
     return r
 
 
+def auto_hopeless(grading: dict) -> str:
+    """Why ``N="auto"`` does not double the links (``""``: it does): the grading on the first
+    links (:func:`snapping.caps_runs.grading_for`'s answer) found a fold that collapses onto them
+    which graded links would resolve but for their cost (``too_fine``: the finer level over
+    :data:`snapping.caps_runs.MAX_GRADED_LINKS`), and the bending length is under
+    :data:`snapping.caps_runs.GRADE_LINKS` links even on the last of :data:`AUTO_N`: no uniform
+    links it would try reach the scale that holds the fold (the climbing rope at chi 0.05 and 0.1:
+    0.31 links on 1600, where its tension still moved 35% from 800; 10.8 s of CPU for nothing).
+
+    >>> auto_hopeless({"used": False, "too_fine": 5552, "bending_length": 1.91e-4})[:45]
+    'the fold collapses onto the links and graded '
+    >>> auto_hopeless({"used": False, "too_fine": 5552, "bending_length": 0.02}), auto_hopeless({"used": False})
+    ('', '')
+    """
+    from .caps_runs import GRADE_LINKS, MAX_GRADED_LINKS
+
+    n, lb = grading.get("too_fine"), grading.get("bending_length", 0.0)
+    if grading.get("used") or not n or not lb or lb * AUTO_N[-1] >= GRADE_LINKS:
+        return ""
+    return (f"the fold collapses onto the links and graded links would need {n} (> {MAX_GRADED_LINKS}); the "
+            f"bending length ({lb:.3g} L) is {lb * AUTO_N[-1]:.2g} links even on {AUTO_N[-1]} (< {GRADE_LINKS:g}): "
+            f"no uniform links up to {AUTO_N[-1]} resolve it, so they were not doubled: NOT resolved, on "
+            f"{AUTO_N[0]} links")
+
+
+#: the most links of the finer graded level that ``N="auto"`` runs when uniform links cannot reach the bending
+#: length (:func:`auto_graded`): the climbing rope's 5552 (levels 2785 and 5552: 7.6 s of CPU for its whole answer
+#: at chi 0.25, load 5.7)
+AUTO_GRADED_LINKS = 6000
+
+
+def auto_graded(runs, grading: dict, graded="auto") -> str:
+    """Why ``N="auto"`` takes graded links where the grading rule on its first links did not
+    (``""``: it does not): the line has bending, ``graded`` is ``"auto"``, the bending length is
+    under :data:`snapping.caps_runs.GRADE_LINKS` links even on the last of :data:`AUTO_N` (uniform
+    links it would try never resolve the bending length at the free end, where the peaks then converge
+    at first order: the climbing rope at chi 0.25, v 124.7, 134.1, 139.1, 141.6 m/s on 400-3200 links,
+    its graded levels 143.96 and 143.98), and the finer graded level is at most
+    :data:`AUTO_GRADED_LINKS` links."""
+    from .caps_runs import GRADE_LINKS, bending_length
+
+    if graded != "auto" or grading.get("used") or grading.get("why") == "no bending":
+        return ""
+    lb = bending_length(runs.sp)
+    if not (0.0 < lb and lb * AUTO_N[-1] < GRADE_LINKS):
+        return ""
+    n = graded_h(runs.chi, lb, 1).size
+    if n > AUTO_GRADED_LINKS:
+        return ""
+    return (f"the bending length ({lb:.3g} L) is {lb * AUTO_N[-1]:.2g} links even on {AUTO_N[-1]} (< {GRADE_LINKS:g}): "
+            f"uniform links up to {AUTO_N[-1]} do not resolve the free end, graded links (finer level {n} <= "
+            f"{AUTO_GRADED_LINKS}) do")
+
+
 def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int | None = None, tol: float = 1e-6,
            max_tension=None, max_speed=None, max_acceleration=None, quantity: str = "sigma_peak",
            alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL, graded="auto",
@@ -361,14 +443,17 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
     (the mechanism that capped the snap at that chi, decided on ``quantity``: :func:`cap`'s rule),
     ``graded`` (:func:`cap`'s: the real peaks from graded links, extrapolated, with their error),
-    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it. ``N``: the
-    links of every run (None: 200, a line of discrete links its own, as :func:`cap`)."""
+    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it, ``N`` (the
+    row's links) and ``resolved``. ``N``: the links of every run; None (the default) or ``"auto"``:
+    each chi on the links that resolve it, :func:`cap`'s ``N="auto"`` (since ``designres``; 200
+    links for every chi before), a line of discrete links on its own."""
     sp = _as_spec(line, params)
     chis = _check_chis(chis)
-    if isinstance(N, str) and N == "auto":
-        raise V.SnappingInputError("N='auto' is cap's (one separation): design runs every chi on the same links: "
-                                   "give N an integer in [2, 20000]")
-    N = V.integer("N", (200 if sp.own_links() is None else sp.own_links()) if N is None else N, 2, 20000)
+    own = sp.own_links()
+    if N is None or (isinstance(N, str) and N == "auto"):
+        N = "auto" if own is None else own
+    else:
+        N = V.integer("N", N, 2, 20000)
     if quantity not in QUANTITIES:
         raise V.SnappingInputError(f"quantity={quantity!r} is not one of {tuple(QUANTITIES)}")
     limits = {}
@@ -389,13 +474,19 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
         n_rhs += r["n_rhs"]
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],
-                     "stretching": r["stretching"],
+                     "stretching": r["stretching"], "N": r.get("N", N), "resolved": _row_resolved(r),
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
     ok = [r["chi"] for r in rows if r["admissible"]]
     return {"line": sp.name, "N": N, "limits": limits, "quantity": quantity, "rows": rows, "admissible_chi": ok,
-            "numbers": sp.numbers(N), "n_rhs": n_rhs, "wall": time.perf_counter() - t0,
+            "numbers": sp.numbers(None if N == "auto" else N), "n_rhs": n_rhs, "wall": time.perf_counter() - t0,
             "cpu": time.process_time() - c0}
+
+
+def _row_resolved(r: dict):
+    """A design row's verdict: :func:`cap`'s ``resolved`` where it gives one (``N="auto"``, own links),
+    else None (given links: no check in a design)."""
+    return r.get("resolved")
 
 
 def format_answer(r: dict) -> list[str]:
@@ -416,6 +507,8 @@ def format_answer(r: dict) -> list[str]:
                    f"mechanism alone")
     elif r.get("own_links"):
         out.append(f"  links: {r['own_links']['why']}")
+    elif r.get("auto_why"):
+        out.append(f"  links: {r['auto_why']}")
     elif r.get("auto_N"):
         out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
                    f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
@@ -448,15 +541,22 @@ def format_design(d: dict) -> list[str]:
     """Text lines of a :func:`design` answer."""
     lim = ", ".join(f"{q} <= {v:g} {QUANTITIES[q]}" for q, v in d["limits"].items())
     q = d.get("quantity", "sigma_peak")
-    out = [f"Design from runs of the real model: {d['line']}, {d['N']} links; limits {lim}",
+    auto = d["N"] == "auto"
+    links = (f"links resolved per chi (N='auto': doubled from {AUTO_N[0]} until {q} moves by <= {RESOLVED:.0%}, or "
+             f"graded)" if auto else f"{d['N']} links")
+    out = [f"Design from runs of the real model: {d['line']}, {links}; limits {lim}",
            f"  {'chi':>6}{'ideal v':>11}{'real v':>11}{'ideal a':>11}{'real a':>11}{'ideal T':>11}{'real T':>11}"
-           f"{'T factor':>10}  {'capped by':<12}  real ok  ideal ok"]
+           f"{'T factor':>10}  {'capped by':<12}  real ok  ideal ok" + ("  links" if auto else "")]
     for r in d["rows"]:
         i, x = r["ideal"], r["real"]
+        where = ""
+        if auto:
+            where = ("graded" if r.get("graded", {}).get("used") else str(r.get("N")))
+            where = f"  {where}{'' if r.get('resolved') else ' (NOT resolved)'}"
         out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
                    f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
-                   f"{'yes' if r['ideal_admissible'] else 'no':>8}")
+                   f"{'yes' if r['ideal_admissible'] else 'no':>8}" + where)
     gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%}"
           + ("" if r["graded"].get("stopped", "within") == "within" else ", NOT all peaks within 1%") + ")"
           for r in d["rows"] if r.get("graded", {}).get("used")]

@@ -34,7 +34,8 @@ def add_real_options(p, resolve: bool = True) -> None:
     if resolve:
         g.add_argument("--resolve", action="store_true",
                        help="double the links from 100 (to 1600 at most) until the peak of --quantity moves by at "
-                            "most 1%% (instead of --links; a chain of discrete links, --line ball-chain: its own)")
+                            "most 1%%, or graded links (instead of --links; the default without --links since "
+                            "designres; a chain of discrete links, --line ball-chain: its own)")
     g.add_argument("--quantity", default="sigma_peak", choices=("sigma_peak", "v_peak", "a_peak"),
                    help="the peak that decides the capping mechanism (default the tension)")
 
@@ -112,7 +113,7 @@ def cmd_real_estimate(args) -> int:
     sp = _spec(args)
     if args.resolve and links is not None:
         raise SnappingInputError("--resolve chooses the links itself: give --resolve or --links, not both")
-    N = "auto" if args.resolve else links  # (None: 200 links, a line of discrete links its own: caps.cap)
+    N = "auto" if args.resolve else links  # (None: caps.cap's "auto", a line of discrete links its own)
     r = caps.cap(sp, _chi(args, sp), N=N, quantity=args.quantity)
     if args.json:
         print_json({**r, "dimensionless_numbers": r["numbers"]})

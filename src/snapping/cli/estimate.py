@@ -73,7 +73,8 @@ def _add_estimate(sub) -> None:
     _add_g_option(p)
     p.add_argument("--links", type=int, default=None, metavar="N",
                    help="the chain's number of links: leads with the computed peaks (table: 10 to 10000); a real "
-                        "line's runs: 2 to 20000, default 200, a chain of discrete links (--line ball-chain) its own")
+                        "line's runs: 2 to 20000, default: the links that resolve it (--resolve), a chain of discrete links "
+                        "(--line ball-chain) its own")
     p.add_argument("--tip-mass", type=float, default=0.0, metavar="RATIO",
                    help="a point mass at the free end, as a ratio to the chain's mass (needs --links; table: 0 "
                         "to 1, for up to 1800 links)")
@@ -192,7 +193,8 @@ def _add_design(sub) -> None:
     _add_g_option(p)
     p.add_argument("--links", type=int, default=None, metavar="N",
                    help="the chain's number of links (10 to 10000; required, but for a real line: 2 to 20000, "
-                        "default 200, a chain of discrete links such as --line ball-chain its own)")
+                        "default: each chi on the links that resolve it, a chain of discrete links such as "
+                        "--line ball-chain its own)")
     p.add_argument("--tip-mass", type=float, default=None, metavar="RATIO",
                    help="tip mass / chain mass (default: scan the table's tip masses, 0 to 1)")
     p.add_argument("--plot", default=None, metavar="PNG", help="save the peaks against the separation here")
