@@ -81,6 +81,39 @@ def test_study_flag_from_the_finest_links():
     assert ds.converged.values.tolist() == [[0, 1]]
 
 
+def _walked_resolution(chi, beta, level, sig, kap):
+    """l_B / h_fold on ``level``'s links rebuilt from the grading, walked link by link from the free end."""
+    from snapping.simulate import grading
+
+    h_min = max(level["h_min"], R.BEND_FLOOR * level["frac"] * math.sqrt(beta))
+    h = grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
+    s = 0.0
+    for hi in h:
+        s += hi
+        if s >= 1.0 / kap:
+            return math.sqrt(beta / sig) / hi
+    return math.sqrt(beta / sig) / h[-1]
+
+
+def test_escalated_cell_flag_from_its_own_finest_links():
+    """(branch bendesc) An escalating bending study (3 base levels + 1): the cell that ran the extra
+    level has its bending_resolution from that level's links, the one that did not from the third's;
+    the fold link halves with the level, so the escalated cell's is about twice the base level's."""
+    chis, betas = [0.3], [1e-8, 2e-8]
+    ds, lev = _bending_study(chis, betas, levels=4)
+    ds.attrs.update(levels=3, escalate=0.01, extra_levels=1)
+    for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v"):
+        ds[f"{q}_level"].values[0, 0, 3] = np.nan  # beta 1e-8: three levels; 2e-8: escalated to four
+    ds = R._finish(ds)
+    assert ds.levels_run.values.tolist() == [[3, 4]]
+    sig = kap = float(ds.sigma_peak_ideal[0])
+    assert float(ds.bending_resolution[0, 0]) == pytest.approx(_walked_resolution(0.3, 1e-8, lev[2], sig, kap),
+                                                                 rel=1e-12)
+    four = _walked_resolution(0.3, 2e-8, lev[3], sig, kap)
+    assert float(ds.bending_resolution[0, 1]) == pytest.approx(four, rel=1e-12)
+    assert four > 1.8 * _walked_resolution(0.3, 2e-8, lev[2], sig, kap)
+
+
 def test_analyze_leaves_unconverged_cells_out():
     """Synthetic: ratios 1.0, 0.5 (a false, flagged cap), 0.95, 0.5 against the number. With the
     flag the crossover lies between the third and the fourth number, not the first and second."""
