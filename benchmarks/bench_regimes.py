@@ -59,9 +59,14 @@ STUDIES = {
     "drag": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-3, 10.0, 8), "accuracy": "medium",
              "levels": 3, "escalate": 0.01, "extra_levels": 2, "escalate_max_rhs": 600_000},
     # bending: 4 levels (frac 0.08-0.01; was 3 to 0.02, whose small-beta cells at chi 0.1-0.2 sat before their
-    # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs
+    # asymptotic regime, see benchmarks/bench_bendconv.py); `--extend bending` reuses the 3-level file's runs.
+    # Escalated (branch bendesc): a cell over 1% whose level 4 took <= 40,000 evaluations runs a fifth level (chi 0.2
+    # beta 7.2e-8, 5.18e-7; chi 0.3 beta 5.18e-7: a_peak 2.2%, 2.5%, 1.1% on 4 levels, unconverged, branch bend05),
+    # and the ideal with them (chi 0.1-0.3, 48 s CPU at chi 0.1, 14,625 links). The cap leaves chi 0.1's four
+    # small-beta cells (47,000-72,000 at level 4, 65-104 s; a fifth ~4x) and chi 0.5 beta 1e-2 (78,000: grid
+    # damping, no continuum limit) at 4 levels, marked escalation_capped
     "bending": {"chis": [0.1, 0.2, 0.3, 0.5], "numbers": np.geomspace(1e-8, 1e-2, 8), "accuracy": "medium",
-                "levels": 4},
+                "levels": 4, "escalate": 0.01, "extra_levels": 1, "escalate_max_rhs": 40_000},
     # stretching (number sqrt(gL)/c), shipped since branch shipstretch: benchmarks/stretch_scan.py's scan, RODAS4
     # in link coordinates (regimes_spec.STRETCH_METHOD, its tip links floored at STRETCH_TIP_TIME * c), the 1%
     # levels of the other mechanisms (accuracy "medium": fold levels -1 ... 2) at tol 1e-6, the numbers

@@ -81,6 +81,39 @@ def test_study_flag_from_the_finest_links():
     assert ds.converged.values.tolist() == [[0, 1]]
 
 
+def _walked_resolution(chi, beta, level, sig, kap):
+    """l_B / h_fold on ``level``'s links rebuilt from the grading, walked link by link from the free end."""
+    from snapping.simulate import grading
+
+    h_min = max(level["h_min"], R.BEND_FLOOR * level["frac"] * math.sqrt(beta))
+    h = grading.fold_following(chi, frac=level["frac"], h_min=h_min, h_max=max(level["h_max"], h_min))
+    s = 0.0
+    for hi in h:
+        s += hi
+        if s >= 1.0 / kap:
+            return math.sqrt(beta / sig) / hi
+    return math.sqrt(beta / sig) / h[-1]
+
+
+def test_escalated_cell_flag_from_its_own_finest_links():
+    """(branch bendesc) An escalating bending study (3 base levels + 1): the cell that ran the extra
+    level has its bending_resolution from that level's links, the one that did not from the third's;
+    the fold link halves with the level, so the escalated cell's is about twice the base level's."""
+    chis, betas = [0.3], [1e-8, 2e-8]
+    ds, lev = _bending_study(chis, betas, levels=4)
+    ds.attrs.update(levels=3, escalate=0.01, extra_levels=1)
+    for q in ("v_peak", "a_peak", "sigma_peak", "kappa_peak", "t_snap_v"):
+        ds[f"{q}_level"].values[0, 0, 3] = np.nan  # beta 1e-8: three levels; 2e-8: escalated to four
+    ds = R._finish(ds)
+    assert ds.levels_run.values.tolist() == [[3, 4]]
+    sig = kap = float(ds.sigma_peak_ideal[0])
+    assert float(ds.bending_resolution[0, 0]) == pytest.approx(_walked_resolution(0.3, 1e-8, lev[2], sig, kap),
+                                                                 rel=1e-12)
+    four = _walked_resolution(0.3, 2e-8, lev[3], sig, kap)
+    assert float(ds.bending_resolution[0, 1]) == pytest.approx(four, rel=1e-12)
+    assert four > 1.8 * _walked_resolution(0.3, 2e-8, lev[2], sig, kap)
+
+
 def test_analyze_leaves_unconverged_cells_out():
     """Synthetic: ratios 1.0, 0.5 (a false, flagged cap), 0.95, 0.5 against the number. With the
     flag the crossover lies between the third and the fourth number, not the first and second."""
@@ -145,3 +178,73 @@ def test_module_example():
 
     res = doctest.testmod(RR)
     assert res.attempted >= 1 and res.failed == 0
+
+
+def _richardson(q):
+    """By hand (as tests/test_regimes_stretch.py): the Richardson limit of the last three of four or more
+    halving levels (NaN after: the levels run), order log2(d1/d2); its bar max(|limit - the three before's|,
+    |correction|/10); the finest level and the last three's spread where they do not converge monotonically."""
+    q = np.asarray(q, dtype=float)
+    q = q[:int(np.isfinite(q).cumprod().sum())]
+    d = np.diff(q)
+    ests = []
+    for k in (q.size - 2, q.size - 1):
+        d1, d2 = d[k - 2], d[k - 1]
+        ok = d1 != 0 and d2 != 0 and np.sign(d1) == np.sign(d2) and abs(d2) < abs(d1)
+        ests.append(q[k] + d2 / (2 ** math.log2(d1 / d2) - 1) if ok else None)
+    if ests[1] is None:
+        return q[-1], float(np.ptp(q[-3:]))
+    err = abs(ests[1] - q[-1]) if ests[0] is None else max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[-1]))
+    return ests[1], err
+
+
+def test_shipped_bending_study_escalated_exactly_the_cheap_misses():
+    """(branch bendesc) The shipped study escalated at 1% with one extra level, capped at 40,000
+    evaluations: by hand from its four base levels, the cells over 1% in v/a/sigma whose level 3 took at
+    most 40,000 evaluations ran five (the three pre-asymptotic cells), those over it are marked capped
+    (chi 0.1's four small betas, chi 0.5 beta 1e-2); the three are now within 1% in a_peak (their
+    five-level limits by hand); the ideal ran five at chi 0.1-0.3 (with its cells, or its own a_peak bar
+    at chi 0.1), four at 0.5; the file carries the fifth peak kappa_peak_approach."""
+    ds = R.bundled_study("bending")
+    assert (ds.attrs["escalate"], ds.attrs["extra_levels"], ds.attrs["escalate_max_rhs"]) == (0.01, 1, 40_000)
+    five, capped = [], []
+    for i, chi in enumerate(ds.chi.values):
+        for j, beta in enumerate(ds.number.values):
+            over = any(e > 0.01 * abs(v) for v, e in (_richardson(ds[f"{q}_level"].values[i, j, :4])
+                                                      for q in ("v_peak", "a_peak", "sigma_peak")))
+            if over:
+                (five if ds.n_rhs_level.values[i, j, 3] <= 40_000 else capped).append((float(chi), float(beta)))
+    assert five == [(0.2, 7.2e-8), (0.2, 5.18e-7), (0.3, 5.18e-7)]
+    assert capped == [(0.1, 1e-8), (0.1, 7.2e-8), (0.1, 5.18e-7), (0.1, 3.73e-6), (0.5, 0.01)]
+    for i, chi in enumerate(ds.chi.values):
+        for j, beta in enumerate(ds.number.values):
+            assert int(ds.levels_run.values[i, j]) == (5 if (chi, beta) in five else 4)
+            assert int(ds.escalation_capped.values[i, j]) == ((chi, beta) in capped)
+    for chi, beta in five:
+        row = ds.a_peak_level.sel(chi=chi, number=beta).values
+        lim, err = _richardson(row)
+        assert np.isfinite(row).sum() == 5 and err <= 0.01 * lim
+        assert float(ds.a_peak.sel(chi=chi, number=beta)) == pytest.approx(lim, rel=1e-12)
+    assert ds.levels_run_ideal.values.tolist() == [5, 5, 5, 4]
+    e = _richardson(ds.a_peak_ideal_level.values[0, :4])
+    assert e[1] > 0.01 * e[0]  # chi 0.1's ideal over 1% on four levels: it ran its fifth on its own bar
+    assert np.isfinite(ds.kappa_peak_approach_level.values[:, :, :4]).all()
+
+
+def test_bench_regimes_bending_settings_are_the_shipped_files(monkeypatch):
+    """``bench_regimes.py --study bending`` (its STUDIES entry) writes the shipped file's study key, so it
+    resumes the file (nothing to run) instead of refusing it (fake runs: only the key is compared)."""
+    import importlib.util
+    import pathlib
+
+    from snapping.continuum import QUANTITIES
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "benchmarks" / "bench_regimes.py"
+    spec = importlib.util.spec_from_file_location("bench_regimes_for_test", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    s = dict(bench.STUDIES["bending"])
+    monkeypatch.setattr(R, "_run_task", lambda *a, **k: {**{q: 1.0 for q in QUANTITIES}, "n_links": 1, "n_rhs": 1,
+                                                         "cpu_time": 0.0})
+    ds = R.regimes("bending", s.pop("chis"), bench._numbers(s.pop("numbers")), progress=False, **s)
+    assert ds.attrs["regimes_study"] == R.bundled_study("bending").attrs["regimes_study"]

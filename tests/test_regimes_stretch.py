@@ -176,7 +176,7 @@ def test_shipped_ideal_runs_agree_with_the_bending_study(shipped):
     """The ideal's runs (fold levels -1..2, tol 1e-6) against the bending study's (the same links at
     tol 1e-7: other runs): level by level within 1e-6 relative, the limits within their bars."""
     other = R.bundled_study("bending")
-    a, b = shipped.v_peak_ideal_level.values[:, :4], other.v_peak_ideal_level.sel(chi=shipped.chi).values
+    a, b = shipped.v_peak_ideal_level.values[:, :4], other.v_peak_ideal_level.sel(chi=shipped.chi).values[:, :4]
     np.testing.assert_allclose(a, b, rtol=1e-6)
     for chi in shipped.chi.values:
         va, ea = float(shipped.v_peak_ideal.sel(chi=chi)), float(shipped.v_peak_ideal_error.sel(chi=chi))
@@ -209,7 +209,7 @@ def test_snap_peaks_resolved_and_capped(shipped):
     other = R.bundled_study("bending")
     for q in ("a_peak", "sigma_peak"):
         np.testing.assert_allclose(shipped[f"{q}_ideal_level"].values[:, :4],
-                                   other[f"{q}_ideal_level"].sel(chi=shipped.chi).values, rtol=1e-6)
+                                   other[f"{q}_ideal_level"].sel(chi=shipped.chi).values[:, :4], rtol=1e-6)
         n_ok = 0
         for i, chi in enumerate(shipped.chi.values):
             for j in range(shipped.sizes["number"]):

@@ -121,7 +121,8 @@ def _finest_links(chi: float, number: float, levels: int, first: int, n0: int, r
 
 def _mark(ds: xr.Dataset) -> None:
     """The per-cell ``converged`` flag and, for bending, ``bending_resolution`` (the finest level's
-    l_B / h_fold): :mod:`snapping.regimes_resolution`."""
+    l_B / h_fold; an escalated cell's finest level is its last run): :mod:`snapping.regimes_resolution`."""
+    from .regimes_escalate import prefix
     from .regimes_resolution import BEND_RESOLVED, bending_resolution, converged
 
     res = None
@@ -133,8 +134,8 @@ def _mark(ds: xr.Dataset) -> None:
             if not (np.isfinite(sig) and np.isfinite(kap)):
                 continue
             for j, beta in enumerate(ds.number.values):
-                h = _finest_links(float(chi), float(beta), int(a["levels"]), int(a["first"]), int(a["n0"]),
-                                  float(a["ratio"]), a["grading"])
+                n = max(int(a["levels"]), prefix(ds["v_peak_level"].values[i, j]))  # an escalated cell: its finest
+                h = _finest_links(float(chi), float(beta), n, int(a["first"]), int(a["n0"]), float(a["ratio"]), a["grading"])
                 res[i, j] = bending_resolution(h, float(beta), sig, kap)
         ds["bending_resolution"] = (("chi", "number"), res, {
             "long_name": "bending length sqrt(beta/sigma_peak_ideal) over the finest level's link at the ideal fold "
