@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from richardson_by_hand import richardson as _richardson
 from snapping import regimes as R
 from snapping import regimes_analysis as A
 from snapping import regimes_resolution as RR
@@ -178,24 +179,6 @@ def test_module_example():
 
     res = doctest.testmod(RR)
     assert res.attempted >= 1 and res.failed == 0
-
-
-def _richardson(q):
-    """By hand (as tests/test_regimes_stretch.py): the Richardson limit of the last three of four or more
-    halving levels (NaN after: the levels run), order log2(d1/d2); its bar max(|limit - the three before's|,
-    |correction|/10); the finest level and the last three's spread where they do not converge monotonically."""
-    q = np.asarray(q, dtype=float)
-    q = q[:int(np.isfinite(q).cumprod().sum())]
-    d = np.diff(q)
-    ests = []
-    for k in (q.size - 2, q.size - 1):
-        d1, d2 = d[k - 2], d[k - 1]
-        ok = d1 != 0 and d2 != 0 and np.sign(d1) == np.sign(d2) and abs(d2) < abs(d1)
-        ests.append(q[k] + d2 / (2 ** math.log2(d1 / d2) - 1) if ok else None)
-    if ests[1] is None:
-        return q[-1], float(np.ptp(q[-3:]))
-    err = abs(ests[1] - q[-1]) if ests[0] is None else max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[-1]))
-    return ests[1], err
 
 
 def test_shipped_bending_study_escalated_exactly_the_cheap_misses():

@@ -17,6 +17,7 @@ import math
 import numpy as np
 import pytest
 
+from richardson_by_hand import richardson as _richardson
 from snapping import regimes as R
 from snapping import regimes_spec as S
 from snapping._validate import SnappingInputError
@@ -125,26 +126,6 @@ def shipped():
         return R.bundled_study("stretching")
     except SnappingInputError as exc:
         pytest.skip(str(exc))
-
-
-def _richardson(q):
-    """Four or more levels halving (the levels a cell ran: an escalated cell's five, NaN after), by
-    hand: the Richardson limit of the last three (order p = log2(d1/d2), limit q3 + d2/(2^p - 1)), its
-    error bar max(|limit - the three before's limit|, |correction|/10); where the last three do not
-    converge monotonically, the finest level, its bar their spread."""
-    q = np.asarray(q, dtype=float)
-    q = q[:int(np.isfinite(q).cumprod().sum())]
-    assert q.size >= 4
-    d = np.diff(q)
-    ests = []
-    for k in (q.size - 2, q.size - 1):
-        d1, d2 = d[k - 2], d[k - 1]
-        ok = d1 != 0 and d2 != 0 and np.sign(d1) == np.sign(d2) and abs(d2) < abs(d1)
-        ests.append(q[k] + d2 / (2 ** math.log2(d1 / d2) - 1) if ok else None)
-    if ests[1] is None:
-        return q[-1], float(np.ptp(q[-3:]))
-    err = abs(ests[1] - q[-1]) if ests[0] is None else max(abs(ests[1] - ests[0]), 0.1 * abs(ests[1] - q[-1]))
-    return ests[1], err
 
 
 def test_shipped_study_is_the_links_scan(shipped, monkeypatch):
