@@ -57,6 +57,7 @@ from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .snap_edge import window_edge
 from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
+from .elastic_body import BODY_METHODS
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
 from .elastic_links_rodas import LinksStepper
@@ -363,6 +364,9 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise V.SnappingInputError(f"method={method!r} is not one of {tuple(METHODS)} (the elastic line's methods)")
     method = method.lower()
+    if line.body is not None and method not in BODY_METHODS:
+        raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
+                                   f"not take the body's forces yet; use method='radau' (or 'dop853')")
     if t_end is not None:
         t_end = V.positive("t_end", t_end)
     t_end_max = V.positive("t_end_max", t_end_max)
