@@ -262,7 +262,7 @@ def test_ea_to_infinity_is_the_chain():
     ref = np.array([a["v_peak"], a["sigma_peak"]])
     errs = []
     for c in (100.0, 300.0, 1000.0):
-        b = solve(p, Elastic.from_wave_speed(c), tol=1e-8, start="matched").dataset.attrs
+        b = solve(p, Elastic.from_wave_speed(c), tol=1e-7, start="matched").dataset.attrs
         assert b["status"] == "completed"
         errs.append(np.abs(np.array([b["v_peak"], b["sigma_peak"]]) - ref) / ref)
     errs = np.array(errs)
