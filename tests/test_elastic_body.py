@@ -218,11 +218,11 @@ def test_energy_rate_and_run_balance():
     r = solve(p, line.elastic, t_end=0.3, tol=1e-9, start="unstretched")
     a = r.dataset.attrs
     assert a["status"] == "completed" and a["dissipated_total"] > 0.05
-    assert a["energy_drift"] < 1e-6 * a["dissipated_total"] * 100
+    assert a["energy_drift"] < 1e-9  # (1.8e-11 measured, against D = 0.108, W = 0.0215)
     Xf = line.unpack(r.state, 0.3)
     e_end = ref.energy(0.3, *Xf) - r.state[4 * N] + r.state[4 * N + 1]
     e0 = ref.energy(0.0, *line.unpack(line.start("unstretched"), 0.0))
-    assert abs(e_end - e0) < 1e-6
+    assert abs(e_end - e0) < 1e-9
 
 
 def test_inactive_body_is_the_plain_line():
@@ -273,7 +273,7 @@ def test_ea_to_infinity_is_the_chain():
 
 def test_cantilever_tip_deflection():
     """A straight line clamped horizontally sags by q L^4/(8 B) (small deflection: B = 100),
-    the discrete line's error O(h^2)."""
+    the discrete line's error O(h^2) (+1.00e-2 at N = 10, +2.50e-3 at N = 20)."""
     B, w = 100.0, []
     for N in (10, 20):
         x = np.linspace(1.0, 0.0, N + 1)
@@ -282,8 +282,8 @@ def test_cantilever_tip_deflection():
         w.append(line.statics(line.start("unstretched"))[1])
     exact = 1.0 / (8.0 * B)
     e = np.array(w) / exact - 1.0
-    assert 3.5 < e[0] / e[1] < 4.5
-    assert abs((4 * w[1] - w[0]) / 3 / exact - 1.0) < 2e-5
+    assert 3.9 < e[0] / e[1] < 4.1  # (+1.00e-2, +2.50e-3)
+    assert abs((4 * w[1] - w[0]) / 3 / exact - 1.0) < 1e-5  # (-1.25e-6: the large deflection's correction)
 
 
 def test_methods_and_checks():
@@ -292,6 +292,31 @@ def test_methods_and_checks():
     for m in ("rodas4", "rodas4-links"):
         with pytest.raises(SnappingInputError, match=f"method='{m}' with a body.*radau"):
             solve(p, el, method=m, t_end=0.1)
+    # the stretched start: at rest in equilibrium with the bending (node 0 held): no force on nodes 1..N-1
+    line = ElasticLine(p, el)
+    z = line.start("stretched")
+    acc = line.rhs(0.0, z)
+    assert np.abs(acc[6:4 * line.N:4]).max() < 1e-8 and np.abs(acc[7:4 * line.N:4]).max() < 1e-8
+    assert line.body.bending_energy(0.0, z) > 1e-4
     a = solve(p, el, method="dop853", t_end=0.2, tol=1e-10)
     b = solve(p, el, method="radau", t_end=0.2, tol=1e-10)
     assert np.abs(a.state - b.state).max() < 1e-7 and a.dataset.attrs["energy_drift"] < 1e-7
+
+
+def test_stop_floor_is_the_stretching_energy():
+    """The stop rule's noise floor (elastic_solve.speed_floor) takes the release's stretching
+    energy, not the bending energy of the start's shape (at N = 400 that put the floor, 5.9,
+    above the snap's 4.8: the run never stopped)."""
+    from snapping.simulate.elastic_solve import speed_floor
+
+    N = 400
+    p = Problem.catenary(0.3, links=Links.uniform(N, lumping="shared"), body=Body(1e-4, drag_normal=1.0))
+    r = solve(p, Elastic.from_wave_speed(30.0), tol=1e-6, start="matched", t_end=1e-4)
+    line = r.line
+    z0 = line.start("matched")
+    X, Y, _, _ = line.unpack(z0, 0.0)
+    e = np.hypot(np.diff(X), np.diff(Y)) / line.h - 1.0
+    u = float(np.sum(np.where(e > 0.0, 0.5 * 900.0 * line.h * e * e, 0.0)))
+    floor = r.dataset.attrs["stop_speed_floor"]
+    assert floor == pytest.approx(speed_floor(u, float(line.m.min()), 0.5), rel=1e-9)
+    assert floor < 1.0

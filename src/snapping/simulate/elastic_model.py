@@ -31,6 +31,13 @@ it is the inextensible chain's release). ``"stretched"`` is a physical sudden re
 hanging between two holds, one let go: its unloading wave rings along the line); ``"matched"``
 is the start to compare with the rigid chain.
 
+A problem's :class:`~snapping.simulate.body.Body` (bending stiffness and damping, natural
+curvature, drag, wind, a clamped held end) adds its node forces
+(:mod:`~snapping.simulate.elastic_body`; methods ``"radau"`` and ``"dop853"``): the
+``"stretched"`` start's statics then include the bending energy (its Newton iteration runs on
+the full forces), the ``"matched"`` start takes the rigid chain's tensions with the body's
+forces (:func:`~snapping.simulate.elastic_body.matched_body`).
+
 Example
 -------
 >>> from snapping.simulate.problem import Links, Problem

@@ -317,6 +317,8 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         same RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`: each
         link's length and angle, steps not capped by the wave speed c; its error measured in
         node values, so tol means the same; its loop compiled as RODAS4's).
+        A problem with a body (bending, drag: :mod:`snapping.simulate.elastic_body`) takes
+        ``"radau"`` or ``"dop853"`` only.
     start : {"stretched", "unstretched", "matched"}
         See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
         both ends held, then released (its unloading wave rings); ``"matched"`` the start's
@@ -435,6 +437,8 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
     first_slack = np.nan
     i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
+    if line.body is not None:  # (the release's energy is the stretching's: the bending energy V_b is the shape's)
+        U0 -= line.body.bending_energy(0.0, z0)
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
     t_prev, z_prev = 0.0, z0.copy()
