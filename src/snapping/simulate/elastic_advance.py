@@ -33,7 +33,7 @@ from . import elastic_rodas as ER
 __all__ = ["advance", "advance_links", "RodasRun", "LinksRun", "NREC", "NSLOT"]
 
 #: columns of a record row: t, then elastic_solve.STEP_NAMES
-NREC = 21
+NREC = 22
 #: rows of the record buffer (a full buffer returns to Python, which drains it)
 ROWS = 4096
 #: step slots of the pool (three kept steps per peak kind, the last step, one being taken)
@@ -122,6 +122,7 @@ def _book(N, t, t_old, y, mm, s, s_node, s_link, nfev, finished, ref, keep, nkee
     row[18] = mm[16]
     row[19] = mm[17]
     row[20] = s_node[int(mm[18])]
+    row[21] = mm[19]
     sctl[S_NREC] = r + 1
     prev = int(sctl[S_PREV])
     _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best)

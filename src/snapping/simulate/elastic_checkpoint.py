@@ -78,9 +78,9 @@ def held(checkpoint, resume):
         check_paths(checkpoint, resume)
         yield
 
-#: layout version of the ``ckpt_`` variables (2: the record's kappa_max, s_kappa_max columns; a
-#: version-1 checkpoint is refused by name)
-VERSION = 2
+#: layout version of the ``ckpt_`` variables (2: the record's kappa_max, s_kappa_max columns; 3, branch
+#: stretchapp: its kappa_max_interior column; an older checkpoint is refused by name)
+VERSION = 3
 PREFIX = "ckpt_"
 
 

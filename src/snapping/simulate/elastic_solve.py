@@ -53,6 +53,7 @@ from . import elastic_checks as EC
 from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
+from .elastic_approach import approach_peak
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .snap_edge import window_edge
 from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
@@ -106,7 +107,8 @@ def _record(line, t, z, dt, mm):
     s_link = line.snode - 0.5 * line.h
     W, D = z[4 * line.N], z[4 * line.N + 1]
     return [dt, mm[0], mm[2], mm[4], s_node[int(mm[1])], s_node[int(mm[3])], s_link[int(mm[5])], mm[6], mm[8], mm[9],
-            mm[10], mm[11], mm[12] + mm[13] + mm[14], mm[14], W, D, mm[15], mm[16], mm[17], s_node[int(mm[18])]]
+            mm[10], mm[11], mm[12] + mm[13] + mm[14], mm[14], W, D, mm[15], mm[16], mm[17], s_node[int(mm[18])],
+            mm[19]]
 
 
 class _Peaks:
@@ -549,6 +551,8 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
         # the chain's kappa_peak: the largest curvature over the run (t = 0 and every accepted step)
         "kappa_peak": float(rec[:, STEP_NAMES.index("kappa_max")].max()),
         "kappa_max_0": float(rec[0, STEP_NAMES.index("kappa_max")]),
+        **approach_peak(np.asarray(times), rec[:, STEP_NAMES.index("v_max")],
+                        rec[:, STEP_NAMES.index("kappa_max_interior")]),
         "t_first_slack": float(first_slack), "n_slack_steps": int(slack_rows.size),
         "energy_initial": float(E0), "energy_drift": float(np.abs(en - en[0]).max()),
         "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
