@@ -1,0 +1,212 @@
+"""The extensible line's curvature on the approach (branch stretchapp, issue 24): per step
+``kappa_max_interior`` (the joints at least KAPPA_TIP_JOINTS = 8 links from the free end, turning angle
+over the mean rest length), the run attributes ``kappa_peak_approach`` / ``t_kappa_peak_approach`` (the
+largest over the accepted steps at which v_max is at its running maximum), and the stretching study
+that records them.
+
+Expectations are independent of the code under test: closed forms of hand-built polylines (a circle's
+chord curvature 2 asin(h/2R)/h), numpy profiles of the run's own snapshots, states integrated between
+the steps (snapshots), the inextensible chain (another model and method) as c -> infinity, and the
+Richardson limits of the shipped study's levels by hand (``tests/richardson_by_hand.py``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from snapping._validate import SnappingInputError
+from snapping.simulate import Links, Problem, run
+from snapping.simulate import elastic_checkpoint as ECK
+from snapping.simulate.elastic import Elastic, solve
+from snapping.simulate.elastic_approach import approach_peak
+from snapping.simulate.elastic_kernels import curvature_max, curvature_max_both
+from snapping.simulate.errors import RunInterrupted
+
+TIP = 8  # KAPPA_TIP_JOINTS, the chain's value, written out
+
+
+def _z(x, y):
+    """The elastic state vector of nodes 0..N-1 (node N, the held end, apart), at rest."""
+    N = len(x) - 1
+    z = np.zeros(4 * N + 2)
+    z[0:4 * N:4], z[1:4 * N:4] = x[:N], y[:N]
+    return z, np.array([x[N], y[N], 0.0, 0.0])
+
+
+def _polyline(turns, lengths):
+    """Nodes 0..N of a polyline whose link j has the given length and turns by ``turns[j-1]`` at node j."""
+    ang = np.concatenate([[0.3], 0.3 + np.cumsum(turns)])
+    x = np.concatenate([[0.0], np.cumsum(lengths * np.cos(ang))])
+    y = np.concatenate([[0.0], np.cumsum(lengths * np.sin(ang))])
+    return x, y
+
+
+def _interior_by_hand(x, y, h):
+    """max over nodes i >= TIP (1..N-1) of |turning angle| at node i over (h_{i-1} + h_i)/2 (numpy)."""
+    dx, dy = np.diff(x), np.diff(y)
+    k = np.arctan2(np.abs(dx[:-1] * dy[1:] - dy[:-1] * dx[1:]), dx[:-1] * dx[1:] + dy[:-1] * dy[1:])
+    k = k / (0.5 * (h[:-1] + h[1:]))
+    return float(np.max(k[TIP - 1:])) if k.size >= TIP else np.nan
+
+
+def test_circle_chord_curvature_exact():
+    # nodes on a circle of radius R with equal chords h (the rest lengths): every joint turns by the
+    # central angle 2 asin(h/2R), so kappa = 2 asin(h/2R)/h everywhere, interior included
+    R, N, h = 0.37, 30, 0.05
+    D = 2 * math.asin(h / (2 * R))
+    ang = D * np.arange(N + 1)
+    z, pin = _z(R * np.cos(ang), R * np.sin(ang))
+    k, i, kin = curvature_max_both(N, z, pin, np.full(N, h))
+    assert kin == pytest.approx(2 * math.asin(h / (2 * R)) / h, rel=1e-13)
+    assert k == pytest.approx(kin, rel=1e-13)
+    assert (k, i) == curvature_max(N, z, pin, np.full(N, h))
+
+
+@pytest.mark.parametrize("at", [1, TIP - 1, TIP, 20])
+def test_tip_joints_left_out(at):
+    # a gentle arc with one sharp kink at node `at`: kappa_max sees it wherever it is, the interior
+    # curvature only at nodes >= TIP (else the arc's)
+    N, h, D, kink = 24, 1.0 / 24, 0.02, 2.5
+    turns = np.full(N - 1, D)
+    turns[at - 1] = kink
+    x, y = _polyline(turns, np.full(N, h))
+    z, pin = _z(x, y)
+    k, i, kin = curvature_max_both(N, z, pin, np.full(N, h))
+    assert i == at and k == pytest.approx(kink / h, rel=1e-12)
+    assert kin == pytest.approx(kink / h if at >= TIP else D / h, rel=1e-12)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_graded_polyline_by_hand(seed):
+    # random turns (some past pi/2: the dot product negative), random rest lengths, stretched links
+    rng = np.random.default_rng(seed)
+    N = 17
+    turns = rng.uniform(-2.8, 2.8, N - 1) * rng.choice([0.05, 1.0], N - 1)
+    h = rng.uniform(0.02, 0.1, N)
+    x, y = _polyline(turns, h * (1.0 + rng.uniform(0.0, 0.2, N)))
+    z, pin = _z(x, y)
+    k, i, kin = curvature_max_both(N, z, pin, h)
+    full = np.abs(turns) / (0.5 * (h[:-1] + h[1:]))  # node j = 1..N-1
+    assert kin == pytest.approx(np.max(full[TIP - 1:]), rel=1e-12)
+    assert kin == pytest.approx(_interior_by_hand(x, y, h), rel=1e-12)
+    assert k == pytest.approx(np.max(full), rel=1e-12) and i == 1 + int(np.argmax(full))
+
+
+def test_too_few_links_is_nan():
+    for N, finite in ((TIP, False), (TIP + 1, True)):  # node TIP exists from TIP + 1 links on
+        x, y = _polyline(np.full(N - 1, 0.1), np.full(N, 1.0 / N))
+        z, pin = _z(x, y)
+        kin = curvature_max_both(N, z, pin, np.full(N, 1.0 / N))[2]
+        assert np.isfinite(kin) == finite
+        if finite:
+            assert kin == pytest.approx(0.1 * N, rel=1e-12)
+
+
+def test_approach_rule_on_records():
+    t = np.arange(7) * 0.1
+    v = np.array([0.0, 1.0, 1.0, 0.5, 3.0, 2.0, 4.0])
+    k = np.array([1.0, 4.0, 6.0, 99.0, 5.0, 99.0, 2.0])  # rows 3 and 5: v below its running peak
+    assert approach_peak(t, v, k) == {"kappa_peak_approach": 6.0, "t_kappa_peak_approach": t[2]}
+    k[2] = np.nan  # (NaN rows are skipped; all NaN: NaN)
+    assert approach_peak(t, v, k) == {"kappa_peak_approach": 5.0, "t_kappa_peak_approach": t[4]}
+    out = approach_peak(t, v, np.full(7, np.nan))
+    assert np.isnan(out["kappa_peak_approach"]) and np.isnan(out["t_kappa_peak_approach"])
+
+
+def _approach_by_hand(ds):
+    best, tb, run_v = -np.inf, np.nan, -np.inf
+    for tt, v, q in zip(ds.t.values, ds.v_max.values, ds.kappa_max_interior.values):
+        run_v = max(run_v, v)
+        if v >= run_v and q > best:
+            best, tb = q, tt
+    return best, tb
+
+
+P30 = Problem.catenary(0.3, links=Links.uniform(30, lumping="shared"), chords="exact")
+
+
+@pytest.mark.parametrize("method", ["rodas4-links", "rodas4", "radau", "dop853"])
+def test_every_method_records_it(method):
+    ds = solve(P30, Elastic.from_wave_speed(15.0), tol=1e-6, method=method, start="matched",
+               t_end=None if method.startswith("rodas4") else 0.9).dataset
+    h = ds.link_length.values
+    assert ds.kappa_max_interior.dims == ("step",) and np.all(np.isfinite(ds.kappa_max_interior.values))
+    for kind, row in (("initial", 0), ("final", -1)):
+        snap = ds.sel(snapshot=int(np.flatnonzero(ds.snapshot_kind.values == kind)[0]))
+        assert ds.kappa_max_interior.values[row] == pytest.approx(_interior_by_hand(snap.x.values, snap.y.values, h),
+                                                                  rel=1e-12)
+    assert np.all(ds.kappa_max_interior.values <= ds.kappa_max.values)
+    best, tb = _approach_by_hand(ds)
+    assert ds.attrs["kappa_peak_approach"] == best and ds.attrs["t_kappa_peak_approach"] == tb
+    assert ds.attrs["kappa_peak_approach"] <= ds.attrs["kappa_peak"]
+
+
+def test_approach_peak_between_the_steps():
+    # a real run to its snap; then the same run with 40 snapshots over the two steps around the peak
+    # (states integrated from the step's start, not interpolated; the steps unchanged): their interior
+    # curvature, where v_max is at its running peak, lies at most 2e-4 above the steps' (the study's cells:
+    # up to 7.5e-4, docs/guide/regimes.md) and never below it beyond the tolerance
+    E = Elastic.from_wave_speed(40.0)
+    kw = dict(tol=1e-7, method="rodas4-links", start="matched")
+    ds = solve(P30, E, **kw).dataset
+    t = ds.t.values
+    i = int(np.searchsorted(t, ds.attrs["t_kappa_peak_approach"]))
+    assert t[i] == ds.attrs["t_kappa_peak_approach"] and ds.attrs["t_kappa_peak_approach"] < ds.attrs["t_snap_v"]
+    ts = np.linspace(t[i - 1], t[i + 1], 42)[1:-1]
+    d2 = solve(P30, E, snapshot_times=ts, **kw).dataset
+    np.testing.assert_array_equal(d2.kappa_max_interior.values, ds.kappa_max_interior.values)
+    vrun, best = float(np.max(ds.v_max.values[:i])), -np.inf
+    for k in np.flatnonzero(d2.snapshot_kind.values == "requested"):
+        v = float(np.max(d2.speed.values[k]))
+        vrun = max(vrun, v)
+        if v >= vrun:
+            best = max(best, _interior_by_hand(d2.x.values[k], d2.y.values[k], d2.link_length.values))
+    short = 1.0 - ds.attrs["kappa_peak_approach"] / best
+    assert -1e-6 < short < 2e-4, short
+
+
+def test_stiff_limit_is_the_chains():
+    # the same 40 links: as c -> infinity the elastic line's curvature tends to the inextensible chain's
+    # as 1/c^2 (at t_end = 1.15, both landing there: 3.3e-3, 3.05e-4, 3.4e-5, 3.1e-6 at c 300, 1000, 3000,
+    # 10000), and its approach peak (at t 1.002, on the steps) to the chain's (on its dense output) within
+    # the steps' sampling (-4.6e-6, -2.4e-6, -3.1e-6, -6e-8)
+    p = Problem.catenary(0.3, links=Links.uniform(40, lumping="shared"), chords="exact")
+    ch = run(p, method="fast", tol=1e-10, t_end=1.15, progress=False).dataset
+    err = []
+    for c in (1000.0, 3000.0):
+        e = solve(p, Elastic.from_wave_speed(c), tol=1e-10, method="rodas4-links", start="matched", t_end=1.15).dataset
+        assert e.t.values[-1] == ch.t.values[-1] == 1.15
+        err.append(e.kappa_max_interior.values[-1] / ch.kappa_max_interior.values[-1] - 1.0)
+        rel = e.attrs["kappa_peak_approach"] / ch.attrs["kappa_peak_approach"] - 1.0
+        assert abs(rel) < 2e-5, (c, rel)
+        assert abs(e.attrs["t_kappa_peak_approach"] - ch.attrs["t_kappa_peak_approach"]) < 3e-4
+    order = math.log(err[0] / err[1]) / math.log(3.0)
+    assert err[1] > 0 and 1.8 < order < 2.2, (err, order)
+
+
+def test_old_checkpoint_refused_by_name(tmp_path):
+    # a version-2 checkpoint (before the kappa_max_interior column) is refused, naming the version
+    p = Problem.catenary(0.25, links=Links.uniform(12, lumping="shared"))
+    E, path = Elastic.from_wave_speed(20.0), tmp_path / "ck.nc"
+    n = [0]
+
+    def hook(run):
+        n[0] += 1
+        return 2 if n[0] == 2 else None  # (signal.SIGINT)
+
+    ECK._chunk_hook = hook
+    try:
+        with pytest.raises(RunInterrupted):
+            solve(p, E, method="rodas4", checkpoint=path, tol=1e-6, snapshot_times=(0.1, 0.5))
+    finally:
+        ECK._chunk_hook = None
+    ds = xr.load_dataset(path)
+    assert ds.attrs["checkpoint_version"] == 3 and "kappa_max_interior" in ds
+    ds.attrs["checkpoint_version"] = 2
+    old = tmp_path / "old.nc"
+    ds.to_netcdf(old)
+    with pytest.raises(SnappingInputError, match="checkpoint_version=2, expected 3"):
+        solve(p, E, method="rodas4", resume=old, tol=1e-6, snapshot_times=(0.1, 0.5))
