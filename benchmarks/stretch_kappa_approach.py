@@ -9,6 +9,12 @@ angle over the mean rest length, joints >= KAPPA_TIP_JOINTS from the free end), 
 running maximum. Prints the relative shortfall of the steps' value.
 
     PYTHONPATH=src python benchmarks/stretch_kappa_approach.py --cells 0.1:0.0588 0.2:0.0051 --levels 0 3
+
+``--graft OLD NEW OUT``: the shipped file made from a fresh study NEW (``bench_regimes.py --study stretching
+--out NEW``; its cells bit for bit OLD's, with kappa_peak_approach) and the shipped OLD: OLD's ideal runs kept
+(every variable OLD has, bit for bit: they were run by older chain code, 1e-9 from today's runs, and OLD's
+chi 0.5 ran a fifth ideal level that a fresh study does not ask for), NEW's ideal kappa_peak_approach levels,
+and the ideal levels OLD ran and NEW did not run now (their kappa_peak_approach only); the limits recomputed.
 """
 
 from __future__ import annotations
@@ -69,12 +75,46 @@ def between_steps(chi, number, level, samples=40):
     return float(ds.attrs["kappa_peak_approach"]), best, tb, float(ds.attrs["t_kappa_peak_approach"]), int(ds.sizes["link"])
 
 
+def graft(old_path, new_path, out):
+    import os
+
+    from snapping import regimes as R
+    from snapping.sweep_files import atomic_to_netcdf
+
+    old, new = R.load_study(old_path), R.load_study(new_path)
+    if old.attrs["regimes_study"] != new.attrs["regimes_study"] or os.path.lexists(out):
+        raise SystemExit("--graft: OLD and NEW must be the same study, and OUT a new file")
+    key = json.loads(old.attrs["regimes_study"])
+    acc = {k: v for k, v in key.items() if k not in ("mechanism", "chi", "number", "ratio")}
+    acc["levels"] += acc.get("extra_levels", 0)
+    ideal_p = R._levels("fold", acc, 0.5)
+    ds = new.copy(deep=True)
+    for name in old.data_vars:
+        if name.endswith("_ideal_level"):
+            ds[name].values[...] = old[name].values
+    q = ds["kappa_peak_approach_ideal_level"].values
+    cpu = time.process_time()
+    for i, chi in enumerate(ds.chi.values):
+        for k in range(ds.sizes["level"]):
+            if np.isfinite(old.v_peak_ideal_level.values[i, k]) and not np.isfinite(q[i, k]):
+                row = R._run_task(float(chi), None, 0.0, ideal_p[k], key["tol"])
+                q[i, k] = row["kappa_peak_approach"]
+                print(f"ideal chi {chi:g} level {k}: kappa_peak_approach {q[i, k]:.10g} (v_peak {row['v_peak']:.12g}, "
+                      f"OLD's {old.v_peak_ideal_level.values[i, k]:.12g})", flush=True)
+    q[~np.isfinite(old.v_peak_ideal_level.values)] = np.nan
+    atomic_to_netcdf(R._finish(ds), out)
+    print(f"{out}: NEW's cells, OLD's ideal runs, the ideal's kappa_peak_approach ({time.process_time() - cpu:.1f} s CPU)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", nargs="+", default=["0.1:0.0588", "0.2:0.0051", "0.5:0.3"])
     ap.add_argument("--levels", nargs="+", type=int, default=[0])
     ap.add_argument("--samples", type=int, default=40)
+    ap.add_argument("--graft", nargs=3, default=None, metavar=("OLD", "NEW", "OUT"))
     a = ap.parse_args()
+    if a.graft:
+        return graft(*a.graft)
     from snapping import regimes as R
 
     old = R.bundled_study("stretching")
