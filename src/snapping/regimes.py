@@ -286,7 +286,7 @@ def _extra(mechanism) -> tuple:
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
     nc, nn, nl = len(chis), len(numbers), len(levels)
     data = {}
-    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time") + (() if mechanism == "stretching" else CHAIN_COST_PARTS):
+    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time") + CHAIN_COST_PARTS:  # (stretching's too: stretchapp)
         data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
         data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
     data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
