@@ -44,6 +44,7 @@ def cell_run(chi, number, level, snapshot_times=()):
     old = R.bundled_study("stretching")
     key = json.loads(old.attrs["regimes_study"])
     acc = {k: v for k, v in key.items() if k not in ("mechanism", "chi", "number", "ratio")}
+    acc["levels"] += acc.get("extra_levels", 0)  # (the escalated levels too)
     lev = R._levels(R.MECHANISMS["stretching"][1], acc, 0.5)[level]
     p = R.cell_problem(chi, "stretching", number, lev, damping=key["damping"], method=key["elastic_method"])
     return solve(p, Elastic.from_wave_speed(1.0 / number, grid_damping=key["damping"]),
