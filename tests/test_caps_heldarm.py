@@ -77,6 +77,7 @@ def test_climbing_rope_ladder_at_chi_half_by_hand():
 @pytest.mark.parametrize("name,chis", [("nylon-monofilament", (0.1, 0.2, 0.3, 0.4, 0.5)),
                                        ("fly-line", (0.1, 0.2, 0.3, 0.4, 0.5)),
                                        ("bungee-cord", (0.1, 0.2, 0.3, 0.4, 0.5)),
+                                       ("bullwhip", (0.1, 0.2, 0.3, 0.4, 0.5)),
                                        ("climbing-rope", (0.05, 0.1, 0.15, 0.2))])
 def test_ladder_unchanged_where_the_fold_is_near_the_bending_length(name, chis):
     # the ladder before the floor, literally: fold 1.5 l_b, free end 0.4 l_b, held arm 20 l_b (<= 0.5), halved
