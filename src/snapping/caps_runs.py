@@ -57,7 +57,6 @@ GRADED_ORDER = 2.0
 #: fold's scale there, ``grading.fold_following``), at the free end TIP_LINK, the held arm HELD_LINK;
 #: the finer level halves them all
 FOLD_LINK, TIP_LINK, HELD_LINK = 1.5, 0.4, 20.0
-# --- heldarm ---
 #: ... but the fold's links are never finer than FOLD_FRAC of the fold's radius on the crude law
 #: ``a (2x)^(1/4)`` (``a`` the catenary parameter): where the catenary's fold is wider than FOLD_LINK/FOLD_FRAC
 #: = 150 bending lengths (the climbing rope at chi > 0.2, a drag-capped fold: its smallest radius along the
