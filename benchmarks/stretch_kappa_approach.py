@@ -1,12 +1,13 @@
 """The elastic line's kappa_peak_approach on accepted steps against the peak between them (branch stretchapp).
 
 For stretching-study cells (the shipped study's key: links, tolerance, method, start), one run gives
-``kappa_peak_approach`` on the accepted steps (:mod:`snapping.simulate.elastic_approach`); the same run
-again with ``--samples`` snapshots spread over the two steps around it (states integrated from the step's
+``kappa_peak_approach`` on the accepted steps (:func:`snapping.simulate.elastic_approach.approach_peak` of its
+records) and located between them (the run's attribute); the same run again with ``--samples`` snapshots
+spread over the two steps around the steps' best (states integrated from the step's
 start by the run's own method, not interpolated: ``elastic_solve._snapshot``; the steps are unchanged)
 gives the interior curvature between the steps, computed here from the snapshot's node positions (turning
 angle over the mean rest length, joints >= KAPPA_TIP_JOINTS from the free end), where v_max is at its
-running maximum. Prints the relative shortfall of the steps' value.
+running maximum. Prints the relative shortfall of the steps' value and of the located one.
 
     PYTHONPATH=src python benchmarks/stretch_kappa_approach.py --cells 0.1:0.0588 0.2:0.0051 --levels 0 3
 
@@ -53,10 +54,13 @@ def cell_run(chi, number, level, snapshot_times=()):
 
 
 def between_steps(chi, number, level, samples=40):
-    """(steps' value, the largest between the steps, its time, the run's t_kappa_peak_approach, links)."""
+    """(steps' value, the largest between the steps, its time, the steps' time, links, the located value)."""
+    from snapping.simulate.elastic_approach import approach_peak
+
     ds = cell_run(chi, number, level)
     t = ds.t.values
-    i = int(np.searchsorted(t, ds.attrs["t_kappa_peak_approach"]))
+    st = approach_peak(t, ds.v_max.values, ds.kappa_max_interior.values)
+    i = int(np.flatnonzero(t == st["t_kappa_peak_approach"])[0])
     lo, hi = t[max(i - 1, 0)], t[min(i + 1, t.size - 1)]
     ts = np.linspace(lo, hi, samples + 1)[1:-1]
     d2 = cell_run(chi, number, level, snapshot_times=ts)
@@ -73,7 +77,8 @@ def between_steps(chi, number, level, samples=40):
         q = interior_kappa(d2.x.values[k], d2.y.values[k], h)
         if q > best:
             best, tb = q, float(tk)
-    return float(ds.attrs["kappa_peak_approach"]), best, tb, float(ds.attrs["t_kappa_peak_approach"]), int(ds.sizes["link"])
+    return (st["kappa_peak_approach"], best, tb, st["t_kappa_peak_approach"], int(ds.sizes["link"]),
+            float(ds.attrs["kappa_peak_approach"]))
 
 
 def graft(old_path, new_path, out):
@@ -124,9 +129,10 @@ def main():
         num = float(old.number.values[np.argmin(abs(np.log(old.number.values / num)))])
         for lev in a.levels:
             cpu = time.process_time()
-            k_step, k_dense, t_dense, t_step, n = between_steps(chi, num, lev, a.samples)
+            k_step, k_dense, t_dense, t_step, n, k_loc = between_steps(chi, num, lev, a.samples)
             print(f"chi {chi:g} number {num:.4g} level {lev} ({n} links): steps {k_step:.8g} at t {t_step:.8f}, "
-                  f"between {k_dense:.8g} at t {t_dense:.8f}: shortfall {1 - k_step / k_dense:+.2e} "
+                  f"between {k_dense:.8g} at t {t_dense:.8f}: shortfall {1 - k_step / k_dense:+.2e}; located "
+                  f"{k_loc:.8g}: {1 - k_loc / k_dense:+.2e} "
                   f"({time.process_time() - cpu:.1f} s CPU)", flush=True)
 
 
