@@ -276,10 +276,9 @@ def bundled_study(mechanism: str) -> xr.Dataset:
 
 
 def _extra(mechanism) -> tuple:
-    """The peaks a study of ``mechanism`` keeps beside QUANTITIES: ``kappa_peak_approach``, the run's curvature
-    peak on the approach without the free end's node layer (:data:`snapping.regimes_spec.CHAIN_EXTRA_PEAKS`;
-    the elastic line's since branch stretchapp, :mod:`snapping.simulate.elastic_approach`), and stretching's
-    STRETCH_EXTRA_PEAKS before it."""
+    """The peaks a study of ``mechanism`` keeps beside QUANTITIES: ``kappa_peak_approach`` (the approach's curvature
+    peak without the free end's node layer, :data:`snapping.regimes_spec.CHAIN_EXTRA_PEAKS`; the elastic line's
+    too since branch stretchapp), after stretching's STRETCH_EXTRA_PEAKS."""
     return tuple(STRETCH_EXTRA_PEAKS) + CHAIN_EXTRA_PEAKS if mechanism == "stretching" else CHAIN_EXTRA_PEAKS
 
 
