@@ -61,7 +61,7 @@ def links(chi: float, lb: float, level: int, fold=1.0, tip=1.0, held=1.0, gscale
     a = estimates.catenary_parameter(chi)
     h_max = min(0.5, CR.HELD_LINK * lb) * k * held
     h_min = min(h_max, CR.TIP_LINK * lb * k * tip)
-    frac = min(0.5, CR.FOLD_LINK * lb / a) * k * fold
+    frac = min(0.5, max(CR.FOLD_LINK * lb / a, CR.FOLD_FRAC)) * k * fold  # graded_h's floor (``heldarm``)
     gamma = 0.1 * (k if gscale else 1.0)
     xf = 0.6  # grading.fold_following's 1/2 + margin
 

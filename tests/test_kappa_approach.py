@@ -169,7 +169,7 @@ def test_worker_keeps_the_approach_peak_for_chain_mechanisms():
     row = R._run_task(0.5, "end-mass", 1e-3, level, 1e-7)
     assert np.isfinite(row["kappa_peak_approach"]) and row["kappa_peak_approach"] <= row["kappa_peak"]  # (an end mass: its peak inside, the same)
     assert R._extra("end-mass") == ("kappa_peak_approach",) and R._extra("drag") == ("kappa_peak_approach",)
-    assert "kappa_peak_approach" not in R._extra("stretching")
+    assert R._extra("stretching") == ("sigma_peak_taut", "kappa_peak_approach")  # (branch stretchapp)
 
 
 def test_shipped_drag_study_holds_the_approach_peak_of_every_run():

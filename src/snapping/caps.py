@@ -406,8 +406,8 @@ def auto_hopeless(grading: dict) -> str:
 
 
 #: the most links of the finer graded level that ``N="auto"`` runs when uniform links cannot reach the bending
-#: length (:func:`auto_graded`): the climbing rope's 5552 (levels 2785 and 5552: 7.6 s of CPU for its whole answer
-#: at chi 0.25, load 5.7)
+#: length (:func:`auto_graded`): the climbing rope's 5552 at chi 0.2 (levels 2785 and 5552: 5.6 s of CPU for its
+#: whole answer, load 1.7; at chi 0.25-0.5, since ``heldarm``'s floor on the fold's links, 4220 down to 1552: 5.0-2.4 s)
 AUTO_GRADED_LINKS = 6000
 
 

@@ -26,7 +26,7 @@ __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "S
            "STRETCH_N", "STRETCH_LEVELS", "STRETCH_START", "STRETCH_METHOD", "accept_factors", "QUANTITIES",
            "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
            "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
-           "MAX_ESCALATED_LINKS", "grading_for", "graded_levels", "observed_order", "GRADED_WITHIN"]
+           "MAX_ESCALATED_LINKS", "FOLD_FRAC", "grading_for", "graded_levels", "observed_order", "GRADED_WITHIN"]
 
 #: links of the coarser level of the elastic and rigid runs that give the stretching factor
 STRETCH_N = 30
@@ -57,6 +57,19 @@ GRADED_ORDER = 2.0
 #: fold's scale there, ``grading.fold_following``), at the free end TIP_LINK, the held arm HELD_LINK;
 #: the finer level halves them all
 FOLD_LINK, TIP_LINK, HELD_LINK = 1.5, 0.4, 20.0
+#: ... but the fold's links are never finer than FOLD_FRAC of the fold's radius on the crude law
+#: ``a (2x)^(1/4)`` (``a`` the catenary parameter): where the catenary's fold is wider than FOLD_LINK/FOLD_FRAC
+#: = 150 bending lengths (the climbing rope at chi > 0.2, a drag-capped fold: its smallest radius along the
+#: path 338-572 l_b at chi 0.5, where FOLD_LINK alone gave links of 0.56-1.5 l_b, 1/600-1/380 of it;
+#: ``bench_caps.py --profile climbing-rope --chi 0.5 --levels 0``) the links follow the fold, not the
+#: bending length. Every other catalogue line's ladder is unchanged at chi <= 0.5 (the nylon line's
+#: FOLD_LINK l_b/a is 0.013 at chi 0.5), and so is the climbing rope's at chi <= 0.2 (0.0103 at 0.2; at
+#: chi 0.15, unresolved on the old ladder, a floor of 0.02 took the acceleration's error bar from 2.5% to
+#: 4.7%: there bending holds the fold). The climbing rope at chi 0.5: 782/1552 links, 2.2 s of CPU, against
+#: 2785/5552, 9.4 s; the peaks within 0.03% of the old ones (docs/guide/caps.md, "The climbing rope's ladder").
+#: A floor on the held arm's links instead saves nothing: it holds 122 of the 2785 links (x > 0.6 from the free
+#: end), the fold's path 2551; the held arm's links at 0.05 L give 2713.
+FOLD_FRAC = 0.01
 #: the peaks answered: (name, SI units)
 QUANTITIES = {"v_peak": "m/s", "a_peak": "m/s^2", "sigma_peak": "N"}
 #: the mechanisms, in the order they are tried
@@ -162,9 +175,10 @@ def bending_length(sp) -> float:
 def graded_h(chi: float, lb: float, level: int) -> np.ndarray:
     """The links of graded level ``level`` (0 or 1) of a line whose bending length is ``lb``
     (nondimensional, :func:`bending_length`): ``grading.fold_following`` with the links along the
-    fold's path at most :data:`FOLD_LINK` lb, :data:`TIP_LINK` lb at the free end and
-    :data:`HELD_LINK` lb on the held arm (each at most 0.5 L, the fold's at most half its radius),
-    all halved on level 1 (the nylon line: 545 and 1072 links, at every chi)."""
+    fold's path at most :data:`FOLD_LINK` lb but not below :data:`FOLD_FRAC` of its radius (the
+    fold's at most half its radius), :data:`TIP_LINK` lb at the free end and :data:`HELD_LINK` lb on
+    the held arm (each at most 0.5 L), all halved on level 1 (the nylon line: 545 and 1072 links, at
+    every chi <= 0.5; the climbing rope: 2785 and 5552 at chi <= 0.2, 782 and 1552 at 0.5)."""
     from . import estimates
     from .simulate import grading
 
@@ -172,7 +186,7 @@ def graded_h(chi: float, lb: float, level: int) -> np.ndarray:
     a = estimates.catenary_parameter(chi)
     h_max = min(0.5, HELD_LINK * lb)  # level 0's, capped before the halving: the levels stay halvings
     h_min = min(h_max, TIP_LINK * lb)
-    frac = min(0.5, FOLD_LINK * lb / a)
+    frac = min(0.5, max(FOLD_LINK * lb / a, FOLD_FRAC))  # the fold's links: FOLD_LINK l_b, or FOLD_FRAC of its radius
     return grading.fold_following(chi, frac=frac * k, h_min=h_min * k, h_max=h_max * k)
 
 

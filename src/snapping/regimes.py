@@ -196,7 +196,7 @@ def _run_task(chi, mechanism, number, level, tol, damping=GRID_DAMPING, start=ST
     if a.get("status") != "completed":
         raise RuntimeError(f"chi={chi:g} {mechanism}={number:g} ({problem.links.N} links): run {a.get('status')}: "
                            f"{a.get('stop_reason', '')}" + (f" ({a['peak_note']})" if a.get("peak_note") else ""))
-    row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES + (CHAIN_EXTRA_PEAKS if mechanism != "stretching" else ())}
+    row = {q: float(a.get(q, float("nan"))) for q in QUANTITIES + CHAIN_EXTRA_PEAKS}  # (an elastic run's too: branch stretchapp)
     if mechanism == "stretching" and number > 0:  # the snap's peaks, not the slack fold's / recoil's after it
         row.update({q: float(a[name]) for q, name in STRETCH_PEAK_ATTRS.items() if name in a})
         row.update({q: float(a[name]) for q, name in STRETCH_EXTRA_PEAKS.items() if name in a})
@@ -276,16 +276,16 @@ def bundled_study(mechanism: str) -> xr.Dataset:
 
 
 def _extra(mechanism) -> tuple:
-    """The peaks a study of ``mechanism`` keeps beside QUANTITIES (stretching: STRETCH_EXTRA_PEAKS; the
-    chain's mechanisms: ``kappa_peak_approach``, the run's curvature peak on the approach without the free
-    end's node layer, :data:`snapping.regimes_spec.CHAIN_EXTRA_PEAKS`)."""
-    return tuple(STRETCH_EXTRA_PEAKS) if mechanism == "stretching" else CHAIN_EXTRA_PEAKS
+    """The peaks a study of ``mechanism`` keeps beside QUANTITIES: ``kappa_peak_approach`` (the approach's curvature
+    peak without the free end's node layer, :data:`snapping.regimes_spec.CHAIN_EXTRA_PEAKS`; the elastic line's
+    too since branch stretchapp), after stretching's STRETCH_EXTRA_PEAKS."""
+    return tuple(STRETCH_EXTRA_PEAKS) + CHAIN_EXTRA_PEAKS if mechanism == "stretching" else CHAIN_EXTRA_PEAKS
 
 
 def _empty(mechanism, chis, numbers, levels, ideal_levels, key, acc, ratio) -> xr.Dataset:
     nc, nn, nl = len(chis), len(numbers), len(levels)
     data = {}
-    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time") + (() if mechanism == "stretching" else CHAIN_COST_PARTS):
+    for q in QUANTITIES + _extra(mechanism) + ("n_rhs", "cpu_time") + CHAIN_COST_PARTS:  # (stretching's too: stretchapp)
         data[f"{q}_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
         data[f"{q}_ideal_level"] = (("chi", "level"), np.full((nc, nl), np.nan))
     data["n_links_level"] = (("chi", "number", "level"), np.full((nc, nn, nl), np.nan))
@@ -533,7 +533,7 @@ def regimes(mechanism: str, chis, numbers, *, accuracy: str = "coarse", levels: 
             return
         i, j, k = t
         if j is None and mechanism == "stretching":  # the ideal chain (inextensible: never slack): its taut snap's tension is its run's
-            row = {**row, **{q: row["sigma_peak"] for q in _extra(mechanism)}}
+            row = {**row, **{q: row["sigma_peak"] for q in STRETCH_EXTRA_PEAKS}}
         for q, v in row.items():
             name = f"{q}_ideal_level" if j is None else f"{q}_level"
             if name not in ds:  # (a study file from before the name: its earlier runs have none)

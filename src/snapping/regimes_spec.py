@@ -150,7 +150,8 @@ STRETCH_PEAKS_KEY = "snap"
 #: so it has no continuum limit on these levels (docs/guide/regimes.md "The taut snap's tension").
 #: The ideal chain's (inextensible: never slack) is its run's sigma_peak
 STRETCH_EXTRA_PEAKS = {"sigma_peak_taut": "sigma_peak_taut"}
-#: the chain mechanisms' studies keep beside QUANTITIES the runs' ``kappa_peak_approach``: the curvature peak
+#: every study keeps beside QUANTITIES the runs' ``kappa_peak_approach`` (stretching's cells since branch stretchapp: the
+#: elastic line's, :mod:`snapping.simulate.elastic_approach`): the curvature peak
 #: while v_max rises to the snap, at the joints at least ``general.KAPPA_TIP_JOINTS`` links from the free end.
 #: The run's kappa_peak is the node next to the free end's (a node-index boundary layer, 1.29x the curvature
 #: a few joints in at every resolution) and the larger of two maxima, one before the speed peak and one after

@@ -138,7 +138,8 @@ PROBLEM_ATTRS: dict[str, str] = {
     "start": "start shape: 'catenary', 'supports', 'curve' or 'nodes'",
     "kappa_peak_approach": ("the snap's curvature peak on the approach: the largest kappa_max_interior over the steps "
                             "at which v_max is at its running maximum (up to the speed peak), located on the dense "
-                            "output; NaN for a run resumed from a checkpoint written before it existed "
+                            "output (the elastic line: as its v/a/sigma peaks, its kept steps sampled and integrated "
+                            "again); NaN for a run resumed from a checkpoint written before it existed "
                             "(docs/guide/regimes.md, 'The curvature peak')"),
     "t_kappa_peak_approach": "time of kappa_peak_approach",
     "n_rhs_approach": ("of n_rhs, the right-hand-side evaluations that located kappa_peak_approach (n_rhs less them: "

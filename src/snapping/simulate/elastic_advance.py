@@ -33,13 +33,19 @@ from . import elastic_rodas as ER
 __all__ = ["advance", "advance_links", "RodasRun", "LinksRun", "NREC", "NSLOT"]
 
 #: columns of a record row: t, then elastic_solve.STEP_NAMES
-NREC = 21
+NREC = 22
 #: rows of the record buffer (a full buffer returns to Python, which drains it)
 ROWS = 4096
-#: step slots of the pool (three kept steps per peak kind, the last step, one being taken)
-NSLOT = 12
+#: step slots of the pool (three kept steps per peak kind, the last step, one being taken; four kinds since
+#: branch stretchapp: v, a, sigma and kappa_max_interior on the approach)
+NSLOT = 15
+#: the approach kind's row in the pool's peaks (``best``, ``keep``): kappa_max_interior while v_max is at its
+#: running peak (``kappa_peak_approach``), refined after the other three (:func:`elastic_refine.refine_approach`)
+APPROACH = 3
 #: the peak kinds' columns of the measures (v_max, a_max, sigma_max)
 KCOL = ERF.KCOL
+#: the approach kind's column (kappa_max_interior)
+KIN = ERF.KIN
 #: the run's controls (``sctl``): t_end given, stop_fraction, the stop floor, the running peak
 #: of v_max, when the stop rule was armed, the largest energy error, E(0), U(0), max_rhs, the
 #: next snapshot time, the first slack time, rows in the buffer, the running peak's time, the
@@ -61,14 +67,18 @@ def _hold(ref, keep, nkeep, k, s):
 @njit(cache=True, error_model="numpy")
 def _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best):
     """``_Peaks.update`` of elastic_solve on slots: a new maximum keeps the step before it and
-    its own, and the step after it once taken."""
-    for k in range(3):
-        c = KCOL[k]
+    its own, and the step after it once taken. The fourth kind (:data:`APPROACH`): kappa_max_interior
+    where v_max is at its running peak (the v kind's best, this step's included), else nothing."""
+    for k in range(4):
+        if k < 3:
+            q = mm[KCOL[k]]
+        else:
+            q = mm[KIN] if mm[0] >= best[0, 0] else -np.inf
         if after[k]:
             _hold(ref, keep, nkeep, k, s)
             after[k] = False
-        if mm[c] > best[k, 0]:
-            best[k, 0] = mm[c]
+        if q > best[k, 0]:
+            best[k, 0] = q
             best[k, 1] = t
             for q in range(nkeep[k]):
                 ref[keep[k, q]] -= 1
@@ -122,6 +132,7 @@ def _book(N, t, t_old, y, mm, s, s_node, s_link, nfev, finished, ref, keep, nkee
     row[18] = mm[16]
     row[19] = mm[17]
     row[20] = s_node[int(mm[18])]
+    row[21] = mm[19]
     sctl[S_NREC] = r + 1
     prev = int(sctl[S_PREV])
     _peaks_update(t, mm, s, prev, ref, keep, nkeep, after, best)
@@ -216,10 +227,14 @@ class RodasRun:
         self.PC = np.zeros((NSLOT, 2, n))
         self.PT = np.zeros((NSLOT, 2))
         self.ref = np.zeros(NSLOT, dtype=np.int64)
-        self.keep = np.full((3, 3), -1, dtype=np.int64)
-        self.nkeep = np.zeros(3, dtype=np.int64)
-        self.after = np.ones(3, dtype=np.bool_)  # (as _Peaks.update(0, mm0, None) leaves them)
-        self.best = np.array([[mm0[c], 0.0] for c in KCOL])
+        self.keep = np.full((4, 3), -1, dtype=np.int64)
+        self.nkeep = np.zeros(4, dtype=np.int64)
+        self.after = np.ones(4, dtype=np.bool_)  # (as _Peaks.update(0, mm0, None) leaves them)
+        self.best = np.array([[mm0[c], 0.0] for c in KCOL] + [[-np.inf, 0.0]])
+        if mm0[KIN] > -np.inf:  # (NaN: fewer than KAPPA_TIP_JOINTS + 1 links, no approach peak)
+            self.best[APPROACH, 0] = mm0[KIN]
+        else:
+            self.after[APPROACH] = False
         self.sctl = np.zeros(NSCTL)
         c = self.sctl
         c[S_TEND], c[S_FRAC], c[S_FLOOR], c[S_RUN] = float(t_end_given), stop_fraction, floor, 0.0
@@ -298,10 +313,11 @@ class RodasRun:
 
     def segments(self):
         """{kind index: (best value, its time, [(t_old, y_old, t, dense) of the kept steps])}
-        (kinds v, a, sigma): the peaks before refinement, with the kept steps' starts."""
+        (kinds v, a, sigma, and the approach's kappa_max_interior): the peaks before refinement, with the
+        kept steps' starts."""
         return {k: (float(self.best[k, 0]), float(self.best[k, 1]),
                     [(float(self.PT[s, 0]), self.start(int(s)), float(self.PT[s, 1]), self.dense(int(s)))
-                     for s in self.keep[k, :self.nkeep[k]]]) for k in range(3)}
+                     for s in self.keep[k, :self.nkeep[k]]]) for k in range(4)}
 
 
 class LinksRun(RodasRun):

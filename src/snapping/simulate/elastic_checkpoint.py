@@ -78,9 +78,9 @@ def held(checkpoint, resume):
         check_paths(checkpoint, resume)
         yield
 
-#: layout version of the ``ckpt_`` variables (2: the record's kappa_max, s_kappa_max columns; a
-#: version-1 checkpoint is refused by name)
-VERSION = 2
+#: layout version of the ``ckpt_`` variables (2: the record's kappa_max, s_kappa_max columns; 3, branch
+#: stretchapp: its kappa_max_interior column; an older checkpoint is refused by name)
+VERSION = 3
 PREFIX = "ckpt_"
 
 
@@ -125,9 +125,11 @@ def read(path, key: dict, names) -> dict:
     if status not in schema.RESUMABLE_STATUS:
         raise V.SnappingInputError(f"{what} is not an extensible-line checkpoint (status={status!r}; expected one "
                                    f"of {schema.RESUMABLE_STATUS})")
-    if ds.attrs.get("checkpoint_version") != VERSION or "checkpoint_inputs" not in ds.attrs:
+    ver = ds.attrs.get("checkpoint_version")
+    if ver != VERSION or "checkpoint_inputs" not in ds.attrs:
+        ver = int(ver) if isinstance(ver, (int, np.integer)) else ver  # (netCDF's np.int64 named as a plain number)
         raise V.SnappingInputError(f"{what} is not an extensible-line checkpoint of this version (checkpoint_version="
-                                   f"{ds.attrs.get('checkpoint_version')!r}, expected {VERSION})")
+                                   f"{ver!r}, expected {VERSION})")
     verify_digest(ds, what)
     stored = json.loads(str(ds.attrs["checkpoint_inputs"]))
     given = json.loads(json.dumps(key, sort_keys=True))

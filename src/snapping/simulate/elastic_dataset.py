@@ -20,7 +20,8 @@ __all__ = ["dataset", "STEP_NAMES"]
 #: the per-step record's columns (the Dataset's step variables, in this order)
 STEP_NAMES = ("dt", "v_max", "a_max", "sigma_max", "s_v_max", "s_a_max", "s_sigma_max", "sigma_min", "v_end",
               "a_end", "pin_force_x", "pin_force_y", "energy", "elastic_energy", "pin_work", "dissipated",
-              "strain_max", "n_slack", "kappa_max", "s_kappa_max")
+              "strain_max", "n_slack", "kappa_max", "s_kappa_max",
+              "kappa_max_interior")
 #: the Dataset assembled without xarray's merge (:func:`_assemble`); False: its public constructor
 DIRECT_DATASET = True
 

@@ -26,8 +26,11 @@ from numba import njit
 #: number of measures written by :func:`measure` (see ``MEASURE_NAMES``)
 MEASURE_NAMES = ("v_max", "iv", "a_max", "ia", "sigma_max", "isig", "sigma_min", "imin", "v_end", "a_end",
                  "pin_force_x", "pin_force_y", "kinetic", "gravity", "elastic_energy", "strain_max", "n_slack",
-                 "kappa_max", "ik")
+                 "kappa_max", "ik", "kappa_max_interior")
 NMEAS = len(MEASURE_NAMES)
+#: ``kappa_max_interior`` leaves out the joints (nodes) fewer than this many links from the free end, as the
+#: chain's (:data:`snapping.simulate.general.KAPPA_TIP_JOINTS`, the same value; not imported: no cycle)
+KAPPA_TIP_JOINTS = 8
 
 
 @njit(cache=True)
@@ -324,9 +327,10 @@ def measure_given(N, z, pin, h, m, ea, tabe, tabt, tabw, g, snode, dz, T, E, out
     out[14] = ue
     out[15] = emax
     out[16] = nslack
-    kap, ik = curvature_max(N, z, pin, h)
+    kap, ik, kin = curvature_max_both(N, z, pin, h)
     out[17] = kap
     out[18] = ik
+    out[19] = kin
 
 
 @njit(cache=True, error_model="numpy")
@@ -339,7 +343,19 @@ def curvature_max(N, z, pin, h):
     line's geometric curvature is this over the joint's stretch ``1 + e``). ``(0.0, 0)`` with
     one link (no joint). ``phi = atan2(|d_j x d_j+1|, d_j . d_j+1)`` only where its bound
     ``pi/2 sin(phi)`` (``cos(phi) > 0``) can beat the best so far."""
+    kbest, ik, _ = curvature_max_both(N, z, pin, h)
+    return kbest, ik
+
+
+@njit(cache=True, error_model="numpy")
+def curvature_max_both(N, z, pin, h):
+    """``(kappa, i, kappa_interior)``: :func:`curvature_max`'s two, the same floats, and the largest
+    curvature over the joints at least :data:`KAPPA_TIP_JOINTS` links from the free end (nodes
+    ``i >= KAPPA_TIP_JOINTS``; the chain's ``kappa_max_interior``, ``general.general_measure``; NaN with
+    fewer than ``KAPPA_TIP_JOINTS + 1`` links). A joint's atan2 is skipped only where its bound beats
+    neither best (the interior one counting from node ``KAPPA_TIP_JOINTS`` on)."""
     kbest = -1.0
+    kin = -1.0
     ik = -1
     dxp = (z[4] if N > 1 else pin[0]) - z[0]
     dyp = (z[5] if N > 1 else pin[1]) - z[1]
@@ -354,14 +370,20 @@ def curvature_max(N, z, pin, h):
         Sn = abs(dxp * dyn - dyp * dxn)
         hb = 2.0 / (h[j] + h[j + 1])
         bound = 0.5 * math.pi * Sn * hb
-        if not (C > 0.0 and kbest >= 0.0 and bound * bound <= kbest * kbest * lp * ln):
+        skip = C > 0.0 and kbest >= 0.0 and bound * bound <= kbest * kbest * lp * ln
+        if skip and j + 1 >= KAPPA_TIP_JOINTS:
+            skip = kin >= 0.0 and bound * bound <= kin * kin * lp * ln
+        if not skip:
             kap = math.atan2(Sn, C) * hb
             if kap > kbest:
                 kbest = kap
                 ik = j + 1
+            if j + 1 >= KAPPA_TIP_JOINTS and kap > kin:
+                kin = kap
         dxp = dxn
         dyp = dyn
         lp = ln
+    kin = kin if kin >= 0.0 else np.nan
     if ik < 0:
-        return 0.0, 0
-    return kbest, ik
+        return 0.0, 0, kin
+    return kbest, ik, kin

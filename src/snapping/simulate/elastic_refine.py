@@ -28,8 +28,10 @@ from . import elastic_stage as ES
 #: the peak kinds' columns of the measures (v_max, a_max, sigma_max; ``elastic_advance`` keeps its
 #: peaks in this order)
 KCOL = np.array([0, 2, 4])
+#: the measures' column of kappa_max_interior (the approach kind's, ``elastic_advance.APPROACH``)
+KIN = 19
 
-__all__ = ["refine", "refine_slots", "refine_segments", "restep", "restep_links", "restep_call", "grid", "measure"]
+__all__ = ["refine", "refine_approach", "refine_slots", "refine_segments", "restep", "restep_links", "restep_call", "grid", "measure"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -250,13 +252,33 @@ def refine(run, samples: int, window: int):
     return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)
 
 
-def refine_segments(stepper, best, keep, samples: int, window: int):
+def refine_approach(run, samples: int, window: int):
+    """:func:`refine` of the run's fourth kind (``elastic_advance.APPROACH``: kappa_max_interior on the
+    approach, column :data:`KIN`), on its own (no integration shared with the other three, whose numbers
+    and evaluations are as before it existed): ``((value, time), evaluations)``; ``((NaN, NaN), 0)`` with
+    no such peak (fewer than KAPPA_TIP_JOINTS + 1 links)."""
+    st = run.st
+    ln = st.line
+    links = hasattr(run, "PN0")
+    if not run.best[3, 0] > -np.inf:
+        return (np.nan, np.nan), 0
+    out = np.zeros((1, 2))
+    nfev = refine_slots(st.N, np.array([KIN]), run.best[3:], run.keep[3:], run.nkeep[3:], run.PT, run.PY0, run.PY1,
+                        run.PC, int(samples), int(window), st.tol, st.ctl[ER.C_AUTO], st.pinpar, st.pintab, ln.h,
+                        ln._invm, ln.m, ln.ea, ln.damp, ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, links,
+                        run.PN0 if links else run.PY0)
+    return (float(out[0, 0]), float(out[0, 1])), int(nfev)
+
+
+def refine_segments(stepper, best, keep, samples: int, window: int, kcol=KCOL):
     """:func:`refine` for a ``"rodas4-links"`` run of the Python loop: ``best`` and ``keep`` of
     ``elastic_solve._Peaks`` (kinds v, a, sigma; kept steps ``(t_old, y_old, t, LinksDense)``)
-    put on step slots, refined by :func:`refine_slots` (``links``)."""
+    put on step slots, refined by :func:`refine_slots` (``links``); ``kcol``: the kinds' measure columns
+    (``[KIN]`` with ``_Peaks``' approach kind alone: :func:`refine_approach`'s)."""
     segs, idx = [], {}
-    kk = np.full((3, 3), -1, dtype=np.int64)
-    nk = np.zeros(3, dtype=np.int64)
+    nkind = len(kcol)
+    kk = np.full((nkind, 3), -1, dtype=np.int64)
+    nk = np.zeros(nkind, dtype=np.int64)
     for k, lst in enumerate(keep.values()):
         for q, seg in enumerate(lst):
             if id(seg) not in idx:
@@ -271,12 +293,12 @@ def refine_segments(stepper, best, keep, samples: int, window: int):
         PT[s] = t0, t1
         PY0[s], PY1[s], PR0[s], PC[s, 0], PC[s, 1] = d.y0, d.y1, y0, d.c2, d.c3
     ln = stepper.line
-    bb = np.array([best[k] for k in ("v", "a", "sigma")], dtype=float)
-    out = np.zeros((3, 2))
-    nfev = refine_slots(stepper.N, KCOL, bb, kk, nk, PT, PY0, PY1, PC, int(samples), int(window), stepper.tol,
+    bb = np.array([best[k] for k in keep], dtype=float)
+    out = np.zeros((nkind, 2))
+    nfev = refine_slots(stepper.N, np.asarray(kcol), bb, kk, nk, PT, PY0, PY1, PC, int(samples), int(window), stepper.tol,
                         stepper.ctl[ER.C_AUTO], stepper.pinpar, stepper.pintab, ln.h, ln._invm, ln.m, ln.ea, ln.damp,
                         ln.tabe, ln.tabt, ln.tabw, ln.g, ln.snode, out, True, PR0)
-    return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(("v", "a", "sigma"))}, int(nfev)
+    return {k: (float(out[i, 0]), float(out[i, 1])) for i, k in enumerate(keep)}, int(nfev)
 
 
 def restep_call(stepper, method: str, n_restep: list):

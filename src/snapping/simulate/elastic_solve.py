@@ -53,6 +53,7 @@ from . import elastic_checks as EC
 from . import elastic_progress as EP
 from . import elastic_refine as ERF
 from . import elastic_rodas as ER
+from .elastic_approach import refine_peaks
 from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .snap_edge import window_edge
 from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
@@ -107,7 +108,8 @@ def _record(line, t, z, dt, mm):
     s_link = line.snode - 0.5 * line.h
     W, D = z[4 * line.N], z[4 * line.N + 1]
     return [dt, mm[0], mm[2], mm[4], s_node[int(mm[1])], s_node[int(mm[3])], s_link[int(mm[5])], mm[6], mm[8], mm[9],
-            mm[10], mm[11], mm[12] + mm[13] + mm[14], mm[14], W, D, mm[15], mm[16], mm[17], s_node[int(mm[18])]]
+            mm[10], mm[11], mm[12] + mm[13] + mm[14], mm[14], W, D, mm[15], mm[16], mm[17], s_node[int(mm[18])],
+            mm[19]]
 
 
 class _Peaks:
@@ -127,32 +129,45 @@ class _Peaks:
 
     COLS = {"v": 0, "a": 2, "sigma": 4}
 
+    #: the approach kind (branch stretchapp): kappa_max_interior where v_max is at its running peak
+    #: (``kappa_peak_approach``), kept and refined apart (:meth:`refine_approach`)
+    APPROACH = {"kappa_approach": ERF.KIN}
+
     def __init__(self):
-        self.best = {k: (-np.inf, 0.0) for k in self.COLS}
-        self.keep = {k: [] for k in self.COLS}
-        self.after = dict.fromkeys(self.COLS, False)
+        kinds = {**self.COLS, **self.APPROACH}
+        self.best = {k: (-np.inf, 0.0) for k in kinds}
+        self.keep = {k: [] for k in kinds}
+        self.after = dict.fromkeys(kinds, False)
         self.prev = None
         self.run = None  # (a compiled RODAS4 run whose kept steps elastic_refine.refine refines)
 
     def update(self, t, mm, seg):
         """Record the accepted step ``seg = (t_old, y_old, t, dense)`` (None for the initial
         state) ending at ``t`` with the measures ``mm``."""
-        for k, c in self.COLS.items():
+        for k, c in {**self.COLS, **self.APPROACH}.items():
+            q = mm[c] if k in self.COLS or mm[0] >= self.best["v"][0] else -np.inf
             if self.after[k] and seg is not None:
                 self.keep[k].append(seg)
                 self.after[k] = False
-            if mm[c] > self.best[k][0]:
-                self.best[k] = (float(mm[c]), float(t))
+            if q > self.best[k][0]:
+                self.best[k] = (float(q), float(t))
                 self.keep[k] = [d for d in (self.prev, seg) if d is not None]
                 self.after[k] = True
         self.prev = seg
 
-    def refine(self, line, restep):
+    def refine_approach(self, line, restep):
+        """:meth:`refine` of the approach kind alone (its own integrations: the others' unchanged):
+        (value, time), (NaN, NaN) without one."""
+        if not self.best["kappa_approach"][0] > -np.inf:
+            return (np.nan, np.nan)
+        return self.refine(line, restep, self.APPROACH)["kappa_approach"]
+
+    def refine(self, line, restep, kinds=None):
         """The refined peaks {name: (value, time)}; ``restep(t0, y0, t1)`` the state at ``t1``
         integrated from ``(t0, y0)`` (None if that fails: the sample is left out)."""
         out = {}
         cache = {}
-        for k, c in self.COLS.items():
+        for k, c in (self.COLS if kinds is None else kinds).items():
             val, tp = self.best[k]
             guide, gval = None, -np.inf
             for seg in self.keep[k]:
@@ -282,7 +297,7 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
     if COMPILED_REFINE:
         peaks.run = run
     else:
-        for k, (val, tp, segs) in zip(peaks.COLS, run.segments().values()):
+        for k, (val, tp, segs) in zip({**peaks.COLS, **peaks.APPROACH}, run.segments().values()):
             peaks.best[k], peaks.keep[k] = (val, tp), segs
     sc = run.sctl
     if sc[EA.S_RUN] > 0.0:
@@ -534,14 +549,8 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
     snap_z += [peak_state[1], zf]
     snap_kind += ["peak", "final"]
     rec = np.asarray(rows, dtype=float)
-    if peaks.run is not None:
-        ref, nf = ERF.refine(peaks.run, PEAK_SAMPLES, PEAK_RESTEP)
-        n_restep[0] += nf
-    elif method == "rodas4-links" and COMPILED_REFINE:
-        ref, nf = ERF.refine_segments(solver, peaks.best, peaks.keep, PEAK_SAMPLES, PEAK_RESTEP)
-        n_restep[0] += nf
-    else:
-        ref = peaks.refine(line, restep)
+    ref, app, n_app = refine_peaks(peaks, solver, method, line, restep, n_restep, samples=PEAK_SAMPLES,
+                                   window=PEAK_RESTEP, compiled=COMPILED_REFINE)
     wall = wall_before + time.perf_counter() - wall0
 
     en = rec[:, STEP_NAMES.index("energy")] - rec[:, STEP_NAMES.index("pin_work")] + \
@@ -557,6 +566,8 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
         # the chain's kappa_peak: the largest curvature over the run (t = 0 and every accepted step)
         "kappa_peak": float(rec[:, STEP_NAMES.index("kappa_max")].max()),
         "kappa_max_0": float(rec[0, STEP_NAMES.index("kappa_max")]),
+        # the chain's fifth peak: kappa_max_interior on the approach, refined between the steps as v/a/sigma
+        "kappa_peak_approach": float(app[0]), "t_kappa_peak_approach": float(app[1]), "n_rhs_approach": int(n_app),
         "t_first_slack": float(first_slack), "n_slack_steps": int(slack_rows.size),
         "energy_initial": float(E0), "energy_drift": float(np.abs(en - en[0]).max()),
         "dissipated_total": float(rec[-1, STEP_NAMES.index("dissipated")]),
