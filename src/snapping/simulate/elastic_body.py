@@ -32,6 +32,10 @@ Energy: ``KE + V_grav + V_elastic + V_b - W + D`` is conserved with
 ``W' = -F^int_N . v_pin + M_N phi'`` (the springs' and the bending couples' force on node N,
 the clamp's torque times its rate) and ``D' = KV + 2R - sum_j F^drag_j . v_j``.
 
+The turning angle is the wrapped one, in (-pi, pi]: a joint folded past pi (a limp line's
+fold) turns its moment's sign where the inextensible chain's unwrapped angles would not (``V_b``
+stays continuous there without natural curvature, its force does not).
+
 Jacobian: node i's force depends on nodes i-2..i+2 (five 4 x 4 blocks); the springs' blocks
 are the analytic ones (:func:`elastic_kernels.jac_blocks`), the body's are central differences
 over the nodes coloured mod 5 (:func:`body_jac_fd`: 40 force evaluations, O(N) each; error
