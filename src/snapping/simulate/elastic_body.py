@@ -36,6 +36,13 @@ The turning angle is the wrapped one, in (-pi, pi]: a joint folded past pi (a li
 fold) turns its moment's sign where the inextensible chain's unwrapped angles would not (``V_b``
 stays continuous there without natural curvature, its force does not).
 
+Compression: a line with bending (``Body.has_bending``) is a rod, and its links push when shorter
+than their rest length, with the springs' law continued below it (:func:`compression`,
+``T = min(0, EA e + c edot)``, energy ``h EA e^2/2``): without it the inextensible chain's
+compression (a bending chain pushes near its free end) has no limit in the tension-only line,
+which folds there, the more violently the larger EA (chi 0.3, N 10, beta 1e-2, to t 0.4: a_peak
+8x, 25x, 87x the chain's at c = 100, 300, 1000). A line with drag only stays tension-only.
+
 Jacobian: node i's force depends on nodes i-2..i+2 (five 4 x 4 blocks); the springs' blocks
 are the analytic ones (:func:`elastic_kernels.jac_blocks`), the body's are central differences
 over the nodes coloured mod 5 (:func:`body_jac_fd`: 40 force evaluations, O(N) each; error
@@ -88,16 +95,19 @@ def _geometry(N, z, pin, UX, UY, LN, OM):
 
 @njit(cache=True, error_model="numpy")
 def body_forces(N, z, pin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex, ey, phid,
-                UX, UY, LN, OM, MM, FX, FY):
+                push, h, EA, KV, UX, UY, LN, OM, MM, FX, FY):
     """The body's node forces into ``FX, FY`` (N + 1 each, overwritten; entry N the force on the
     held end); returns ``(M_N, diss, p_drag)``: the clamp's moment, the bending damping's
     dissipation rate 2R and the drag's power ``sum_j F_j . v_j``. ``(ex, ey)`` the clamp's
-    unit link direction, ``phid`` its rate."""
+    unit link direction, ``phid`` its rate. With ``push`` a link shorter than its rest length
+    pushes (:func:`compression`: the rod's axial stiffness ``EA`` and damping ``KV``, rest lengths ``h``)."""
     _geometry(N, z, pin, UX, UY, LN, OM)
     for i in range(N + 1):
         FX[i] = 0.0
         FY[i] = 0.0
     diss = 0.0
+    if push:
+        diss += compression(N, z, pin, h, EA, KV, UX, UY, LN, FX, FY)
     MM[0] = 0.0
     for i in range(1, N):
         cr = UX[i - 1] * UY[i] - UY[i - 1] * UX[i]
@@ -158,6 +168,42 @@ def body_forces(N, z, pin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex,
 
 
 @njit(cache=True, error_model="numpy")
+def compression(N, z, pin, h, EA, KV, UX, UY, LN, FX, FY):
+    """A compressed link's push (added to ``FX, FY``; returns its damping's dissipation rate): the
+    springs' law continued below the rest length, ``T_j = min(0, EA_j e_j + KV_j edot_j)`` for
+    ``e_j <= 0`` (the springs carry ``max(0, ...)`` above it), force ``+T_j u_j`` on node j."""
+    diss = 0.0
+    for j in range(N):
+        e = LN[j] / h[j] - 1.0
+        if e > 0.0:
+            continue
+        vx1 = z[4 * j + 6] if j + 1 < N else pin[2]
+        vy1 = z[4 * j + 7] if j + 1 < N else pin[3]
+        ed = (UX[j] * (vx1 - z[4 * j + 2]) + UY[j] * (vy1 - z[4 * j + 3])) / h[j]
+        f = EA[j] * e
+        t = f + KV[j] * ed
+        if t > 0.0:
+            t = 0.0
+        diss += h[j] * (t - f) * ed
+        FX[j] += t * UX[j]
+        FY[j] += t * UY[j]
+        FX[j + 1] -= t * UX[j]
+        FY[j + 1] -= t * UY[j]
+    return diss
+
+
+@njit(cache=True, error_model="numpy")
+def compression_energy(N, h, EA, LN):
+    """``sum h_j EA_j e_j^2/2`` over the compressed links (``LN`` their lengths)."""
+    v = 0.0
+    for j in range(N):
+        e = LN[j] / h[j] - 1.0
+        if e < 0.0:
+            v += 0.5 * h[j] * EA[j] * e * e
+    return v
+
+
+@njit(cache=True, error_model="numpy")
 def bending_energy(N, z, pin, Bl, K0L, clamped, ex, ey, UX, UY, LN, OM):
     """``V_b`` of the state ``z`` (the clamp's link direction ``(ex, ey)`` when clamped)."""
     _geometry(N, z, pin, UX, UY, LN, OM)
@@ -174,10 +220,10 @@ def bending_energy(N, z, pin, Bl, K0L, clamped, ex, ey, UX, UY, LN, OM):
 
 @njit(cache=True, error_model="numpy")
 def add_body(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex, ey, phid,
-             UX, UY, LN, OM, MM, FX, FY, dz):
+             push, h, EA, KV, UX, UY, LN, OM, MM, FX, FY, dz):
     """Add the body's accelerations, held-end power and dissipation to the springs' ``dz``."""
     mn, diss, pd = body_forces(N, z, pin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex, ey, phid,
-                               UX, UY, LN, OM, MM, FX, FY)
+                               push, h, EA, KV, UX, UY, LN, OM, MM, FX, FY)
     for i in range(N):
         dz[4 * i + 2] += FX[i] * invm[i]
         dz[4 * i + 3] += FY[i] * invm[i]
@@ -187,7 +233,7 @@ def add_body(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, 
 
 @njit(cache=True, error_model="numpy")
 def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex, ey, phid,
-                UX, UY, LN, OM, MM, FX, FY, GX, GY, zz, B5):
+                push, h, EA, KV, UX, UY, LN, OM, MM, FX, FY, GX, GY, zz, B5):
     """Add the body's acceleration derivatives to the 5-block band ``B5[i, k]`` (node i's rows
     by node ``i - 2 + k``'s columns): central differences, the nodes perturbed together in
     colours mod 5 (a node's force reaches two nodes either side: the colours' rows never
@@ -202,7 +248,7 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
                     e = 1e-6 * hmin if comp < 2 else 1e-6 * (1.0 + abs(v))
                     zz[4 * i + comp] = v + sgn * e
                 body_forces(N, zz, pin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex, ey, phid,
-                            UX, UY, LN, OM, MM, FX, FY)
+                            push, h, EA, KV, UX, UY, LN, OM, MM, FX, FY)
                 if sgn > 0.0:
                     for k in range(N):
                         GX[k] = FX[k]
@@ -220,11 +266,22 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
                     B5[k, i - k + 2, 3, comp] += GY[k] * invm[k] / (2.0 * e)
 
 
+def body_inputs(line, method: str, inputs: dict) -> None:
+    """:func:`snapping.simulate.elastic_solve.solve`'s part for a body: refuse a method without
+    one (SnappingInputError), record ``compression`` (1 or 0) in ``inputs``."""
+    if line.body is None:
+        return
+    if method not in BODY_METHODS:
+        raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
+                                   f"not take the body's forces yet; use method='radau' (or 'dop853')")
+    inputs["compression"] = int(line.body.push)
+
+
 class LineBody:
     """A :class:`Body` on an :class:`ElasticLine`: its node arrays, the clamp's motion, and
     the rhs, Jacobian, measures and energy of the line with it."""
 
-    def __init__(self, line, body):
+    def __init__(self, line, body, compression=None):
         if isinstance(body.clamp, str):  # ("start": the direction the problem's start leaves the held end)
             body = body.resolved(line.problem.x, line.problem.y)
         self.line, self.body = line, body
@@ -245,6 +302,9 @@ class LineBody:
         self._scr = tuple(np.zeros(N + 1) for _ in range(9))
         self._zz = np.zeros(4 * N + 2)
         self.hmin = float(line.h.min())
+        #: a bending line's links push when shorter than their rest length (a rod: :func:`compression`)
+        #: (``compression``: True or False to choose; None: a body with bending pushes)
+        self.push = bool(body.has_bending) if compression is None else bool(compression)
 
     def clamp(self, t: float):
         """``(ex, ey, phi')``: the clamp's unit link direction (the held link pointing at the held
@@ -261,15 +321,19 @@ class LineBody:
 
     def _args(self, t):
         ex, ey, phid = self.clamp(t)
+        L = self.line
         return (self.Bl, self.K0L, self.El, self.CN, self.CT, self.KN, self.KT, self.cd, self.wx, self.wy,
-                self.clamped, ex, ey, phid)
+                self.clamped, ex, ey, phid, self.push, L.h, L.ea, L.damp)
 
-    def forces(self, t, z):
+    def forces(self, t, z, push: bool | None = None):
         """``(FX, FY, M_N, diss, p_drag)``: copies of the body's node forces (N + 1) and
-        :func:`body_forces`' returns."""
+        :func:`body_forces`' returns; ``push=False``: without the compressed links' push."""
         L = self.line
         s = self._scr
-        mn, diss, pd = body_forces(L.N, z, L.pin_state(t), *self._args(t), *s[:7])
+        a = self._args(t)
+        if push is not None:
+            a = a[:14] + (bool(push) and self.push,) + a[15:]
+        mn, diss, pd = body_forces(L.N, z, L.pin_state(t), *a, *s[:7])
         return s[5].copy(), s[6].copy(), mn, diss, pd
 
     def rhs(self, t, z, dz):
@@ -330,6 +394,8 @@ class LineBody:
         out[10] += FXN
         out[11] += FYN
         out[14] += self.bending_energy(t, z)
+        if self.push:  # (the geometry of z: bending_energy's)
+            out[14] += compression_energy(L.N, L.h, L.ea, self._scr[2])
         return out
 
 
@@ -343,7 +409,8 @@ def matched_body(line, *, tol: float = 1e-15, max_iter: int = 50):
     + g e_y`` (``a_N`` the held end's), ``l_j'' = (a_{j+1} - a_j).u_j + l_j theta_j'^2 = 0`` is a
     tridiagonal linear system for the tensions; the strains ``f^{-1}(T)`` change the lengths, so
     it is repeated until they stop changing. A link the rigid chain would compress (``T_j <= 0``:
-    a bending chain can push, a tension-only link cannot) is left at its rest length. Returns
+    a bending chain can push) is shortened by ``T_j/EA_j`` where the line's links push (a body
+    with bending: :func:`compression`), else left at its rest length (a tension-only link). Returns
     (state vector, tensions, passes)."""
     from scipy.linalg import solve_banded
 
@@ -374,13 +441,14 @@ def matched_body(line, *, tol: float = 1e-15, max_iter: int = 50):
     change = np.inf
     for it in range(1, max_iter + 1):
         z = lay(lengths)
-        FX, FY, _, _, _ = line.body.forces(0.0, z)
+        FX, FY, _, _, _ = line.body.forces(0.0, z, push=False)  # (the links' own forces are the T_j)
         Fu = FX[:N] * c + FY[:N] * s  # F_j . u_j
         Fnu = np.concatenate([FX[1:N] * c[:-1] + FY[1:N] * s[:-1], [0.0]])  # F_{j+1} . u_j
         b = -(Fnu * np.concatenate([invm[1:], [0.0]]) - Fu * invm + lengths * om * om)
         b[-1] -= pax * c[-1] + pay * s[-1] - line.g * s[-1]
         T = solve_banded((1, 1), ab, b)
-        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), 0.0)
+        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), np.minimum(T, 0.0) / line.ea if
+                     line.body.push else 0.0)
         new = line.h * (1.0 + e)
         change = float(np.abs(new - lengths).max())
         lengths = new

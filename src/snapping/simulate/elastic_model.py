@@ -206,7 +206,7 @@ class ElasticLine:
     link), ``g``, ``pin`` (the problem's :class:`PinMotion`).
     """
 
-    def __init__(self, problem, elastic: Elastic):
+    def __init__(self, problem, elastic: Elastic, *, compression: bool | None = None):
         from .problem import Problem
 
         if not isinstance(problem, Problem):
@@ -246,10 +246,23 @@ class ElasticLine:
         self._work = tuple(np.zeros(N) for _ in range(4))
         #: the problem's active :class:`Body` on this line (:class:`elastic_body.LineBody`), or None
         self.body = None
+        if compression is not None and not isinstance(compression, (bool, np.bool_)):
+            raise V.SnappingInputError(f"compression={compression!r} must be True, False or None (automatic)")
         if problem.body is not None and problem.body.active:
             from .elastic_body import LineBody
 
-            self.body = LineBody(self, problem.body)
+            self.body = LineBody(self, problem.body, compression)
+        elif compression:
+            raise V.SnappingInputError("compression=True needs a body with bending (problem.body): the line without "
+                                       "one is tension-only")
+
+    def solve_inputs(self, method: str, inputs: dict) -> None:
+        """With a body: refuse a method that has none, record ``compression``
+        (:func:`snapping.simulate.elastic_body.body_inputs`)."""
+        if self.body is not None:
+            from .elastic_body import body_inputs
+
+            body_inputs(self, method, inputs)
 
     @property
     def wave_speed(self) -> float:

@@ -58,7 +58,6 @@ from .elastic_dataset import STEP_NAMES, dataset as _dataset
 from .snap_edge import window_edge
 from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
-from .elastic_body import BODY_METHODS
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
 from .elastic_links_rodas import LinksStepper
@@ -309,7 +308,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
           snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None,
           progress: bool | None = False, checkpoint=None, checkpoint_every: float | None = None,
-          resume=None) -> ElasticRun:
+          resume=None, compression: bool | None = None) -> ElasticRun:
     """Integrate the elastic line of ``problem`` made of ``elastic`` links.
 
     Parameters
@@ -332,8 +331,6 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         same RODAS4 in link coordinates (:mod:`snapping.simulate.elastic_links_rodas`: each
         link's length and angle, steps not capped by the wave speed c; its error measured in
         node values, so tol means the same; its loop compiled as RODAS4's).
-        A problem with a body (bending, drag: :mod:`snapping.simulate.elastic_body`) takes
-        ``"radau"`` or ``"dop853"`` only.
     start : {"stretched", "unstretched", "matched"}
         See :mod:`snapping.simulate.elastic_model`: ``"stretched"`` the static equilibrium with
         both ends held, then released (its unloading wave rings); ``"matched"`` the start's
@@ -369,21 +366,21 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         others are refused by name, as is a file whose digest fails); the result equals the
         uninterrupted run's, bit for bit (``wall_time`` aside: it adds up the sessions).
         Further checkpoints go to ``checkpoint``, by default this file.
+    compression : bool, optional
+        A body's (:mod:`snapping.simulate.elastic_body`: methods radau, dop853): whether a link
+        shorter than its rest length pushes (a rod); None: when the body bends.
 
     Returns
     -------
     ElasticRun
     """
-    line = ElasticLine(problem, elastic)
+    line = ElasticLine(problem, elastic, compression=compression)
     tol = V.positive("tol", tol)
     if not 1e-13 <= tol <= 1e-2:
         raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in [1e-13, 1e-2]")
     if not isinstance(method, str) or method.lower() not in METHODS:
         raise V.SnappingInputError(f"method={method!r} is not one of {tuple(METHODS)} (the elastic line's methods)")
     method = method.lower()
-    if line.body is not None and method not in BODY_METHODS:
-        raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
-                                   f"not take the body's forces yet; use method='radau' (or 'dop853')")
     if t_end is not None:
         t_end = V.positive("t_end", t_end)
     t_end_max = V.positive("t_end_max", t_end_max)
@@ -414,6 +411,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
               "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
               "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
               "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
+    line.solve_inputs(method, inputs)  # (a body: its methods checked, "compression" recorded)
     with ECK.held(checkpoint, resume) if checkpoint is not None else contextlib.nullcontext():
         return _solve(line, problem, inputs, method=method, tol=tol, t_end=t_end, t_end_max=t_end_max,
                       stop_fraction=stop_fraction, start=start, initial=initial, snaps=snaps, max_rhs=max_rhs,
@@ -452,8 +450,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
     first_slack = np.nan
     i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
-    if line.body is not None:  # (the release's energy is the stretching's: the bending energy V_b is the shape's)
-        U0 -= line.body.bending_energy(0.0, z0)
+    U0 -= 0.0 if line.body is None else line.body.bending_energy(0.0, z0)  # (the release's: not V_b, the shape's)
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
     t_prev, z_prev = 0.0, z0.copy()
