@@ -182,6 +182,11 @@ def test_rhs_against_independent_forces(clamp):
     # energy (measure) against the energy written again
     mm = line.measure(t, z)
     assert abs(mm[12] + mm[13] + mm[14] - ref.g * np.sum(ref.m * line.snode) - ref.energy(t, X, Y, VX, VY)) < 1e-11
+    # slack: a compressed link pushes; only a link at or above its rest length can carry nothing
+    d, dv = np.diff(np.stack([X, Y], 1), axis=0), np.diff(np.stack([VX, VY], 1), axis=0)
+    ln = np.hypot(d[:, 0], d[:, 1])
+    e, ed = ln / line.h - 1.0, np.sum(d * dv, 1) / (ln * line.h)
+    assert mm[16] == np.count_nonzero((e >= 0.0) & (EA * e + KV * ed <= 0.0)) < np.count_nonzero(e <= 0.0)
 
 
 def test_jacobian_against_differences():

@@ -381,8 +381,10 @@ class LineBody:
 
     def measure(self, t, z):
         """The line's measures (:data:`elastic_kernels.MEASURE_NAMES`) with the body: the
-        accelerations of the full rhs, the bending energy in ``elastic_energy`` (index 14),
-        the body's force on the held end in ``pin_force_x, _y``."""
+        accelerations of the full rhs, the bending energy (and a pushing line's compression
+        energy) in ``elastic_energy`` (index 14), the body's force on the held end in
+        ``pin_force_x, _y``; a pushing line's ``n_slack`` counts the links at or above their rest
+        length that carry nothing (``sigma_max``/``sigma_min`` stay the springs' tensions, >= 0)."""
         L = self.line
         pin = L.pin_state(t)
         dz = np.empty_like(z)
@@ -396,6 +398,7 @@ class LineBody:
         out[14] += self.bending_energy(t, z)
         if self.push:  # (the geometry of z: bending_energy's)
             out[14] += compression_energy(L.N, L.h, L.ea, self._scr[2])
+            out[16] = float(np.count_nonzero((T == 0.0) & (E >= 0.0)))  # (a compressed link pushes: not slack)
         return out
 
 
