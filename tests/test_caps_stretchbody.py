@@ -69,7 +69,7 @@ def _fake_body_levels(monkeypatch, levels):
 def test_cap_takes_the_combined_factor_where_the_line_has_a_body(monkeypatch):
     calls = _fake_body_levels(monkeypatch, {50: {"v_peak": 0.997, "a_peak": 0.99, "sigma_peak": 1.268},
                                             100: {"v_peak": 0.9977, "a_peak": 0.93, "sigma_peak": 1.275}})
-    r = caps.cap("bungee-cord", 0.3, N=16, check=False, alone=False, graded=False)
+    r = caps.cap("bungee-cord", 0.3, N=16, check=False, graded=False)
     assert calls == [(50, ("bending", "drag")), (100, ("bending", "drag"))]
     s = r["stretching"]
     assert s["body"] is True and s["resolved"] == {"v_peak": True, "a_peak": False, "sigma_peak": True}
@@ -78,6 +78,8 @@ def test_cap_takes_the_combined_factor_where_the_line_has_a_body(monkeypatch):
     assert r["real"]["a_peak"] == r["full"]["a_peak"]
     assert "combined model's" in s["why"] and "50 and 100 uniform links" in s["why"]
     assert [x["N"] for x in r["runs"] if x["run"] == "stretching"] == [50, 100]
+    # the combined factor is stretching's with the body, not alone: no "stretching alone" to be the cap
+    assert set(r["alone"]) == {"bending", "drag"} and r["cap"] in ("bending", "drag")
 
 
 def test_a_line_without_a_body_keeps_the_elastic_over_rigid_factor(monkeypatch):

@@ -267,7 +267,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                          f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
                                       + "); " + stretch_words(sl, ok)
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
-            if alone:
+            if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
             stretching["why"] = (f"v_peak/c = {ratio:.3g} < {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
