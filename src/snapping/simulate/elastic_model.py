@@ -31,6 +31,13 @@ it is the inextensible chain's release). ``"stretched"`` is a physical sudden re
 hanging between two holds, one let go: its unloading wave rings along the line); ``"matched"``
 is the start to compare with the rigid chain.
 
+A problem's :class:`~snapping.simulate.body.Body` (bending stiffness and damping, natural
+curvature, drag, wind, a clamped held end) adds its node forces
+(:mod:`~snapping.simulate.elastic_body`; methods ``"radau"`` and ``"dop853"``): the
+``"stretched"`` start's statics then include the bending energy (its Newton iteration runs on
+the full forces), the ``"matched"`` start takes the rigid chain's tensions with the body's
+forces (:func:`~snapping.simulate.elastic_body.matched_body`).
+
 Example
 -------
 >>> from snapping.simulate.problem import Links, Problem
@@ -199,16 +206,13 @@ class ElasticLine:
     link), ``g``, ``pin`` (the problem's :class:`PinMotion`).
     """
 
-    def __init__(self, problem, elastic: Elastic):
+    def __init__(self, problem, elastic: Elastic, *, compression: bool | None = None):
         from .problem import Problem
 
         if not isinstance(problem, Problem):
             raise V.SnappingInputError(f"problem={type(problem).__name__} is not a snapping.simulate.Problem")
         if not isinstance(elastic, Elastic):
             raise V.SnappingInputError(f"elastic={type(elastic).__name__} is not a snapping.simulate.elastic.Elastic")
-        if problem.body is not None:
-            raise V.SnappingInputError("problem.body: bending and drag are not built for the elastic line yet; "
-                                       "give a problem without a body")
         self.problem, self.elastic = problem, elastic
         links = problem.links
         N = self.N = links.N
@@ -240,6 +244,25 @@ class ElasticLine:
             self.damp = self.damp + elastic.grid_damping * self.h * np.sqrt(self.ea * self.lam)
         self._invm = 1.0 / self.m
         self._work = tuple(np.zeros(N) for _ in range(4))
+        #: the problem's active :class:`Body` on this line (:class:`elastic_body.LineBody`), or None
+        self.body = None
+        if compression is not None and not isinstance(compression, (bool, np.bool_)):
+            raise V.SnappingInputError(f"compression={compression!r} must be True, False or None (automatic)")
+        if problem.body is not None and problem.body.active:
+            from .elastic_body import LineBody
+
+            self.body = LineBody(self, problem.body, compression)
+        elif compression:
+            raise V.SnappingInputError("compression=True needs a body with bending (problem.body): the line without "
+                                       "one is tension-only")
+
+    def solve_inputs(self, method: str, inputs: dict) -> None:
+        """With a body: refuse a method that has none, record ``compression``
+        (:func:`snapping.simulate.elastic_body.body_inputs`)."""
+        if self.body is not None:
+            from .elastic_body import body_inputs
+
+            body_inputs(self, method, inputs)
 
     @property
     def wave_speed(self) -> float:
@@ -277,6 +300,10 @@ class ElasticLine:
         if not isinstance(kind, str) or kind not in STARTS:
             raise V.SnappingInputError(f"start={kind!r} is not one of {STARTS}")
         if kind == "matched":
+            if self.body is not None:  # (the rigid chain's tensions with the body's forces)
+                from .elastic_body import matched_body
+
+                return matched_body(self)[0]
             from .elastic_statics import matched
 
             return matched(self)[0]
@@ -291,6 +318,8 @@ class ElasticLine:
     # -- the compiled model
     def rhs(self, t: float, z: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         dz = np.empty_like(z) if out is None else out
+        if self.body is not None:
+            return self.body.rhs(t, z, dz)
         EK.rhs(self.N, z, self.pin_state(t), self.h, self._invm, self.ea, self.damp, self.tabe, self.tabt, self.g,
                dz, *self._work)
         return dz
@@ -313,7 +342,10 @@ class ElasticLine:
         return self._pat
 
     def jac(self, t: float, z: np.ndarray) -> sp.csc_matrix:
-        """The Jacobian of :meth:`rhs` (analytic, banded: 7 sub- and super-diagonals), sparse."""
+        """The Jacobian of :meth:`rhs` (analytic, banded: 7 sub- and super-diagonals), sparse;
+        with a body, 15 (:meth:`elastic_body.LineBody.jac`)."""
+        if self.body is not None:
+            return self.body.jac(t, z)
         indices, indptr, order = self._pattern()
         B = self._blocks
         EK.jac_blocks(self.N, z, self.pin_state(t), self.h, self._invm, self.ea, self.damp, self.tabe, self.tabt,
@@ -322,6 +354,8 @@ class ElasticLine:
         return sp.csc_matrix((B.ravel()[order], indices, indptr), shape=(n, n))
 
     def measure(self, t: float, z: np.ndarray) -> np.ndarray:
+        if self.body is not None:
+            return self.body.measure(t, z)
         out = np.zeros(EK.NMEAS)
         EK.measure(self.N, z, self.pin_state(t), self.h, self.m, self.ea, self.damp, self.tabe, self.tabt,
                    self.tabw, self.g, self.snode, np.empty_like(z), *self._work, out)
@@ -334,7 +368,8 @@ class ElasticLine:
         return T, E, ED
 
     def energy(self, t: float, z: np.ndarray) -> float:
-        """Kinetic + gravity + elastic energy (zero hanging unstretched at rest from the origin)."""
+        """Kinetic + gravity + elastic energy (zero hanging unstretched at rest from the origin);
+        with a body the elastic energy includes the bending energy V_b."""
         mm = self.measure(t, z)
         return float(mm[12] + mm[13] + mm[14])
 

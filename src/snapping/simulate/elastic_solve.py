@@ -308,7 +308,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
           start: str = "stretched", initial=None, stop_fraction: float = 0.5, t_end_max: float = 10.0,
           snapshot_times=(), max_rhs: int = 50_000_000, stop_floor: float | None = None,
           progress: bool | None = False, checkpoint=None, checkpoint_every: float | None = None,
-          resume=None) -> ElasticRun:
+          resume=None, compression: bool | None = None) -> ElasticRun:
     """Integrate the elastic line of ``problem`` made of ``elastic`` links.
 
     Parameters
@@ -366,12 +366,15 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
         others are refused by name, as is a file whose digest fails); the result equals the
         uninterrupted run's, bit for bit (``wall_time`` aside: it adds up the sessions).
         Further checkpoints go to ``checkpoint``, by default this file.
+    compression : bool, optional
+        A body's (:mod:`snapping.simulate.elastic_body`: methods radau, dop853): whether a link
+        shorter than its rest length pushes (a rod); None: when the body bends.
 
     Returns
     -------
     ElasticRun
     """
-    line = ElasticLine(problem, elastic)
+    line = ElasticLine(problem, elastic, compression=compression)
     tol = V.positive("tol", tol)
     if not 1e-13 <= tol <= 1e-2:
         raise V.SnappingInputError(f"tol={tol!r} is out of range: must lie in [1e-13, 1e-2]")
@@ -408,6 +411,7 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
               "model": "elastic", "elastic": json.dumps(elastic.describe(), sort_keys=True),
               "problem": problem.describe_json(), "chi": np.nan if problem.chi is None else float(problem.chi),
               "tip_mass": float(problem.links.tip_mass), "gravity": line.g, "pin_motion": problem.pin.kind}
+    line.solve_inputs(method, inputs)  # (a body: its methods checked, "compression" recorded)
     with ECK.held(checkpoint, resume) if checkpoint is not None else contextlib.nullcontext():
         return _solve(line, problem, inputs, method=method, tol=tol, t_end=t_end, t_end_max=t_end_max,
                       stop_fraction=stop_fraction, start=start, initial=initial, snaps=snaps, max_rhs=max_rhs,
@@ -446,6 +450,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
     first_slack = np.nan
     i_en, i_w, i_d = (STEP_NAMES.index(k) for k in ("energy", "pin_work", "dissipated"))
     U0, m_min = float(rows[0][STEP_NAMES.index("elastic_energy")]), float(np.min(line.m))
+    U0 -= 0.0 if line.body is None else line.body.bending_energy(0.0, z0)  # (the release's: not V_b, the shape's)
     err, t_armed, floor = 0.0, np.nan, speed_floor(U0, m_min, stop_fraction) if stop_floor is None else stop_floor
     peak_state = (0.0, z0.copy())
     t_prev, z_prev = 0.0, z0.copy()
