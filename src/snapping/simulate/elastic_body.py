@@ -266,14 +266,28 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
                     B5[k, i - k + 2, 3, comp] += GY[k] * invm[k] / (2.0 * e)
 
 
-def body_inputs(line, method: str, inputs: dict) -> None:
-    """:func:`snapping.simulate.elastic_solve.solve`'s part for a body: refuse a method without
-    one (SnappingInputError), record ``compression`` (1 or 0) in ``inputs``."""
+def check_method(line, method: str, asked=()) -> None:
+    """With a body: refuse a method without one, and checkpoint options (``asked``: their
+    ``(name, value)`` pairs given), which only the compiled RODAS4 loops keep: SnappingInputError,
+    before any file is looked at."""
     if line.body is None:
         return
     if method not in BODY_METHODS:
         raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
                                    f"not take the body's forces yet; use method='radau' (or 'dop853')")
+    if asked:
+        k, v = asked[0]
+        raise V.SnappingInputError(f"{k}={v!r} with a body (bending, drag): only the methods 'rodas4' and "
+                                   f"'rodas4-links' keep checkpoints and they take no body; run the body's methods "
+                                   f"{BODY_METHODS} without checkpoint, resume and checkpoint_every")
+
+
+def body_inputs(line, method: str, inputs: dict) -> None:
+    """:func:`snapping.simulate.elastic_solve.solve`'s part for a body: refuse a method without
+    one (SnappingInputError), record ``compression`` (1 or 0) in ``inputs``."""
+    if line.body is None:
+        return
+    check_method(line, method)
     inputs["compression"] = int(line.body.push)
 
 
@@ -304,6 +318,10 @@ class LineBody:
         self.hmin = float(line.h.min())
         #: a bending line's links push when shorter than their rest length (a rod: :func:`compression`)
         #: (``compression``: True or False to choose; None: a body with bending pushes)
+        if compression and not body.has_bending:
+            raise V.SnappingInputError(f"compression={compression!r} with a body without bending (bending = damping = 0, "
+                                       f"no clamp): a line with drag only is tension-only; compression must be None or "
+                                       f"False here (True needs bending > 0)")
         self.push = bool(body.has_bending) if compression is None else bool(compression)
 
     def clamp(self, t: float):

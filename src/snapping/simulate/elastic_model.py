@@ -264,6 +264,14 @@ class ElasticLine:
 
             body_inputs(self, method, inputs)
 
+    def check_method(self, method: str, asked=()) -> None:
+        """With a body: refuse a method without one and checkpoint options
+        (:func:`snapping.simulate.elastic_body.check_method`)."""
+        if self.body is not None:
+            from .elastic_body import check_method
+
+            check_method(self, method, asked)
+
     @property
     def wave_speed(self) -> float:
         """The smallest longitudinal wave speed sqrt(EA_j/lambda_j) (initial slope for a table)."""

@@ -397,12 +397,12 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     asked = [(k, v) for k, v in (("checkpoint", checkpoint), ("resume", resume), ("checkpoint_every", checkpoint_every))
              if v is not None]
+    line.check_method(method, asked)  # (a body: its methods, and no checkpoint, before any file is looked at)
     if asked and (method not in ECK.METHODS or not COMPILED_LOOP):
         k, v = asked[0]
         raise V.SnappingInputError(f"{k}={str(v) if k != 'checkpoint_every' else v!r} with method={method!r}: only the "
                                    f"methods {ECK.METHODS} (compiled loop) keep checkpoints")
-    if checkpoint is None:
-        checkpoint = resume
+    checkpoint = resume if checkpoint is None else checkpoint
     if checkpoint_every is not None and checkpoint is None:
         raise V.SnappingInputError(f"checkpoint_every={checkpoint_every!r} needs a checkpoint file (checkpoint=PATH)")
     checkpoint, resume = ECK.check_paths(checkpoint, resume)
