@@ -104,3 +104,15 @@ def test_graded_links_arrays_and_planar_wind():
         solve(_p(Body(1e-3, wind=(0.1, 0.0, 0.2))), EL, t_end=0.01)
     with pytest.raises(SnappingInputError, match=r"clamp=1.0 needs bending stiffness"):
         Body(0.0, drag_normal=1.0, clamp=1.0)
+
+
+def test_other_entry_points_point_to_solve():
+    """The studies and sweeps still refuse a body with the extensible line; their refusals say
+    where it is built (``snapping.simulate.elastic.solve``), not that it is not built at all."""
+    from snapping.continuum import converge
+    from snapping.sweep_grid import Grid
+
+    with pytest.raises(SnappingInputError, match=r"convergence studies yet.*elastic\.solve takes a Body"):
+        converge(0.3, levels=2, n0=4, tol=1e-4, body={"bending": 1e-3}, elastic={"ea": 900.0})
+    with pytest.raises(SnappingInputError, match=r"in the sweeps yet.*elastic\.solve takes a Body"):
+        Grid(chi=[0.3], N=[8], options={"elastic": {"ea": 900.0}, "body": {"bending": 1e-3}})
