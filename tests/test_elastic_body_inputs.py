@@ -116,3 +116,23 @@ def test_other_entry_points_point_to_solve():
         converge(0.3, levels=2, n0=4, tol=1e-4, body={"bending": 1e-3}, elastic={"ea": 900.0})
     with pytest.raises(SnappingInputError, match=r"in the sweeps yet.*elastic\.solve takes a Body"):
         Grid(chi=[0.3], N=[8], options={"elastic": {"ea": 900.0}, "body": {"bending": 1e-3}})
+
+
+@pytest.mark.parametrize("body", [None, Body(1e-3, drag_normal=0.5)])
+@pytest.mark.parametrize("j", [0, 3, 5])
+def test_initial_with_a_zero_length_link(body, j):
+    """An ``initial`` state whose link j has (next to) no length: refused naming the link, not a
+    ZeroDivisionError from the compiled Jacobian (plain line and body alike)."""
+    p = _p(body)
+    x, y = p.x.copy(), p.y.copy()
+    if j < p.N - 1:
+        x[j], y[j] = x[j + 1], y[j + 1]
+    else:  # (the held link: node N - 1 onto the held end)
+        x[j] = x[j + 1] + 1e-12
+        y[j] = y[j + 1]
+    v = np.zeros(p.N + 1)
+    with pytest.raises(SnappingInputError, match=rf"initial x, y: link {j} has length .*longer than 1e-09 of its rest"):
+        solve(p, EL, t_end=0.01, initial=(x, y, v, v))
+    x[j] = x[j + 1] + 1e-6 * p.links.h[j]  # (short but not degenerate: runs)
+    y[j] = y[j + 1]
+    assert np.isfinite(solve(p, EL, t_end=1e-3, tol=1e-4, initial=(x, y, v, v)).dataset.attrs["v_peak"])

@@ -237,9 +237,16 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
     """Add the body's acceleration derivatives to the 5-block band ``B5[i, k]`` (node i's rows
     by node ``i - 2 + k``'s columns): central differences, the nodes perturbed together in
     colours mod 5 (a node's force reaches two nodes either side: the colours' rows never
-    overlap). Steps: ``1e-6 hmin`` in position, ``1e-6 (1 + |v|)`` in velocity."""
+    overlap). Steps: ``1e-6 hmin`` in position (``2e-6`` of the shortest link where a link is
+    shorter than ``hmin/2``: a step as long as the link would turn it over), ``1e-6 (1 + |v|)``
+    in velocity."""
     for i in range(z.size):
         zz[i] = z[i]
+    _geometry(N, z, pin, UX, UY, LN, OM)
+    lmin = LN[0]
+    for j in range(1, N):
+        lmin = min(lmin, LN[j])
+    hmin = min(hmin, 2.0 * lmin)
     for col in range(5):
         for comp in range(4):
             for sgn in (1.0, -1.0):
