@@ -136,3 +136,18 @@ def test_initial_with_a_zero_length_link(body, j):
     x[j] = x[j + 1] + 1e-6 * p.links.h[j]  # (short but not degenerate: runs)
     y[j] = y[j + 1]
     assert np.isfinite(solve(p, EL, t_end=1e-3, tol=1e-4, initial=(x, y, v, v)).dataset.attrs["v_peak"])
+
+
+@pytest.mark.parametrize("body", [None, Body(1e-3, drag_normal=0.5)])
+def test_stretched_start_of_a_moving_problem(body):
+    """A moving start (a rigid rotation about the held end) has no static equilibrium to start
+    from: refused naming the start, its speed and the starts that take it; 'matched' runs."""
+    p0 = _p(None)
+    w = 0.5  # (the rotation's rate: speeds w r, the largest at the free end)
+    vx, vy = -w * p0.y, w * p0.x
+    p = Problem.nodes(p0.x, p0.y, vx=vx, vy=vy, links=p0.links, body=body)
+    r0 = float(np.hypot(p0.x, p0.y).max())
+    with pytest.raises(SnappingInputError, match=rf"start='stretched' needs a start at rest.*speed up to "
+                                                 rf"{w * r0:.6g}\).*'matched'.*'unstretched'"):
+        solve(p, EL, t_end=0.01, start="stretched")
+    assert solve(p, EL, t_end=0.01, tol=1e-5, start="matched").dataset.attrs["status"] == "completed"

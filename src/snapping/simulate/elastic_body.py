@@ -60,7 +60,7 @@ from numba import njit
 from .. import _validate as V
 from . import elastic_kernels as EK
 
-__all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "BODY_METHODS"]
+__all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "check_method", "BODY_METHODS"]
 
 #: the elastic line's methods that take a body
 BODY_METHODS = ("radau", "dop853")
