@@ -332,6 +332,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         from .sweep_elastic import description
 
         elastic_d = description(elastic, "elastic")
+        if body_d is not None:  # (checked before: the body was dropped silently)
+            raise V.SnappingInputError("body: bending and drag are not built for the extensible line (elastic) in the "
+                                       "convergence studies yet (snapping.simulate.elastic.solve takes a Body)")
         from .simulate.elastic import STARTS
 
         elastic_start = "stretched" if elastic_start is None else elastic_start
@@ -339,8 +342,6 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
             raise V.SnappingInputError(f"elastic_start={elastic_start!r} is not one of {STARTS}")
     elif elastic_start is not None:
         raise V.SnappingInputError(f"elastic_start={elastic_start!r} is the extensible line's start: give elastic too")
-        if body_d is not None:
-            raise V.SnappingInputError("body: bending and drag are not built for the extensible line (elastic) yet")
     if body_d is not None or elastic_d is not None:
         params = _uniform_levels(levels, ratio, n0, first)
     else:

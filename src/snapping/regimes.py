@@ -63,6 +63,7 @@ import xarray as xr
 
 from . import _validate as V
 from .continuum import QUANTITIES, _uniform_levels, level_parameters
+from .regimes_files import BUNDLED, bundled_study, load_study  # noqa: F401 (re-exported: the public names)
 from .regimes_spec import (ACCURACY, BEND_PEAKS_KEY, CHAIN_COST_PARTS, CHAIN_EXTRA_PEAKS, BEND_SNAP_PEAKS, MECHANISMS, NUMBER_MAX, STRETCH_DAMPING, STRETCH_MAX_RHS, STRETCH_METHOD,
                            STRETCH_EXTRA_PEAKS, STRETCH_MAX_RHS_LINKS, STRETCH_METHODS, STRETCH_PEAK_ATTRS, STRETCH_PEAKS_KEY, STRETCH_START, STRETCH_STOP_FLOOR, STRETCH_TIP_TIME,
                            STRETCH_TOL_C, stretch_tip_floor, stretch_tol)
@@ -234,45 +235,6 @@ def _numbers(numbers) -> list[float]:
 def _study_key(mechanism, chis, numbers, acc, ratio) -> str:
     return json.dumps({"mechanism": mechanism, "chi": chis, "number": numbers, "ratio": ratio, **acc},
                       sort_keys=True)
-
-
-def load_study(path) -> xr.Dataset:
-    """A regime study's file (:func:`regimes`), loaded into memory."""
-    p = V.file_path("path", path)
-    if not os.path.isfile(p):
-        raise V.SnappingInputError(f"path={p!r} does not exist")
-    try:
-        with xr.open_dataset(p) as ds:
-            ds = ds.load()
-    except (OSError, ValueError) as exc:
-        raise V.SnappingInputError(f"path={p!r} is not a readable netCDF file ({exc})") from None
-    if "regimes_study" not in ds.attrs:
-        raise V.SnappingInputError(f"path={p!r} is not a regime study (snapping regimes)")
-    return ds
-
-
-#: the studies shipped with the package (``snapping/data/regimes/<mechanism>.nc``, made by
-#: ``benchmarks/bench_regimes.py --study``): 4 chi x 8 numbers each
-BUNDLED = ("bending", "drag", "end-mass", "stretching")
-
-
-def bundled_study(mechanism: str) -> xr.Dataset:
-    """The regime study of ``mechanism`` shipped with the package (see the guide page
-    "What caps the snap" for how it was computed: its attributes say the levels, tolerance
-    and grid damping), loaded into memory.
-
-    >>> ds = bundled_study("end-mass")  # doctest: +SKIP
-    >>> ds.v_peak_ratio.sel(chi=0.2)  # doctest: +SKIP
-    """
-    from importlib import resources
-
-    if not isinstance(mechanism, str) or mechanism not in BUNDLED:
-        raise V.SnappingInputError(f"mechanism={mechanism!r} is not one of the shipped studies {BUNDLED}")
-    path = resources.files("snapping") / "data" / "regimes" / f"{mechanism}.nc"
-    if not path.is_file():
-        raise V.SnappingInputError(f"the {mechanism} study is not shipped in this installation ({path})")
-    with resources.as_file(path) as p:
-        return load_study(str(p))
 
 
 def _extra(mechanism) -> tuple:

@@ -70,7 +70,8 @@ class Grid:
 
             if "body" in self.options:
                 raise V.SnappingInputError("options: a body (bending, drag) is not built for the extensible line "
-                                           "(elastic) yet; give one of them")
+                                           "(elastic) in the sweeps yet; give one of them (snapping.simulate."
+                                           "elastic.solve takes a Body)")
             self.options = {**self.options, "elastic": sweep_elastic.description(self.options["elastic"])}
             for chi in self.chi:
                 for N in self.N:

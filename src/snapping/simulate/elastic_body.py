@@ -60,7 +60,7 @@ from numba import njit
 from .. import _validate as V
 from . import elastic_kernels as EK
 
-__all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "BODY_METHODS"]
+__all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "check_method", "BODY_METHODS"]
 
 #: the elastic line's methods that take a body
 BODY_METHODS = ("radau", "dop853")
@@ -237,9 +237,16 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
     """Add the body's acceleration derivatives to the 5-block band ``B5[i, k]`` (node i's rows
     by node ``i - 2 + k``'s columns): central differences, the nodes perturbed together in
     colours mod 5 (a node's force reaches two nodes either side: the colours' rows never
-    overlap). Steps: ``1e-6 hmin`` in position, ``1e-6 (1 + |v|)`` in velocity."""
+    overlap). Steps: ``1e-6 hmin`` in position (``2e-6`` of the shortest link where a link is
+    shorter than ``hmin/2``: a step as long as the link would turn it over), ``1e-6 (1 + |v|)``
+    in velocity."""
     for i in range(z.size):
         zz[i] = z[i]
+    _geometry(N, z, pin, UX, UY, LN, OM)
+    lmin = LN[0]
+    for j in range(1, N):
+        lmin = min(lmin, LN[j])
+    hmin = min(hmin, 2.0 * lmin)
     for col in range(5):
         for comp in range(4):
             for sgn in (1.0, -1.0):
@@ -266,14 +273,28 @@ def body_jac_fd(N, z, pin, invm, hmin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, 
                     B5[k, i - k + 2, 3, comp] += GY[k] * invm[k] / (2.0 * e)
 
 
-def body_inputs(line, method: str, inputs: dict) -> None:
-    """:func:`snapping.simulate.elastic_solve.solve`'s part for a body: refuse a method without
-    one (SnappingInputError), record ``compression`` (1 or 0) in ``inputs``."""
+def check_method(line, method: str, asked=()) -> None:
+    """With a body: refuse a method without one, and checkpoint options (``asked``: their
+    ``(name, value)`` pairs given), which only the compiled RODAS4 loops keep: SnappingInputError,
+    before any file is looked at."""
     if line.body is None:
         return
     if method not in BODY_METHODS:
         raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
                                    f"not take the body's forces yet; use method='radau' (or 'dop853')")
+    if asked:
+        k, v = asked[0]
+        raise V.SnappingInputError(f"{k}={v!r} with a body (bending, drag): only the methods 'rodas4' and "
+                                   f"'rodas4-links' keep checkpoints and they take no body; run the body's methods "
+                                   f"{BODY_METHODS} without checkpoint, resume and checkpoint_every")
+
+
+def body_inputs(line, method: str, inputs: dict) -> None:
+    """:func:`snapping.simulate.elastic_solve.solve`'s part for a body: refuse a method without
+    one (SnappingInputError), record ``compression`` (1 or 0) in ``inputs``."""
+    if line.body is None:
+        return
+    check_method(line, method)
     inputs["compression"] = int(line.body.push)
 
 
@@ -304,6 +325,10 @@ class LineBody:
         self.hmin = float(line.h.min())
         #: a bending line's links push when shorter than their rest length (a rod: :func:`compression`)
         #: (``compression``: True or False to choose; None: a body with bending pushes)
+        if compression and not body.has_bending:
+            raise V.SnappingInputError(f"compression={compression!r} with a body without bending (bending = damping = 0, "
+                                       f"no clamp): a line with drag only is tension-only; compression must be None or "
+                                       f"False here (True needs bending > 0)")
         self.push = bool(body.has_bending) if compression is None else bool(compression)
 
     def clamp(self, t: float):

@@ -28,7 +28,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ringing_tension", "slack_share", "peak_guard", "RING_MATCHED", "RING_RELEASE", "SLACK_MAX",
+from .. import _validate as V
+
+#: the shortest link an ``initial`` state may have, relative to its rest length
+MIN_LINK = 1e-9
+
+__all__ = ["ringing_tension", "slack_share", "peak_guard", "initial_state", "MIN_LINK", "RING_MATCHED", "RING_RELEASE", "SLACK_MAX",
            "ENERGY_FLAG", "T_CUT", "MIN_WINDOWS"]
 
 #: the rules look at t <= T_CUT * t_snap_sigma (the fall, before the snap's own rise)
@@ -123,3 +128,33 @@ def peak_guard(t, rec: dict, *, wave_speed: float, length: float, start: str, t_
     if np.isfinite(energy_drift) and energy_drift > ENERGY_FLAG * energy_scale:
         notes.append(f"energy: drift {energy_drift:.3g} above {ENERGY_FLAG:g} of the energy scale {energy_scale:.3g}")
     return ring, not notes, "; ".join(notes)
+
+
+def initial_state(line, start: str, initial):
+    """:func:`snapping.simulate.elastic_solve.solve`'s state at t = 0: ``line.start(start)``, or the
+    given node values ``initial = (x, y, vx, vy)`` checked (N + 1 finite values each, the held end's
+    last; every link longer than ``MIN_LINK`` of its rest length: a link of zero length has no
+    direction, its springs' and body's forces none)."""
+    if initial is None:
+        return line.start(start)
+    try:
+        x, y, vx, vy = (np.asarray(V.float_array(n, a), dtype=float).ravel() for n, a in
+                        zip(("x", "y", "vx", "vy"), initial))
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, V.SnappingInputError):
+            raise
+        raise V.SnappingInputError("initial must be (x, y, vx, vy), N + 1 node values each") from None
+    N = line.N
+    p = line.pin_state(0.0)
+    for name, a, pv in zip(("x", "y", "vx", "vy"), (x, y, vx, vy), p):
+        if a.size != N + 1 or not np.all(np.isfinite(a)):
+            raise V.SnappingInputError(f"initial {name}: expected {N + 1} finite node values; got {a.size}")
+        if a[-1] != pv:
+            raise V.SnappingInputError(f"initial {name}[N]={a[-1]!r} must be the held end's, {pv!r}, at t = 0")
+    ln = np.hypot(np.diff(x), np.diff(y))
+    short = np.flatnonzero(~(ln > MIN_LINK * line.h))
+    if short.size:
+        j = int(short[0])
+        raise V.SnappingInputError(f"initial x, y: link {j} has length {ln[j]:.6g}; every link must be longer than "
+                                   f"{MIN_LINK:g} of its rest length ({line.h[j]:.6g}): nodes {j} and {j + 1} coincide")
+    return line.pack(x, y, vx, vy)

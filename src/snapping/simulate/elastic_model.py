@@ -264,6 +264,14 @@ class ElasticLine:
 
             body_inputs(self, method, inputs)
 
+    def check_method(self, method: str, asked=()) -> None:
+        """With a body: refuse a method without one and checkpoint options
+        (:func:`snapping.simulate.elastic_body.check_method`)."""
+        if self.body is not None:
+            from .elastic_body import check_method
+
+            check_method(self, method, asked)
+
     @property
     def wave_speed(self) -> float:
         """The smallest longitudinal wave speed sqrt(EA_j/lambda_j) (initial slope for a table)."""
@@ -311,7 +319,10 @@ class ElasticLine:
         z = self.pack(p.x, p.y, p.vx, p.vy)
         if kind == "stretched":
             if np.any(p.vx != p.vx[-1]) or np.any(p.vy != p.vy[-1]) or p.vx[-1] != 0.0 or p.vy[-1] != 0.0:
-                raise V.SnappingInputError("start='stretched' needs a start at rest (use start='unstretched')")
+                sp = float(np.hypot(p.vx, p.vy).max())
+                raise V.SnappingInputError(f"start='stretched' needs a start at rest; the problem's nodes move (speed up "
+                                           f"to {sp:.6g}): use start='matched' (the rigid chain's tensions with these "
+                                           f"velocities) or 'unstretched'")
             z = self.statics(z, hold_free_end=True)
         return z
 

@@ -210,26 +210,6 @@ def speed_floor(elastic_energy: float, m_min: float, stop_fraction: float) -> fl
     return 2.0 * np.sqrt(2.0 * elastic_energy / m_min) / (1.0 - stop_fraction)
 
 
-def _initial(line, start, initial):
-    if initial is None:
-        return line.start(start)
-    try:
-        x, y, vx, vy = (np.asarray(V.float_array(n, a), dtype=float).ravel() for n, a in
-                        zip(("x", "y", "vx", "vy"), initial))
-    except (TypeError, ValueError) as exc:
-        if isinstance(exc, V.SnappingInputError):
-            raise
-        raise V.SnappingInputError("initial must be (x, y, vx, vy), N + 1 node values each") from None
-    N = line.N
-    p = line.pin_state(0.0)
-    for name, a, pv in zip(("x", "y", "vx", "vy"), (x, y, vx, vy), p):
-        if a.size != N + 1 or not np.all(np.isfinite(a)):
-            raise V.SnappingInputError(f"initial {name}: expected {N + 1} finite node values; got {a.size}")
-        if a[-1] != pv:
-            raise V.SnappingInputError(f"initial {name}[N]={a[-1]!r} must be the held end's, {pv!r}, at t = 0")
-    return line.pack(x, y, vx, vy)
-
-
 _ENERGY_MSG = (f"energy error above {ENERGY_ERROR_FAIL:g} of the line's energy (the steps do not resolve the "
                "motion: tighten tol)")
 
@@ -397,12 +377,12 @@ def solve(problem, elastic: Elastic, *, t_end: float | None = None, tol: float =
     checkpoint_every = check_checkpoint_every(checkpoint_every)
     asked = [(k, v) for k, v in (("checkpoint", checkpoint), ("resume", resume), ("checkpoint_every", checkpoint_every))
              if v is not None]
+    line.check_method(method, asked)  # (a body: its methods, and no checkpoint, before any file is looked at)
     if asked and (method not in ECK.METHODS or not COMPILED_LOOP):
         k, v = asked[0]
         raise V.SnappingInputError(f"{k}={str(v) if k != 'checkpoint_every' else v!r} with method={method!r}: only the "
                                    f"methods {ECK.METHODS} (compiled loop) keep checkpoints")
-    if checkpoint is None:
-        checkpoint = resume
+    checkpoint = resume if checkpoint is None else checkpoint
     if checkpoint_every is not None and checkpoint is None:
         raise V.SnappingInputError(f"checkpoint_every={checkpoint_every!r} needs a checkpoint file (checkpoint=PATH)")
     checkpoint, resume = ECK.check_paths(checkpoint, resume)
@@ -423,7 +403,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
            stop_floor, progress, checkpoint, checkpoint_every, resume):
     """:func:`solve` once its inputs are checked (and its checkpoint files locked)."""
     wall0, wall_before = time.perf_counter(), 0.0
-    z0 = _initial(line, start, initial)
+    z0 = EC.initial_state(line, start, initial)
     t_bound = t_end if t_end is not None else t_end_max
     count = [0]
 
