@@ -89,7 +89,7 @@ from .caps_inputs import check_chis as _check_chis
 from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIFF_RATIO,  # noqa: F401
                         STIFF_TOL, STRETCH_LEVELS, STRETCH_METHOD, STRETCH_N, STRETCH_START, Runs, accept_factors,
                         bending_length, graded_h, graded_levels, grading_rule, method_for, problem, richardson,
-                        stretch_factor)
+                        stretch_factor, body_stretch_words)
 from .caps_runs import grading_for as _grading
 
 __all__ = ["LineSpec", "spec", "cap", "design", "decide", "auto_hopeless", "auto_graded", "AUTO_GRADED_LINKS", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
@@ -249,20 +249,25 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         stretching.update({"wave_speed": c * math.sqrt(sp.g * sp.length), "v_over_c": ratio,
                            "v_over_c_ideal": ideal_nd["v_peak"] / c})
         if ratio >= STRETCH_MATTERS:
-            sl = [stretch_factor(sp, chi, runs.tol, n, method=runs.stretch_method) for n in STRETCH_LEVELS]
+            body = "bending" in present or "drag" in present  # the combined model's factor (stretchbody)
+            sl = runs.stretching_body(present) if body else [stretch_factor(sp, chi, runs.tol, n, method=runs.stretch_method)
+                                                             for n in STRETCH_LEVELS]
             for f in sl:
-                runs.log.append({"run": "stretching", "N": f["N"], "method": f"elastic {runs.stretch_method}",
+                runs.log.append({"run": "stretching", "N": f["N"], "method": f.get("method", "elastic " + runs.stretch_method),
                                  "tol": runs.tol, "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
             factor_s, ok = accept_factors(*({q: f[q] for q in QUANTITIES} for f in sl), RESOLVED)
-            stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"],
+            stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"], "body": body,
+                               "model": "combined (elastic + body) over inextensible" if body else "elastic over rigid",
                                "levels": [{"N": f["N"], **{q: f[q] for q in QUANTITIES}, "s_sigma": f["s_sigma"],
                                            "t_sigma": f["t_sigma"], "t_snap": f["t_snap"]} for f in sl],
                                "strain_peak": sl[1]["strain_peak"],
                                "why": f"v_peak/c = {ratio:.3g} >= {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
-                                      f"{stretching['v_over_c_ideal']:.3g}): run (elastic over rigid on "
-                                      f"{sl[0]['N']} and {sl[1]['N']} links); " + stretch_words(sl, ok)
-                                      + ("" if all(ok.values()) else unresolved_stretching_words(ratio))})
-            if alone:
+                                      f"{stretching['v_over_c_ideal']:.3g}): run ("
+                                      + (body_stretch_words(sp, sl, ok) if body else
+                                         f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
+                                      + "); " + stretch_words(sl, ok)
+                                      + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
+            if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
             stretching["why"] = (f"v_peak/c = {ratio:.3g} < {STRETCH_MATTERS:g} (the full run's; the ideal chain's "
@@ -313,7 +318,7 @@ def stretch_words(levels: list, resolved: dict) -> str:
     return "; ".join(words)
 
 
-def unresolved_stretching_words(v_over_c: float) -> str:
+def unresolved_stretching_words(v_over_c: float, body: bool = False) -> str:
     """What leaving an unresolved stretching factor out means, said beside it: the answer's error bars
     are the inextensible runs' and do not hold stretching, whose effect at the speed the line reaches
     (``v_over_c``) the elastic guide measured (peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2).
@@ -321,8 +326,9 @@ def unresolved_stretching_words(v_over_c: float) -> str:
     whose snap and v/c grow with the links (the bungee cord at chi 0.25, tension ratio 0.913, 0.715,
     0.654, 0.638 on 30-240 links)."""
     return (f" (so the error bars above do not hold stretching: at v/c = {v_over_c:.2g} it is not negligible -- the "
-            f"elastic guide measured peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2; the factor is the ideal "
-            f"chain's, whose v/c grows with its links, not this line's)")
+            f"elastic guide measured peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2; "
+            + ("the combined model's fold, like the inextensible one's, is not resolved on uniform links)" if body else
+               "the factor is the ideal chain's, whose v/c grows with its links, not this line's)"))
 
 
 def decide(factor: float, real: float, alone: dict, acts: bool = True, tried: bool = True) -> str:
@@ -565,7 +571,8 @@ def format_design(d: dict) -> list[str]:
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:
-        out.append(f"  stretching factor NOT applied (not resolved from {STRETCH_LEVELS[0]} to {STRETCH_LEVELS[1]} "
+        lv = sorted({tuple(x["N"] for x in r["stretching"]["levels"]) for r in d["rows"] if r.get("stretching", {}).get("run")})
+        out.append(f"  stretching factor NOT applied (not resolved from {' or '.join(f'{a} to {b}' for a, b in lv)} "
                    f"links) at chi: {'; '.join(st)}")
     ok = d["admissible_chi"]
     out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")

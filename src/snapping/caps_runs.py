@@ -23,7 +23,8 @@ import time
 import numpy as np
 
 __all__ = ["problem", "method_for", "Runs", "stretch_factor", "GRID_DAMPING", "STIFF_TOL", "STIFF_RATIO",
-           "STRETCH_N", "STRETCH_LEVELS", "STRETCH_START", "STRETCH_METHOD", "accept_factors", "QUANTITIES",
+           "STRETCH_N", "STRETCH_LEVELS", "STRETCH_START", "STRETCH_METHOD", "accept_factors",
+           "stretch_factor_body", "STRETCH_BODY_LEVELS", "STRETCH_BODY_METHOD", "STRETCH_BODY_TOL", "body_stretch_words", "QUANTITIES",
            "MECHANISMS", "bending_length", "graded_h", "richardson", "GRADED_TOL",
            "GRADED_DAMPING", "GRADED_ORDER", "GRADE_LINKS", "COLLAPSE", "MAX_GRADED_LINKS", "grading_rule",
            "MAX_ESCALATED_LINKS", "FOLD_FRAC", "grading_for", "graded_levels", "observed_order", "GRADED_WITHIN"]
@@ -38,6 +39,15 @@ STRETCH_START = "matched"
 #: the elastic line's method in the stretching runs: the compiled RODAS4 (exact banded Jacobian); at tol 1e-6
 #: its peaks are within 1e-5 of DOP853's on the nylon line's 30 and 60 links, at 0.13-0.56 s of CPU against 0.66-1.12
 STRETCH_METHOD = "rodas4"
+#: the stretching factor's two levels for a line with a body (bending or drag; :func:`stretch_factor_body`):
+#: uniform links, shared lumping. 50/100: the bungee cord's factors at chi 0.25 agree within 1% there
+#: (sigma 1.268 / 1.275 / 1.279 on 50 / 100 / 200; the combined runs 1.2 / 1.5 / 2.8 s of CPU)
+STRETCH_BODY_LEVELS = (50, 100)
+#: the combined model's method (the elastic line with a body: RODAS4's compiled steppers have no body forces)
+STRETCH_BODY_METHOD = "radau"
+#: ... at this tolerance: against 1e-6 its factors move by at most 3e-5 relative (the climbing rope at chi 0.15, the
+#: bungee cord at 0.25, 50 and 100 links) at 55-90% of the CPU (1e-4 moved the bungee's a_peak factor 0.6%)
+STRETCH_BODY_TOL = 1e-5
 #: RODAS4's tolerance in the runs it takes (:func:`method_for`)
 STIFF_TOL = 1e-4
 #: a run is stiff when DOP853's stability limit needs more than this many times its accuracy-limited steps
@@ -343,6 +353,59 @@ def stretch_factor(sp, chi: float, tol: float = 1e-6, N: int = STRETCH_N, start:
             "t_snap": float(rigid["t_snap_sigma"])}
 
 
+def stretch_factor_body(sp, chi: float, N: int, on, tol: float = 1e-6, stiff_tol: float = None,
+                        damping: float = GRID_DAMPING, start: str = STRETCH_START,
+                        combined_tol: float = STRETCH_BODY_TOL) -> dict:
+    """One level of the stretching factor of a line with a body (bending or drag): the combined model
+    (the elastic line, ``Elastic(ea=EA/(m g), grid_damping=1)``, carrying the line's body -- bending,
+    drag, tip drag, and its taper and end mass in the links -- :data:`STRETCH_BODY_METHOD` at ``combined_tol``,
+    start ``start``) over the inextensible full run on the same problem (:func:`problem` with the
+    mechanisms ``on``, ``N`` uniform links, ``lumping="shared"``; the method :func:`snapping.caps.cap`
+    takes for it at ``tol``, :func:`method_for`, with its grid damping of ratio ``damping`` on the fast waves, which
+    the combined run then carries too), peak by peak. Besides the ratios (``v_peak``, ``a_peak``,
+    ``sigma_peak``): ``s_sigma``/``t_sigma`` (where and when the combined run's tension peaks),
+    ``t_snap`` (the inextensible run's), ``strain_peak``, ``N``, ``n_rhs``, ``wall``, ``cpu``."""
+    from .simulate import run
+    from .simulate.elastic import Elastic, solve
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    on = tuple(on)
+    p = problem(sp, chi, N, on, lumping="shared")
+    method, itol, omega_min = ("fast", tol, 0.0) if damping <= 0.0 else method_for(p, tol, stiff_tol)
+    if method == "rodas4":
+        p = problem(sp, chi, N, on, lumping="shared", damping=damping, omega_min=omega_min)
+    inext = run(p, method=method, tol=itol, progress=False).dataset.attrs
+    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=combined_tol,
+               method=STRETCH_BODY_METHOD, start=start).dataset.attrs
+    for what, a in (("inextensible", inext), ("combined", el)):
+        if a.get("status") != "completed":
+            raise RuntimeError(f"the {what} run of the stretching factor did not complete ({a.get('stop_reason', '')})")
+    return {**{q: float(el[q]) / float(inext[q]) for q in QUANTITIES}, "N": int(N),
+            "n_rhs": int(el["n_rhs"]) + int(inext["n_rhs"]), "wall": time.perf_counter() - t0,
+            "cpu": time.process_time() - c0, "strain_peak": float(el["strain_peak"]),
+            "s_sigma": float(el["s_sigma_peak"]), "t_sigma": float(el["t_snap_sigma"]),
+            "t_snap": float(inext["t_snap_sigma"]), "method": f"combined {STRETCH_BODY_METHOD} / {method} {itol:g}"}
+
+
+def body_stretch_words(sp, levels: list, resolved: dict) -> str:
+    """What the stretching factor of a line with a body is (:func:`stretch_factor_body`'s ``levels``), and,
+    where a peak's is not resolved, why: the fold is held by bending at the bending length
+    (:func:`bending_length`), and where that is under a link of the finer level the uniform links cannot
+    hold it -- the fold collapses onto them, with stretching as without (the climbing rope)."""
+    n0, n1 = levels[0]["N"], levels[-1]["N"]
+    words = (f"the factor is the combined model's (the elastic line with the line's bending and drag, "
+             f"{STRETCH_BODY_METHOD}) over the inextensible full run, on {n0} and {n1} uniform links")
+    if all(resolved.values()):
+        return words + ": resolved"
+    lb = bending_length(sp)
+    if 0.0 < lb * n1 < 1.0:
+        why = (f"the bending length ({lb:.3g} L) is {lb * n1:.2g} links on {n1}: the fold is below the uniform "
+               f"links and collapses onto them, with stretching as without (graded links would hold it)")
+    else:
+        why = f"the two levels differ by more than 1% (the bending length {lb:.3g} L, {lb * n1:.3g} links on {n1})"
+    return words + ": NOT resolved: " + why
+
+
 def accept_factors(coarse: dict, fine: dict, tol: float) -> tuple[dict, dict]:
     """``(applied, resolved)`` per peak of two levels of the stretching factor (``coarse`` on
     :data:`STRETCH_N` links, ``fine`` on twice as many; {peak: factor}): a peak's factor is resolved
@@ -385,6 +448,13 @@ class Runs:
             self._logged({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
                              "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
+
+    def stretching_body(self, present) -> list:
+        """The stretching factor's two levels for a line with a body (bending or drag among ``present``):
+        :func:`stretch_factor_body` on :data:`STRETCH_BODY_LEVELS` (:func:`snapping.caps.cap` takes any other
+        line's by :func:`stretch_factor`, the elastic line over the rigid chain, on :data:`STRETCH_LEVELS`)."""
+        return [stretch_factor_body(self.sp, self.chi, n, tuple(present), self.tol, self.stiff_tol, self.damping)
+                for n in STRETCH_BODY_LEVELS]
 
     def graded(self, on, level: int) -> dict:
         """The run with the mechanisms ``on`` on graded level ``level`` (:func:`graded_h`): RODAS4 at
