@@ -59,6 +59,7 @@ from numba import njit
 
 from .. import _validate as V
 from . import elastic_kernels as EK
+from .force_drag import add_drag
 
 __all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "check_method", "BODY_METHODS"]
 
@@ -132,38 +133,8 @@ def body_forces(N, z, pin, Bl, K0L, El, CN, CT, KN, KT, cd, wx, wy, clamped, ex,
         FY[j + 1] += fy
         FX[j] -= fx
         FY[j] -= fy
-    pd = 0.0
-    for j in range(N):
-        tx = UX[j]
-        ty = UY[j]
-        if j > 0:
-            bx = UX[j - 1] + tx
-            by = UY[j - 1] + ty
-            nb = math.sqrt(bx * bx + by * by)
-            if nb > 1e-12:
-                tx = bx / nb
-                ty = by / nb
-        vx = z[4 * j + 2]
-        vy = z[4 * j + 3]
-        ux = vx - wx
-        uy = vy - wy
-        ut = ux * tx + uy * ty
-        utx = ut * tx
-        uty = ut * ty
-        unx = ux - utx
-        uny = uy - uty
-        un = abs(ux * ty - uy * tx)
-        an = CN[j] * un + KN[j]
-        at = CT[j] * abs(ut) + KT[j]
-        fx = -an * unx - at * utx
-        fy = -an * uny - at * uty
-        if j == 0 and cd != 0.0:
-            u = math.sqrt(ux * ux + uy * uy)
-            fx -= cd * u * ux
-            fy -= cd * u * uy
-        FX[j] += fx
-        FY[j] += fy
-        pd += fx * vx + fy * vy
+    # the drag: the chain's law per node (force_drag.add_drag; here the node velocities are state values)
+    pd = add_drag(N, UX, UY, wx, wy, CN, CT, KN, KT, cd, z[2:4 * N:4], z[3:4 * N:4], FX, FY)
     return MM[N], diss, pd
 
 
@@ -370,16 +341,10 @@ class LineBody:
 
     def _pattern(self):
         if getattr(self, "_pat", None) is None:
+            from .elastic_model import block_band_pattern
+
             N = self.line.N
-            i, k, r, c = np.meshgrid(np.arange(N), np.arange(5), np.arange(4), np.arange(4), indexing="ij")
-            col_node = i - 2 + k
-            rows = (4 * i + r).ravel()
-            cols = (4 * col_node + c).ravel()
-            keep = np.flatnonzero(((col_node >= 0) & (col_node < N)).ravel())
-            n = 4 * N + 2
-            M = sp.coo_matrix((keep + 1.0, (rows[keep], cols[keep])), shape=(n, n)).tocsc()
-            M.sort_indices()
-            self._pat = (M.indices.copy(), M.indptr.copy(), M.data.astype(np.int64) - 1)
+            self._pat = block_band_pattern(N, 5)
             self._b3 = np.zeros((N, 3, 4, 4))
             self._b5 = np.zeros((N, 5, 4, 4))
         return self._pat
