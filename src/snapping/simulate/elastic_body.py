@@ -341,10 +341,8 @@ class LineBody:
 
     def _pattern(self):
         if getattr(self, "_pat", None) is None:
-            from .elastic_model import block_band_pattern
-
             N = self.line.N
-            self._pat = block_band_pattern(N, 5)
+            self._pat = EK.block_band_pattern(N, 5)
             self._b3 = np.zeros((N, 3, 4, 4))
             self._b5 = np.zeros((N, 5, 4, 4))
         return self._pat

@@ -387,3 +387,22 @@ def curvature_max_both(N, z, pin, h):
     if ik < 0:
         return 0.0, 0, kin
     return kbest, ik, kin
+
+
+def block_band_pattern(N: int, width: int) -> tuple:
+    """CSC structure of a Jacobian of ``width`` (odd) 4 x 4 blocks per node row, centred on the
+    diagonal, over the 4N + 2 state (the W and D rows and columns empty): ``(indices, indptr,
+    order)`` so that ``csc_matrix((blocks.ravel()[order], indices, indptr))``, ``blocks`` of shape
+    ``(N, width, 4, 4)`` (block ``[i, k]``: node i's rows by node ``i - width//2 + k``'s columns;
+    those outside the line dropped), is the matrix."""
+    import scipy.sparse as sp
+
+    i, k, r, c = np.meshgrid(np.arange(N), np.arange(width), np.arange(4), np.arange(4), indexing="ij")
+    col_node = i - width // 2 + k
+    rows = (4 * i + r).ravel()
+    cols = (4 * col_node + c).ravel()
+    keep = np.flatnonzero(((col_node >= 0) & (col_node < N)).ravel())
+    n = 4 * N + 2
+    M = sp.coo_matrix((keep + 1.0, (rows[keep], cols[keep])), shape=(n, n)).tocsc()
+    M.sort_indices()
+    return M.indices.copy(), M.indptr.copy(), M.data.astype(np.int64) - 1

@@ -197,23 +197,6 @@ def _check_table(table) -> tuple:
     return e, t
 
 
-def block_band_pattern(N: int, width: int) -> tuple:
-    """CSC structure of a Jacobian of ``width`` (odd) 4 x 4 blocks per node row, centred on the
-    diagonal, over the 4N + 2 state (the W and D rows and columns empty): ``(indices, indptr,
-    order)`` so that ``csc_matrix((blocks.ravel()[order], indices, indptr))``, ``blocks`` of shape
-    ``(N, width, 4, 4)`` (block ``[i, k]``: node i's rows by node ``i - width//2 + k``'s columns;
-    those outside the line dropped), is the matrix."""
-    i, k, r, c = np.meshgrid(np.arange(N), np.arange(width), np.arange(4), np.arange(4), indexing="ij")
-    col_node = i - width // 2 + k
-    rows = (4 * i + r).ravel()
-    cols = (4 * col_node + c).ravel()
-    keep = np.flatnonzero(((col_node >= 0) & (col_node < N)).ravel())
-    n = 4 * N + 2
-    M = sp.coo_matrix((keep + 1.0, (rows[keep], cols[keep])), shape=(n, n)).tocsc()
-    M.sort_indices()
-    return M.indices.copy(), M.indptr.copy(), M.data.astype(np.int64) - 1
-
-
 class ElasticLine:
     """A :class:`Problem` made of :class:`Elastic` links: the compiled model's arrays.
 
@@ -356,7 +339,7 @@ class ElasticLine:
         """CSC structure of the block-tridiagonal Jacobian: (indices, indptr, order) so that
         ``csc_matrix((blocks.ravel()[order], indices, indptr))`` is the Jacobian."""
         if getattr(self, "_pat", None) is None:
-            self._pat = block_band_pattern(self.N, 3)
+            self._pat = EK.block_band_pattern(self.N, 3)
             self._blocks = np.zeros((self.N, 3, 4, 4))
         return self._pat
 
