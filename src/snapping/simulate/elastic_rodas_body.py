@@ -8,8 +8,11 @@ same tableau, controller and dense output); what differs:
 * the right-hand side is the springs' (:func:`elastic_kernels.rhs`) plus the body's
   (:func:`elastic_body.add_body`), as :meth:`elastic_body.LineBody.rhs` adds them;
 * the Jacobian's node blocks reach two nodes either side (a bending moment at node i turns links
-  i-1 and i): the springs' exact blocks (:func:`elastic_jacobian.jacobian`) plus the body's by central
-  differences over the nodes coloured mod 5 (the steps of :func:`elastic_body.body_jac_fd`), in the
+  i-1 and i): the springs' exact blocks (:func:`elastic_jacobian.jacobian`), a pushing line's compressed
+  links' exact ones (:func:`compression_jacobian`: by differences, a link within the step of its rest
+  length, as at the bottom of a stiff catenary, strain ~1e-7 at c = 300, got a spurious EA/2 and the
+  steps fell 70-fold), plus the bending's and drag's by central differences over the nodes coloured
+  mod 5 (the steps of :func:`elastic_body.body_jac_fd`), in the
   compact form ``B5[i, k, 0:4] = K``, ``B5[i, k, 4:8] = C`` (node i's accelerations by node
   ``i - 2 + k``'s positions, velocities; 2 x 2 row-major);
 * the W row (the held end's power) gets the body's ``d/dz (M_N phi' - F_N . v_pin)``, which reaches
@@ -98,12 +101,12 @@ def body_rhs(N, t, z, pin, h, invm, ea, damp, tabe, tabt, g, bd, dz, T, E, ED, F
 
 
 @njit(cache=True, error_model="numpy")
-def local_dissipation(N, z, pin, El, CN, CT, KN, KT, sc, phid, h, ea, damp, UX, UY, LN, OM, DX, DY, Q):
+def local_dissipation(N, z, pin, El, CN, CT, KN, KT, sc, phid, push, h, ea, damp, UX, UY, LN, OM, DX, DY, Q):
     """The body's dissipation rate ``2R + D_compression - P_drag`` (``elastic_body.body_forces``' ``diss -
     p_drag``) split into per-node terms ``Q[0:N]`` (summing to it), each a function of its node and the
     nodes on either side: the bending damping at joint i (and the clamp's at node N-1), a compressed
-    link j's damping at node j, the drag's power at its node. The geometry ``UX, UY, LN, OM`` of ``z``
-    (:func:`elastic_body._geometry`) on entry."""
+    link j's damping at node j (with ``push``), the drag's power at its node. The geometry ``UX, UY, LN,
+    OM`` of ``z`` (:func:`elastic_body._geometry`) on entry."""
     for i in range(N + 1):
         Q[i] = 0.0
         DX[i] = 0.0
@@ -114,7 +117,7 @@ def local_dissipation(N, z, pin, El, CN, CT, KN, KT, sc, phid, h, ea, damp, UX, 
     if sc[P_CLAMPED] != 0.0:
         dom = phid - OM[N - 1]
         Q[N - 1] += El[N] * dom * dom
-    if sc[P_PUSH] != 0.0:
+    if push:
         for j in range(N):
             e = LN[j] / h[j] - 1.0
             if e > 0.0:
@@ -135,15 +138,85 @@ def local_dissipation(N, z, pin, El, CN, CT, KN, KT, sc, phid, h, ea, damp, UX, 
 @njit(cache=True, error_model="numpy")
 def _body_eval(N, t, zz, pin, h, ea, damp, bd, bs, Q):
     """The body's node forces (``bs[5], bs[6]``), its W rate ``M_N phi' - F_N . v_pin`` (returned) and
-    per-node dissipation ``Q`` at ``zz``."""
+    per-node dissipation ``Q`` at ``zz``, without the compressed links' push (:func:`compression_jacobian`
+    differentiates that exactly: a link a few 1e-7 from its rest length, the bottom of a stiff catenary,
+    would be crossed by the differences' step and get a spurious EA/2)."""
     Bl, K0L, El, CN, CT, KN, KT, sc, cx, cc = bd
     UX, UY, LN, OM, MM, FX, FY, DX, DY = bs[0], bs[1], bs[2], bs[3], bs[4], bs[5], bs[6], bs[7], bs[8]
     ex, ey, phid = clamp_at(t, sc, cx, cc)
     mn, _, _ = body_forces(N, zz, pin, Bl, K0L, El, CN, CT, KN, KT, sc[P_CD], sc[P_WX], sc[P_WY],
-                           sc[P_CLAMPED] != 0.0, ex, ey, phid, sc[P_PUSH] != 0.0, h, ea, damp, UX, UY, LN, OM, MM,
-                           FX, FY)
-    local_dissipation(N, zz, pin, El, CN, CT, KN, KT, sc, phid, h, ea, damp, UX, UY, LN, OM, DX, DY, Q)
+                           sc[P_CLAMPED] != 0.0, ex, ey, phid, False, h, ea, damp, UX, UY, LN, OM, MM, FX, FY)
+    local_dissipation(N, zz, pin, El, CN, CT, KN, KT, sc, phid, False, h, ea, damp, UX, UY, LN, OM, DX, DY, Q)
     return mn * phid - (FX[N] * pin[2] + FY[N] * pin[3])
+
+
+@njit(cache=True, error_model="numpy")
+def compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD):
+    """Add the compressed links' push (:func:`elastic_body.compression`: ``T = min(0, EA e + KV edot)``
+    for ``e <= 0``, force ``+T u`` on node j) to the node blocks ``B5``, the W row ``gW`` and the D row
+    ``gD``, exactly: the springs' formulas of :func:`elastic_jacobian.jacobian` with the linear law
+    (``f = EA e``, slope EA) continued below the rest length."""
+    for j in range(N):
+        if j + 1 < N:
+            x1, y1, vx1, vy1 = z[4 * j + 4], z[4 * j + 5], z[4 * j + 6], z[4 * j + 7]
+        else:
+            x1, y1, vx1, vy1 = pin[0], pin[1], pin[2], pin[3]
+        dx = x1 - z[4 * j]
+        dy = y1 - z[4 * j + 1]
+        ln = math.sqrt(dx * dx + dy * dy)
+        e = ln / h[j] - 1.0
+        if e > 0.0:
+            continue
+        ux = dx / ln
+        uy = dy / ln
+        dvx = vx1 - z[4 * j + 2]
+        dvy = vy1 - z[4 * j + 3]
+        udv = ux * dvx + uy * dvy
+        ed = udv / h[j]
+        fp = ea[j]
+        f = fp * e
+        c = damp[j]
+        tj = f + c * ed
+        if tj > 0.0:
+            tj = 0.0
+        px = (dvx - udv * ux) / ln
+        py = (dvy - udv * uy) / ln
+        if tj < 0.0:
+            gdx, gdy = 2.0 * c * ed * px, 2.0 * c * ed * py
+            gvx, gvy = 2.0 * c * ed * ux, 2.0 * c * ed * uy
+        else:
+            gdx, gdy = -(fp * ed * ux + f * px), -(fp * ed * uy + f * py)
+            gvx, gvy = -f * ux, -f * uy
+        gD[4 * j] -= gdx
+        gD[4 * j + 1] -= gdy
+        gD[4 * j + 2] -= gvx
+        gD[4 * j + 3] -= gvy
+        if j + 1 < N:
+            gD[4 * j + 4] += gdx
+            gD[4 * j + 5] += gdy
+            gD[4 * j + 6] += gvx
+            gD[4 * j + 7] += gvy
+        if tj == 0.0:
+            continue
+        bl = EK.link_blocks(tj, fp, c, h[j], ln, ux, uy, dvx, dvy, udv)
+        mj = invm[j]
+        for q in range(8):
+            B5[j, 2, q] -= mj * bl[q]
+        if j + 1 < N:
+            mk = invm[j + 1]
+            for q in range(8):
+                B5[j, 3, q] += mj * bl[q]
+                B5[j + 1, 1, q] += mk * bl[q]
+                B5[j + 1, 2, q] -= mk * bl[q]
+        else:  # the W row: -(-T u) . v_pin, as the springs'
+            q = tj / ln
+            tdx = fp * ux / h[j] + c * px / h[j]
+            tdy = fp * uy / h[j] + c * py / h[j]
+            uvp = ux * pin[2] + uy * pin[3]
+            gW[8] += -(q * (pin[2] - uvp * ux) + tdx * uvp)
+            gW[9] += -(q * (pin[3] - uvp * uy) + tdy * uvp)
+            gW[10] += -(c * ux / h[j]) * uvp
+            gW[11] += -(c * uy / h[j]) * uvp
 
 
 @njit(cache=True, error_model="numpy")
@@ -164,6 +237,8 @@ def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4
         gW[q] = 0.0
     for q in range(4):
         gW[8 + q] = gW4[q]
+    if bd[7][P_PUSH] != 0.0:
+        compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD)
     n = z.shape[0]
     for i in range(n):
         zz[i] = z[i]
