@@ -12,6 +12,8 @@ import pytest
 
 from snapping.simulate import Body, PinMotion
 from snapping.simulate import elastic_rodas as ER
+from snapping.simulate import elastic_rodas_body as RB
+from snapping.simulate.banded import band_lu
 from snapping.simulate.elastic import Elastic, solve
 from snapping.simulate.elastic_model import ElasticLine
 from snapping.simulate.elastic_rodas_body import RodasBodyStepper
@@ -67,6 +69,23 @@ def test_rhs_and_jacobian(clamp):
         assert np.abs(J[row, :n4] - Jd[row]).max() < 1e-8 * np.abs(Jd[row]).max(), row
     assert not np.any(J[:, n4:])  # (nothing depends on W and D)
     assert st.ctl[ER.C_AUTO] == 0.0  # (a pulled held end)
+
+
+@pytest.mark.parametrize("gh", [1e-4, 1e-2])
+def test_stage_solve_against_dense(gh):
+    """The stage system ``(I/g - J) U = b`` (the reduced velocity band, pivoted, then positions, W, D)
+    against numpy's dense solve with the whole Jacobian the method uses."""
+    line, z = _random_line(N=11, clamp="table")
+    N, n = line.N, 4 * line.N + 2
+    st = RodasBodyStepper(line, 0.13, z, 1.0, 1e-6)
+    J = st.jacobian_dense()
+    RB.assemble_band5(N, st.B5, gh, st.ab5)
+    assert band_lu(st.ab5, 2 * N, RB.KLB, RB.KUB, st.piv5) == 0
+    b = np.random.default_rng(5).standard_normal(n)
+    U = np.zeros(n)
+    RB.solve5(N, st.B5, st.gW12, st.gDb, gh, st.ab5, st.piv5, b, U, np.zeros(2 * N))
+    want = np.linalg.solve(np.eye(n) / gh - J, b)
+    np.testing.assert_allclose(U, want, rtol=0, atol=1e-10 * np.abs(want).max())
 
 
 def test_compressed_link_near_its_rest_length():
