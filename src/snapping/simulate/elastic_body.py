@@ -406,49 +406,27 @@ def matched_body(line, *, tol: float = 1e-15, max_iter: int = 50):
     (state vector, tensions, passes)."""
     from scipy.linalg import solve_banded
 
-    from .elastic_statics import strain_of
-    from .errors import SimulationError
+    from .elastic_statics import matched_lengths, start_angles, strain_of
 
     N = line.N
-    p = line.problem
-    th = np.unwrap(np.arctan2(np.diff(p.y), np.diff(p.x)))
+    th, om = start_angles(line)
     c, s = np.cos(th), np.sin(th)
-    om = (-s * np.diff(p.vx) + c * np.diff(p.vy)) / line.h
     invm = 1.0 / line.m
-    px, py, pvx, pvy, pax, pay = line.pin.kinematics(0.0)
+    _, _, _, _, pax, pay = line.pin.kinematics(0.0)
     C = c[:-1] * c[1:] + s[:-1] * s[1:]  # u_j . u_{j+1}
-    lengths = line.h.copy()
-
-    def lay(lengths):
-        x = px - np.concatenate([np.cumsum((lengths * c)[::-1])[::-1], [0.0]])
-        yy = py - np.concatenate([np.cumsum((lengths * s)[::-1])[::-1], [0.0]])
-        vx = pvx - np.concatenate([np.cumsum((-lengths * om * s)[::-1])[::-1], [0.0]])
-        vy = pvy - np.concatenate([np.cumsum((lengths * om * c)[::-1])[::-1], [0.0]])
-        return line.pack(x, yy, vx, vy)
-
     ab = np.zeros((3, N))
     ab[1] = -invm - np.concatenate([invm[1:], [0.0]])
     ab[0, 1:] = C * invm[1:]  # T_{j+1} in row j
     ab[2, :-1] = C * invm[1:]  # T_{j-1} in row j (over m_j)
-    change = np.inf
-    for it in range(1, max_iter + 1):
-        z = lay(lengths)
+
+    def tensions(lengths, z):
         FX, FY, _, _, _ = line.body.forces(0.0, z, push=False)  # (the links' own forces are the T_j)
         Fu = FX[:N] * c + FY[:N] * s  # F_j . u_j
         Fnu = np.concatenate([FX[1:N] * c[:-1] + FY[1:N] * s[:-1], [0.0]])  # F_{j+1} . u_j
         b = -(Fnu * np.concatenate([invm[1:], [0.0]]) - Fu * invm + lengths * om * om)
         b[-1] -= pax * c[-1] + pay * s[-1] - line.g * s[-1]
         T = solve_banded((1, 1), ab, b)
-        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), np.minimum(T, 0.0) / line.ea if
-                     line.body.push else 0.0)
-        new = line.h * (1.0 + e)
-        change = float(np.abs(new - lengths).max())
-        lengths = new
-        if change <= tol * float(line.h.max()):
-            break
-    else:
-        raise SimulationError(f"matched start: the link lengths still change by {change:.3g} after {max_iter} passes")
-    if not np.all(np.isfinite(lengths)):
-        raise SimulationError("matched start: the rigid chain's tension system has no finite solution")
-    line.matched_iterations = it
-    return lay(lengths), np.where(T > 0.0, T, 0.0), it
+        return T, np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), np.minimum(T, 0.0) / line.ea if
+                           line.body.push else 0.0)
+
+    return matched_lengths(line, th, om, tensions, tol, max_iter)

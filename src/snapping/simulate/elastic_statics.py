@@ -289,22 +289,55 @@ def matched(line, *, tol: float = 1e-15, max_iter: int = 50):
     ``v_j = v_{j+1} - l_j theta_j' n_j``. Returns (state vector, tensions, passes);
     ``line.matched_iterations`` records the passes."""
     from . import general as G
-    from .errors import SimulationError
 
     N = line.N
-    p = line.problem
-    th = np.unwrap(np.arctan2(np.diff(p.y), np.diff(p.x)))
-    c, s = np.cos(th), np.sin(th)
-    om = (-s * np.diff(p.vx) + c * np.diff(p.vy)) / line.h
+    th, om = start_angles(line)
     invm = 1.0 / line.m
     pin_args = line.pin.model_args()
     t0 = 0.0
     if 0.0 in G.breakpoints(G.make_model(line.h, invm, g=line.g, **pin_args)):
         t0 = float(np.nextafter(0.0, 1.0))  # (the held end's acceleration from t = 0 on: the right limit)
+
+    def tensions(lengths, z):
+        T = _rigid_release_tensions(N, t0, th, om, lengths, invm, line.g, pin_args)
+        return T, np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), 0.0)
+
+    return matched_lengths(line, th, om, tensions, tol, max_iter, lay_positions=False)
+
+
+def start_angles(line) -> tuple:
+    """The start's link angles (unwrapped) and angular velocities ``theta_j'`` (from the
+    problem's node positions and velocities, over the rest lengths)."""
+    p = line.problem
+    th = np.unwrap(np.arctan2(np.diff(p.y), np.diff(p.x)))
+    om = (-np.sin(th) * np.diff(p.vx) + np.cos(th) * np.diff(p.vy)) / line.h
+    return th, om
+
+
+def lay(line, th, om, lengths) -> np.ndarray:
+    """The state vector of links of ``lengths`` at angles ``th`` turning at ``om``, laid from
+    the held end: node j = node j+1 - l_j t_j, ``v_j = v_{j+1} - l_j theta_j' n_j``."""
+    c, s = np.cos(th), np.sin(th)
+    px, py, pvx, pvy = line.pin_state(0.0)
+    x = px - np.concatenate([np.cumsum((lengths * c)[::-1])[::-1], [0.0]])
+    yy = py - np.concatenate([np.cumsum((lengths * s)[::-1])[::-1], [0.0]])
+    vx = pvx - np.concatenate([np.cumsum((-lengths * om * s)[::-1])[::-1], [0.0]])
+    vy = pvy - np.concatenate([np.cumsum((lengths * om * c)[::-1])[::-1], [0.0]])
+    return line.pack(x, yy, vx, vy)
+
+
+def matched_lengths(line, th, om, tensions, tol: float, max_iter: int, lay_positions: bool = True):
+    """The matched start's fixed point, shared by :func:`matched` and
+    :func:`snapping.simulate.elastic_body.matched_body`: from the rest lengths, ``T, e =
+    tensions(lengths, z)`` (``z`` the state laid on those lengths when ``lay_positions``, else
+    None) and lengths ``h (1 + e)``, until they change by at most ``tol`` times the longest
+    rest link. Returns (state vector, tensions clipped at 0, passes); records the passes as
+    ``line.matched_iterations``."""
+    from .errors import SimulationError
+
     lengths = line.h.copy()
     for it in range(1, max_iter + 1):
-        T = _rigid_release_tensions(N, t0, th, om, lengths, invm, line.g, pin_args)
-        e = np.where(T > 0.0, strain_of(line, np.maximum(T, 0.0)), 0.0)
+        T, e = tensions(lengths, lay(line, th, om, lengths) if lay_positions else None)
         new = line.h * (1.0 + e)
         change = float(np.abs(new - lengths).max())
         lengths = new
@@ -314,14 +347,8 @@ def matched(line, *, tol: float = 1e-15, max_iter: int = 50):
         raise SimulationError(f"matched start: the link lengths still change by {change:.3g} after {max_iter} passes")
     if not np.all(np.isfinite(lengths)):
         raise SimulationError("matched start: the rigid chain's tension system has no finite solution")
-    px, py, pvx, pvy = line.pin_state(0.0)
-    # node j = node j+1 - l_j t_j, from the held end
-    x = px - np.concatenate([np.cumsum((lengths * c)[::-1])[::-1], [0.0]])
-    yy = py - np.concatenate([np.cumsum((lengths * s)[::-1])[::-1], [0.0]])
-    vx = pvx - np.concatenate([np.cumsum((-lengths * om * s)[::-1])[::-1], [0.0]])
-    vy = pvy - np.concatenate([np.cumsum((lengths * om * c)[::-1])[::-1], [0.0]])
     line.matched_iterations = it
-    return line.pack(x, yy, vx, vy), np.where(T > 0.0, T, 0.0), it
+    return lay(line, th, om, lengths), np.where(T > 0.0, T, 0.0), it
 
 
 def _rigid_release_tensions(N, t, th, om, lengths, invm, g, pin_args) -> np.ndarray:
