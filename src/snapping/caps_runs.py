@@ -43,7 +43,8 @@ STRETCH_METHOD = "rodas4"
 #: uniform links, shared lumping. 50/100: the bungee cord's factors at chi 0.25 agree within 1% there
 #: (sigma 1.268 / 1.275 / 1.279 on 50 / 100 / 200; the combined runs 1.2 / 1.5 / 2.8 s of CPU)
 STRETCH_BODY_LEVELS = (50, 100)
-#: the combined model's method (the elastic line with a body: RODAS4's compiled steppers have no body forces)
+#: the combined model's method (the elastic line with a body; rodas4 takes a body since branch rodasbody, Radau
+#: kept here: the catalogue answers' numbers)
 STRETCH_BODY_METHOD = "radau"
 #: ... at this tolerance: against 1e-6 its factors move by at most 3e-5 relative (the climbing rope at chi 0.15, the
 #: bungee cord at 0.25, 50 and 100 links) at 55-90% of the CPU (1e-4 moved the bungee's a_peak factor 0.6%)

@@ -137,7 +137,7 @@ def elastic_from_args(args, scales):
     if body_from_args(args) is not None:
         raise SnappingInputError("bending, drag and wind are not built for the extensible line on the command "
                                  "line yet: give --ea/--stretching without body options (in Python, "
-                                 "snapping.simulate.elastic.solve takes a Body: method radau or dop853)")
+                                 "snapping.simulate.elastic.solve takes a Body: method radau, dop853 or rodas4)")
     n_stiff = sum(getattr(args, d) is not None for d in ("ea", "stretching", "strain_table"))
     if n_stiff != 1:
         raise SnappingInputError("give exactly one of --ea, --stretching and --strain-table (the axial stiffness)")

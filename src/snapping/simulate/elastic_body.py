@@ -63,8 +63,8 @@ from .force_drag import add_drag
 
 __all__ = ["LineBody", "body_forces", "bending_energy", "body_jac_fd", "check_method", "BODY_METHODS"]
 
-#: the elastic line's methods that take a body
-BODY_METHODS = ("radau", "dop853")
+#: the elastic line's methods that take a body ("rodas4": :mod:`elastic_rodas_body`, branch rodasbody)
+BODY_METHODS = ("radau", "dop853", "rodas4")
 
 
 @njit(cache=True, error_model="numpy")
@@ -251,13 +251,14 @@ def check_method(line, method: str, asked=()) -> None:
     if line.body is None:
         return
     if method not in BODY_METHODS:
-        raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the compiled RODAS4 steppers do "
-                                   f"not take the body's forces yet; use method='radau' (or 'dop853')")
+        raise V.SnappingInputError(f"method={method!r} with a body (bending, drag): the link-coordinate stepper does "
+                                   f"not take the body's forces; use one of {BODY_METHODS}")
     if asked:
         k, v = asked[0]
-        raise V.SnappingInputError(f"{k}={v!r} with a body (bending, drag): only the methods 'rodas4' and "
-                                   f"'rodas4-links' keep checkpoints and they take no body; run the body's methods "
-                                   f"{BODY_METHODS} without checkpoint, resume and checkpoint_every")
+        raise V.SnappingInputError(f"{k}={v!r} with a body (bending, drag): only the compiled loops of 'rodas4' and "
+                                   f"'rodas4-links' keep checkpoints, and they take no body (a body's 'rodas4' steps in "
+                                   f"Python's loop); run the body's methods {BODY_METHODS} without checkpoint, resume "
+                                   f"and checkpoint_every")
 
 
 def body_inputs(line, method: str, inputs: dict) -> None:

@@ -306,8 +306,8 @@ def restep_call(stepper, method: str, n_restep: list):
     RODAS4 run's ``stepper`` as one compiled call (:func:`restep`, :func:`restep_links`: the same numbers as a
     fresh stepper's), its evaluations added to ``n_restep[0]``; None for other methods (branch window: the
     snap window's edge, :mod:`snapping.simulate.snap_edge`)."""
-    if method not in ("rodas4", "rodas4-links"):
-        return None
+    if method not in ("rodas4", "rodas4-links") or getattr(stepper.line, "body", None) is not None:
+        return None  # (a body's rodas4: elastic_rodas_body's stepper, the Python restep)
     fn = restep_links if method == "rodas4-links" else restep
     args = (stepper.tol, stepper.ctl[ER.C_AUTO], stepper.pinpar, stepper.pintab, *stepper.args())
 

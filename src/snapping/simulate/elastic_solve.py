@@ -60,6 +60,7 @@ from .snap_window import SNAP_FRACTION, snap_peaks, taut_peaks
 from .elastic_model import STARTS, Elastic, ElasticLine
 from .options import check_checkpoint_every, check_progress
 from .elastic_rodas import RodasStepper
+from .elastic_rodas_body import RodasBodyStepper
 from .elastic_links_rodas import LinksStepper
 
 __all__ = ["solve", "ElasticRun", "METHODS", "speed_floor"]
@@ -411,8 +412,9 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
         count[0] += 1
         return line.rhs(t, z)
 
+    Rodas = RodasStepper if line.body is None else RodasBodyStepper  # (a body: elastic_rodas_body, Python loop)
     if method == "rodas4":
-        solver = RodasStepper(line, 0.0, z0, t_bound, tol)
+        solver = Rodas(line, 0.0, z0, t_bound, tol)
     elif method == "rodas4-links":
         solver = LinksStepper(line, 0.0, z0, t_bound, tol)
     else:
@@ -438,7 +440,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
 
     def restep(t0, y0, t1):  # the state at t1 integrated from (t0, y0) with the run's method and tol
         if method == "rodas4":
-            st = RodasStepper(line, t0, y0, t1, tol, h0=t1 - t0)
+            st = Rodas(line, t0, y0, t1, tol, h0=t1 - t0)
         elif method == "rodas4-links":
             st = LinksStepper(line, t0, y0, t1, tol, h0=t1 - t0)
         else:
@@ -470,7 +472,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
 
     bar = EP.open_run_bar(problem, method, t_end, progress)
     try:
-        if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
+        if method in ("rodas4", "rodas4-links") and COMPILED_LOOP and line.body is None:
             with sigs if sigs is not None else contextlib.nullcontext():  # (the signals noted, checkpointed runs)
                 rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
                     solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
