@@ -30,7 +30,7 @@ def test_one_level_is_the_combined_model_over_the_inextensible_run():
     assert sp.has("bending") and sp.has("drag") and not sp.has("taper") and not sp.has("end-mass")
     p = _by_hand(sp, chi, N)
     inext = run(p, method="fast", tol=1e-6, progress=False).dataset.attrs
-    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=1e-5, method="radau",
+    el = solve(p, Elastic(ea=sp.ea / (sp.mass * sp.g), grid_damping=1.0), tol=1e-5, method="rodas4",
                start="matched").dataset.attrs
     f = caps_runs.stretch_factor_body(sp, chi, N, ("bending", "drag"), 1e-6, damping=0.0)
     for q in Q:
@@ -59,7 +59,7 @@ def _fake_body_levels(monkeypatch, levels):
     def fake(sp, chi, N, on, tol=1e-6, stiff_tol=None, damping=1.0, start="matched", combined_tol=1e-5):
         calls.append((N, tuple(on)))
         return {**levels[N], "N": N, "n_rhs": 5, "wall": 0.0, "cpu": 0.0, "strain_peak": 0.02, "s_sigma": 0.9,
-                "t_sigma": 1.2, "t_snap": 1.19, "method": "combined radau / fast 1e-06"}
+                "t_sigma": 1.2, "t_snap": 1.19, "method": "combined rodas4 / fast 1e-06"}
 
     monkeypatch.setattr(caps_runs, "stretch_factor_body", fake)
     monkeypatch.setattr(caps, "stretch_factor", lambda *a, **k: pytest.fail("the bodiless factor was run"))

@@ -43,9 +43,12 @@ STRETCH_METHOD = "rodas4"
 #: uniform links, shared lumping. 50/100: the bungee cord's factors at chi 0.25 agree within 1% there
 #: (sigma 1.268 / 1.275 / 1.279 on 50 / 100 / 200; the combined runs 1.2 / 1.5 / 2.8 s of CPU)
 STRETCH_BODY_LEVELS = (50, 100)
-#: the combined model's method (the elastic line with a body; rodas4 takes a body since branch rodasbody, Radau
-#: kept here: the catalogue answers' numbers)
-STRETCH_BODY_METHOD = "radau"
+#: the combined model's method (the elastic line with a body): RODAS4 (a body since branch rodasbody), closer to the
+#: converged factor than Radau at the same tolerance and 2-4x cheaper (the bungee cord at chi 0.05 on 100 links,
+#: tol 1e-5 against Radau's and RODAS4's 1e-8, which agree to 1e-7: a_peak's factor off by 4.3e-5 (Radau 2.1e-4), v's
+#: 4.2e-5 (1.1e-4); CPU of the two levels: the bungee cord 0.5-0.6 s (Radau 0.9-2.2), the climbing rope 0.4-1.2 s
+#: (1.6-3.4), chi 0.05-0.4; factors moved by at most 1.7e-4)
+STRETCH_BODY_METHOD = "rodas4"
 #: ... at this tolerance: against 1e-6 its factors move by at most 3e-5 relative (the climbing rope at chi 0.15, the
 #: bungee cord at 0.25, 50 and 100 links) at 55-90% of the CPU (1e-4 moved the bungee's a_peak factor 0.6%)
 STRETCH_BODY_TOL = 1e-5
