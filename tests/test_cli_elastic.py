@@ -63,6 +63,30 @@ def test_stretching_twin_and_a_linear_strain_table_give_the_same_run(tmp_path, c
     assert t["si"]["dimensionless_numbers"]["stretching"] == pytest.approx(c, rel=1e-12)
 
 
+@pytest.mark.parametrize("method", ["fast", "rodas4"])
+def test_the_lines_body_rides_on_the_extensible_line(method, capsys):
+    """--ea with --ei/--diameter (SI): the extensible line carries the line's bending and drag; the run is
+    snapping.simulate.elastic.solve on the problem built here by hand (EI/(lambda g L^3), 0.5 rho C d L/lambda,
+    0.5 rho C_t pi d L/lambda written out), to round-off; the summary gives the body's numbers."""
+    from snapping.simulate import Body, Links, Problem
+    from snapping.simulate.elastic import Elastic, solve
+
+    EA, EI, d, rho, cn, ct = 300.0, 2e-3, 0.01, 1.2, 1.2, 0.01
+    lam = M / L
+    s = _json(capsys, BASE + SI + ["--ea", str(EA), "--ei", str(EI), "--diameter", str(d), "--elastic-start",
+                                   "matched", "--method", method])
+    body = Body(EI / (lam * G * L ** 3), drag_normal=0.5 * rho * cn * d * L / lam,
+                drag_tangential=0.5 * rho * ct * math.pi * d * L / lam)
+    p = Problem.catenary(0.25, links=Links.uniform(6, lumping="shared"), body=body)
+    r = solve(p, Elastic(ea=EA / (M * G)), t_end=0.15, tol=1e-6, method={"fast": "radau"}.get(method, method),
+              start="matched").dataset.attrs
+    for k in ("v_peak", "a_peak", "sigma_peak", "energy_drift"):
+        assert s[k] == pytest.approx(float(r[k]), rel=1e-9, abs=1e-14), k
+    assert s["body"]["beta"] == pytest.approx(EI / (lam * G * L ** 3), rel=1e-12)
+    assert s["body"]["drag_normal"] == pytest.approx(0.5 * rho * cn * d * L / lam, rel=1e-12)
+    assert s["method"] == {"fast": "radau"}.get(method, method) and s["status"] == "completed"
+
+
 @pytest.mark.parametrize("extra, needle", [
     (SI + ["--ea", "0"], "--ea=0.0 is out of range"),
     (SI + ["--ea", "-5"], "--ea=-5.0 is out of range"),
@@ -76,7 +100,9 @@ def test_stretching_twin_and_a_linear_strain_table_give_the_same_run(tmp_path, c
     (["--stretching", "10", "--method", "euler-richardson"], "--stretching (the extensible line) with --method euler"),
     (["--ea", "100"], "--ea is in SI: it needs --length"),
     (SI + ["--ea", "100", "--stretching", "3"], "exactly one of --ea"),
-    (["--stretching", "10", "--bending", "0.01"], "not built for the extensible line"),
+    (["--stretching", "10", "--bending", "0.01", "--method", "rodas4-links"], "--method rodas4-links does not carry"),
+    (["--stretching", "10", "--drag-normal", "1", "--method", "rodas4", "--checkpoint", "ck.nc"], "with a body"),
+    (["--stretching", "10", "--bending", "0.01", "--start", "equilibrium"], "--start (the bending line's start"),
     (["--stretching", "10", "--dims", "3"], "is planar"),
     (SI + ["--strain-table", "TABLE"], "strains must increase"),
     (SI + ["--strain-table", "NOTCSV"], "is not two comma-separated numbers"),

@@ -128,16 +128,17 @@ def elastic_from_args(args, scales):
         raise SnappingInputError(f"--method {args.method} with {opt} (the extensible line): its methods are fast "
                                  f"(Radau on the banded Jacobian), rodas4 (or stiff: the compiled RODAS4), "
                                  f"rodas4-links (RODAS4 in link coordinates) and dop853")
+    from ..simulate.elastic_body import BODY_METHODS
     from ._body import body_from_args
     from .simulate3d import wants_3d
 
     if hasattr(args, "dims") and wants_3d(args):
         raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
                                  "--perturb or --whirl")
-    if body_from_args(args) is not None:
-        raise SnappingInputError("bending, drag and wind are not built for the extensible line on the command "
-                                 "line yet: give --ea/--stretching without body options (in Python, "
-                                 "snapping.simulate.elastic.solve takes a Body: method radau, dop853 or rodas4)")
+    if body_from_args(args) is not None and ELASTIC_METHOD.get(args.method, "radau") not in BODY_METHODS:
+        raise SnappingInputError(f"--method {args.method} does not carry the line's body (bending, drag, wind) on "
+                                 f"the extensible line: its methods with a body are fast (Radau), dop853 and rodas4 "
+                                 f"(or stiff)")
     n_stiff = sum(getattr(args, d) is not None for d in ("ea", "stretching", "strain_table"))
     if n_stiff != 1:
         raise SnappingInputError("give exactly one of --ea, --stretching and --strain-table (the axial stiffness)")

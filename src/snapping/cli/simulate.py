@@ -227,9 +227,9 @@ def _cmd_simulate(args) -> int:
                                lumping=args.lumping or ("shared" if elastic is not None else None),
                                pin_motion=args.pin_motion, gravity=args.gravity, links=line_links(args))
 
-        if elastic is not None:
-            return _simulate_elastic(args, problem, elastic, times, scales)
         body = body_from_args(args)
+        if elastic is not None:  # (the line's body, if any, rides on the extensible line: simulate.elastic_body)
+            return _simulate_elastic(args, problem if body is None else problem.with_body(body), elastic, times, scales)
         if body is not None or args.start is not None:  # bending, drag, a clamp: a general problem (simulate.body)
             problem = attach_body(problem, body, args)
     try:
@@ -356,6 +356,16 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
         return exc.exit_status
     if args.output:
         summary["output"] = args.output
+    if problem.body is not None:  # (the line's body on the extensible line: its numbers, and the SI they came from)
+        import json
+
+        from ..simulate.body import summarize
+        from ._body import body_si_inputs, si_summary
+
+        summary["body"] = summarize(json.dumps(problem.body.describe(problem.links.h), sort_keys=True))
+        body_si = si_summary(body_si_inputs(args))
+        if body_si:
+            summary["body_si"] = body_si
     numbers = _dimensionless(scales, args, N=args.N, tip_mass=args.tip_mass)
     if numbers is not None and "stretching" not in numbers:  # (--stretching or --strain-table: the run's c)
         from .. import dimensionless
@@ -367,9 +377,10 @@ def _simulate_elastic(args, problem, elastic, times, scales) -> int:
                                                       **({"dimensionless_numbers": numbers} if numbers else {})}))
     else:
         rows = [(k, f"{v:.10g}" if isinstance(v, float) else v, None) for k, v in summary.items()
-                if k not in ("problem", "elastic")]
+                if k not in ("problem", "elastic", "body", "body_si")]
         rows.append(("elastic", summary["elastic"], "EA and damping in M g, M g sqrt(L/g)"))
         print_table(rows, title=f"snapping simulate (extensible line): N={args.N}, {_problem_title(summary)}")
+        _print_body(summary)
         _print_si(scales, units.si_rows(summary, scales) if scales else [])
         _print_dimensionless(numbers)
     if summary["status"] != "completed":
