@@ -108,16 +108,17 @@ def test_graded_links_arrays_and_planar_wind():
         Body(0.0, drag_normal=1.0, clamp=1.0)
 
 
-def test_other_entry_points_point_to_solve():
-    """The studies and sweeps still refuse a body with the extensible line; their refusals say
-    where it is built (``snapping.simulate.elastic.solve``), not that it is not built at all."""
+def test_other_entry_points_take_the_body_and_refuse_a_method_without_one():
+    """The studies and sweeps take a body with the extensible line (tests/test_elastic_body_studies.py);
+    a method that steps no body is refused by name before any run, in a grid and in a study alike."""
     from snapping.continuum import converge
     from snapping.sweep_grid import Grid
 
-    with pytest.raises(SnappingInputError, match=r"convergence studies yet.*elastic\.solve takes a Body"):
-        converge(0.3, levels=2, n0=4, tol=1e-4, body={"bending": 1e-3}, elastic={"ea": 900.0})
-    with pytest.raises(SnappingInputError, match=r"in the sweeps yet.*elastic\.solve takes a Body"):
-        Grid(chi=[0.3], N=[8], options={"elastic": {"ea": 900.0}, "body": {"bending": 1e-3}})
+    with pytest.raises(SnappingInputError, match=r"method='rodas4-links' steps no body"):
+        Grid(chi=[0.3], N=[8], options={"elastic": {"ea": 900.0}, "body": {"bending": 1e-3},
+                                        "method": "rodas4-links"})
+    c = converge(0.3, levels=2, n0=4, tol=1e-4, body={"bending": 1e-3}, elastic={"ea": 900.0})
+    assert "body" in c.dataset.attrs and "elastic" in c.dataset.attrs
 
 
 @pytest.mark.parametrize("body", [None, Body(1e-3, drag_normal=0.5)])

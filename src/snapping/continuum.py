@@ -210,7 +210,7 @@ def _run_level(args):
     if elastic and elastic[0] is not None:  # the extensible line (snapping.sweep_elastic)
         from .sweep_elastic import level_row
 
-        return level_row(chi, h, lumping, free_end, tol, path, elastic[0], *elastic[1:]), path
+        return level_row(chi, h, lumping, free_end, tol, path, elastic[0], *elastic[1:], body_d=body), path
     problem = Problem.catenary(chi, links=Links.graded(h, lumping=lumping, free_end=free_end), chords="exact",
                                body=None if body is None else Body.from_describe(body))
     if path is not None and os.path.isfile(path):
@@ -332,9 +332,6 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         from .sweep_elastic import description
 
         elastic_d = description(elastic, "elastic")
-        if body_d is not None:  # (checked before: the body was dropped silently)
-            raise V.SnappingInputError("body: bending and drag are not built for the extensible line (elastic) in the "
-                                       "convergence studies yet (snapping.simulate.elastic.solve takes a Body)")
         from .simulate.elastic import STARTS
 
         elastic_start = "stretched" if elastic_start is None else elastic_start
@@ -392,7 +389,9 @@ def converge(chi: float, *, levels: int = 4, ratio: float = 0.5, first: int = 0,
         ds = _dataset(chi, params, rows, lumping, free_end, tol, ratio, time.perf_counter() - t0)
         if body_d is not None or elastic_d is not None:
             ds.attrs["grading"] = "uniform"
-            ds.attrs["body" if elastic_d is None else "elastic"] = json.dumps(body_d or elastic_d, sort_keys=True)
+            for k, d in (("body", body_d), ("elastic", elastic_d)):
+                if d is not None:
+                    ds.attrs[k] = json.dumps(d, sort_keys=True)
             if elastic_d is not None:
                 ds.attrs["elastic_start"] = elastic_start
         if output is not None:

@@ -6,7 +6,9 @@ or its description) runs, at each (chi, N), the uniform line of N links with the
 ("shared") lumped masses released from the catenary of chi, made of those links: exactly what
 ``snapping simulate --chi CHI --N N --stretching C`` runs. Its other options are those of
 :func:`~snapping.simulate.elastic.solve` (:data:`OPTIONS`); ``method`` is ``"radau"``
-(``"fast"`` means it) or ``"dop853"``.
+(``"fast"`` means it), ``"dop853"``, ``"rodas4"`` or ``"rodas4-links"``; ``options["body"]`` (a
+:class:`~snapping.simulate.Body` or its description) rides on the line (:mod:`snapping.simulate.elastic_body`;
+methods radau, dop853, rodas4), as ``snapping simulate --stretching C --bending B`` runs it.
 
 Example
 -------
@@ -23,10 +25,10 @@ import numpy as np
 
 from . import _validate as V, _workers
 
-__all__ = ["OPTIONS", "description", "problem_of", "solve_kwargs", "run_point"]
+__all__ = ["OPTIONS", "description", "problem_of", "solve_kwargs", "run_point", "with_body"]
 
 #: the grid options an elastic run takes (besides chi, N and elastic)
-OPTIONS = ("tol", "method", "t_end", "stop_fraction", "t_end_max", "snapshot_times", "chords", "start")
+OPTIONS = ("tol", "method", "t_end", "stop_fraction", "t_end_max", "snapshot_times", "chords", "start", "body")
 #: the sweep's default tolerance of an elastic run (the CLI's)
 DEFAULT_TOL = 1e-6
 
@@ -84,8 +86,23 @@ def solve_kwargs(params: dict) -> dict:
     if kw.get("t_end") is not None:
         kw["t_end"] = V.positive("t_end", kw["t_end"])
     elastic = Elastic.from_describe(el) if isinstance(el, (dict, str)) else el
-    problem = problem_of(chi, V.integer("N", N, 1), chords)
+    problem = with_body(problem_of(chi, V.integer("N", N, 1), chords), kw.pop("body", None), method.lower())
     return {"problem": problem, "elastic": elastic, "method": method.lower(), "tol": tol, **kw}
+
+
+def with_body(problem, body, method: str):
+    """``problem`` carrying the line's ``body`` (a :class:`~snapping.simulate.Body` or its description; None:
+    none), refused by name where ``method`` steps no body (:data:`snapping.simulate.elastic_body.BODY_METHODS`)."""
+    if body is None:
+        return problem
+    from .simulate import Body
+    from .simulate.elastic_body import BODY_METHODS
+
+    body = Body.from_describe(body) if isinstance(body, (dict, str)) else body
+    if body.active and method not in BODY_METHODS:
+        raise V.SnappingInputError(f"method={method!r} steps no body on the extensible line: with a body (bending, "
+                                   f"drag) its methods are {BODY_METHODS} ('fast' is radau)")
+    return problem.with_body(body)
 
 
 def run_point(params: dict, path) -> str:
@@ -107,7 +124,7 @@ def file_bytes(params: dict) -> int:
     return int(8 * (3000 * 21 + n_snap * 12 * (int(params["N"]) + 1)) + 100_000)
 
 
-def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "stretched") -> dict:
+def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "stretched", body_d=None) -> dict:
     """One level of :func:`snapping.continuum.converge` for the extensible line: the line of links
     ``h`` from the catenary of ``chi`` to the snap, its peaks (``kappa_peak``: the run's largest
     curvature, the chain's, on the rest lengths) and cost (``link_drift`` NaN: not measured), from
@@ -120,7 +137,7 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "str
     from .simulate.dataset import load_run
     from .simulate.elastic import Elastic, solve
 
-    problem = problem_of(chi, len(h), lumping=lumping, free_end=free_end, h=h)
+    problem = with_body(problem_of(chi, len(h), lumping=lumping, free_end=free_end, h=h), body_d, "radau")
     elastic = Elastic.from_describe(elastic_d)
     ds, cpu = None, float("nan")
     if path is not None and os.path.isfile(path):
@@ -130,6 +147,7 @@ def level_row(chi, h, lumping, free_end, tol, path, elastic_d, start: str = "str
                     and "kappa_peak" in old.attrs  # (a run from before the line recorded its curvature)
                     and np.array_equal(old.link_length.values, h) and float(old.attrs["tol"]) == tol
                     and old.attrs.get("start", "stretched") == start
+                    and json.loads(old.attrs.get("problem", "{}")).get("body") == problem.describe().get("body")
                     and np.array_equal(old.node_mass.values[:-1], problem.links.m)
                     and json.loads(old.attrs["elastic"]) == json.loads(json.dumps(elastic_d, sort_keys=True))):
                 ds = old  # resumed: this level is done (its CPU time unknown)

@@ -68,10 +68,6 @@ class Grid:
         if "elastic" in self.options:  # the extensible line (snapping.sweep_elastic): its links' description
             from . import sweep_elastic
 
-            if "body" in self.options:
-                raise V.SnappingInputError("options: a body (bending, drag) is not built for the extensible line "
-                                           "(elastic) in the sweeps yet; give one of them (snapping.simulate."
-                                           "elastic.solve takes a Body)")
             self.options = {**self.options, "elastic": sweep_elastic.description(self.options["elastic"])}
             for chi in self.chi:
                 for N in self.N:

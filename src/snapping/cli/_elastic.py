@@ -135,8 +135,8 @@ def elastic_from_args(args, scales):
     if hasattr(args, "dims") and wants_3d(args):
         raise SnappingInputError("the extensible line (--ea/--stretching/...) is planar: not with --dims 3, "
                                  "--perturb or --whirl")
-    if body_from_args(args) is not None and ELASTIC_METHOD.get(args.method, "radau") not in BODY_METHODS:
-        raise SnappingInputError(f"--method {args.method} does not carry the line's body (bending, drag, wind) on "
+    if body_from_args(args) is not None and ELASTIC_METHOD.get(getattr(args, "method", None), "radau") not in BODY_METHODS:
+        raise SnappingInputError(f"--method {getattr(args, 'method', None)} does not carry the line's body (bending, drag, wind) on "
                                  f"the extensible line: its methods with a body are fast (Radau), dop853 and rodas4 "
                                  f"(or stiff)")
     n_stiff = sum(getattr(args, d) is not None for d in ("ea", "stretching", "strain_table"))

@@ -260,7 +260,7 @@ def _cmd_converge(args) -> int:
                                  f"--ratio)")
     extra = {} if body is None or not body.active else {"body": body, "n0": args.n0}
     if elastic is not None:
-        extra = {"elastic": elastic, "n0": args.n0}
+        extra = {**extra, "elastic": elastic, "n0": args.n0}  # (with the body, if any: it rides on the line)
         if args.elastic_start is not None:
             extra["elastic_start"] = args.elastic_start
     res = continuum.converge(args.chi, levels=args.levels, ratio=args.ratio, first=args.first, lumping=args.lumping,
