@@ -135,6 +135,14 @@ def rodas_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, B
                 btmp[i] += dth * ft[i]
         ES.solve(N, B, gW, gD, dlo, dhi, gh, path, F, ab, piv, btmp, St[1 + st], w)
     _comb(z1, z0, St, A_ST[5], 5, n)
+    return finish_step(z0, z1, St, c23, tol, n)
+
+
+@njit(cache=True, error_model="numpy")
+def finish_step(z0, z1, St, c23, tol, n):
+    """The end of a RODAS4 step (the plain line's and :mod:`elastic_rodas_body`'s): the dense output's
+    ``c2, c3`` into ``c23``, ``z1 += U_6`` (the stiffly accurate solution) and the scaled error (max
+    norm of ``U_6/(tol (1 + max(|z0|, |z1|)))``; inf when a value is not finite)."""
     S0, S1, S2, S3, S4, S6 = St[1], St[2], St[3], St[4], St[5], St[6]
     a0, a1, a2, a3, a4 = D2[0], D2[1], D2[2], D2[3], D2[4]
     b0, b1, b2, b3, b4 = D3[0], D3[1], D3[2], D3[3], D3[4]

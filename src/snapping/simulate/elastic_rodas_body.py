@@ -46,7 +46,7 @@ from .banded import band_lu, band_solve
 from .elastic_body import _geometry, add_body
 from .elastic_jacobian import jacobian
 from .force_drag import add_drag
-from .rosenbrock import A_ST, C_NODE, C_ST, D2, D3, D_TIME, GAMMA
+from .rosenbrock import A_ST, C_NODE, C_ST, D_TIME, GAMMA
 
 __all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "local_dissipation", "body_accept",
            "KLB", "KUB", "WIDTHB", "NGW"]
@@ -402,21 +402,7 @@ def body_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, bd
                 btmp[i] += dth * ft[i]
         solve5(N, B5, gW, gD, gh, ab, piv, btmp, St[1 + st], w)
     ER._comb(z1, z0, St, A_ST[5], 5, n)
-    S0, S1, S2, S3, S4, S6 = St[1], St[2], St[3], St[4], St[5], St[6]
-    c2 = c23[0]
-    c3 = c23[1]
-    for i in range(n):
-        c2[i] = ((((0.0 + D2[0] * S0[i]) + D2[1] * S1[i]) + D2[2] * S2[i]) + D2[3] * S3[i]) + D2[4] * S4[i]
-        c3[i] = ((((0.0 + D3[0] * S0[i]) + D3[1] * S1[i]) + D3[2] * S2[i]) + D3[3] * S3[i]) + D3[4] * S4[i]
-    err = 0.0
-    for i in range(n):
-        z1[i] += S6[i]
-        e = abs(S6[i]) / (tol * (1.0 + max(abs(z0[i]), abs(z1[i]))))
-        if not (e - e == 0.0):
-            return np.inf
-        if e > err:
-            err = e
-    return err
+    return ER.finish_step(z0, z1, St, c23, tol, n)
 
 
 @njit(cache=True, error_model="numpy")
