@@ -83,6 +83,7 @@ import time
 
 from . import _validate as V
 from .caps_inputs import END_MASS_MAX, SPEC_KEYS, SPEC_UNITS, LineSpec, spec  # noqa: F401 (caps' public names)
+from .caps_combined import combined_route
 from .caps_inputs import _pos
 from .caps_inputs import as_spec as _as_spec
 from .caps_inputs import check_chis as _check_chis
@@ -110,7 +111,7 @@ def _si(sp: LineSpec, nd: dict) -> dict:
 
 def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float = 1e-6, quantity: str = "sigma_peak",
         check: bool = True, alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL,
-        graded="auto", stretch_method: str = STRETCH_METHOD, **params) -> dict:
+        graded="auto", stretch_method: str = STRETCH_METHOD, combined: bool = False, **params) -> dict:
     """The snap of a real line from runs of the real model, the ideal chain's beside it, and
     what caps it (the module's text says how).
 
@@ -149,6 +150,9 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
         ``"auto"``: the full run on graded links, two levels extrapolated, when the line's bending
         holds a fold that N links cannot resolve (:func:`snapping.caps_runs.grading_rule`); True:
         always (a line with bending); False: never (N uniform links, as before).
+    combined : bool
+        Where a line with a body's stretching factor does not settle on uniform links, answer from the combined
+        model on graded links (:mod:`snapping.caps_combined`; minutes of CPU); False: leave stretching out (said).
     **params
         :func:`spec`'s keywords (SI), overriding the line's.
 
@@ -199,7 +203,7 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
 
     bar = tqdm(desc=f"{sp.name or 'line'}, chi={chi:g}", unit="run", leave=False, disable=None)  # (off without a terminal)
     try:
-        runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method, bar=bar)
+        runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method, bar=bar, combined=combined)
         if N == "auto":
             r = _auto(runs, quantity, alone, graded)
         else:
@@ -213,6 +217,8 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
                                   f"a chain of {own} discrete links answered on N = {N} as asked")}
         if on_own:
             r["resolved"] = True  # (its links are the line's: exact in N)
+    if r["stretching"].get("combined") and "resolved" in r:  # (the real answer is the combined model's)
+        r["resolved"] = r["stretching"]["resolved"][quantity]
     r.update({"runs": runs.log, "n_rhs": sum(x["n_rhs"] for x in runs.log), "wall": time.perf_counter() - t0,
               "cpu": time.process_time() - c0})
     return r
@@ -256,6 +262,10 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                 runs.log.append({"run": "stretching", "N": f["N"], "method": f.get("method", "elastic " + runs.stretch_method),
                                  "tol": runs.tol, "n_rhs": f["n_rhs"], "cpu": f["cpu"]})
             factor_s, ok = accept_factors(*({q: f[q] for q in QUANTITIES} for f in sl), RESOLVED)
+            cg = None
+            if body and runs.combined and not all(ok.values()):  # unsettled: the combined model on graded links answers
+                cg = combined_route(runs, present, full_nd, sl, ok)
+                factor_s, ok = cg["factor"], cg["resolved"]
             stretching.update({"run": True, "factor": factor_s, "resolved": ok, "N": sl[1]["N"], "body": body,
                                "model": "combined (elastic + body) over inextensible" if body else "elastic over rigid",
                                "levels": [{"N": f["N"], **{q: f[q] for q in QUANTITIES}, "s_sigma": f["s_sigma"],
@@ -267,6 +277,8 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                          f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
                                       + "); " + stretch_words(sl, ok)
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
+            if cg is not None:
+                stretching.update(model="combined (elastic + body) on graded links", combined=cg, why=cg["why"])
             if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -327,7 +339,7 @@ def unresolved_stretching_words(v_over_c: float, body: bool = False) -> str:
     0.654, 0.638 on 30-240 links)."""
     return (f" (so the error bars above do not hold stretching: at v/c = {v_over_c:.2g} it is not negligible -- the "
             f"elastic guide measured peaks changed by 0.1-0.3% at v/c 1-3%, 4-11% near 0.2; "
-            + ("the combined model's fold, like the inextensible one's, is not resolved on uniform links)" if body else
+            + ("the combined model's fold is not resolved on uniform links; combined=True answers on graded links)" if body else
                "the factor is the ideal chain's, whose v/c grows with its links, not this line's)"))
 
 

@@ -32,6 +32,10 @@ def add_real_options(p, resolve: bool = True) -> None:
     g.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",
                    help="drag area C_d A of the free end's tip body in m^2")
     if resolve:
+        g.add_argument("--combined", action="store_true",
+                       help="where a line with bending or drag stretches and its stretching factor does not settle "
+                            "on uniform links (the climbing rope), answer from the combined model on graded links "
+                            "(snapping.caps_combined: minutes of CPU; default: stretching left out, and said)")
         g.add_argument("--resolve", action="store_true",
                        help="double the links from 100 (to 1600 at most) until the peak of --quantity moves by at "
                             "most 1%%, or graded links (instead of --links; the default without --links since "
@@ -46,7 +50,7 @@ def wants_real(args) -> bool:
 
 
 #: options that only a real line's answer takes (refused, not ignored, for the ideal chain's table)
-REAL_ONLY = (("quantity", "--quantity"), ("resolve", "--resolve"), ("chis", "--chis"))
+REAL_ONLY = (("quantity", "--quantity"), ("resolve", "--resolve"), ("chis", "--chis"), ("combined", "--combined"))
 
 
 def refuse_real_only(args) -> None:
@@ -114,7 +118,7 @@ def cmd_real_estimate(args) -> int:
     if args.resolve and links is not None:
         raise SnappingInputError("--resolve chooses the links itself: give --resolve or --links, not both")
     N = "auto" if args.resolve else links  # (None: caps.cap's "auto", a line of discrete links its own)
-    r = caps.cap(sp, _chi(args, sp), N=N, quantity=args.quantity)
+    r = caps.cap(sp, _chi(args, sp), N=N, quantity=args.quantity, combined=args.combined)
     if args.json:
         print_json({**r, "dimensionless_numbers": r["numbers"]})
     else:
