@@ -201,15 +201,15 @@ def test_cli_real_line_still_answers_with_the_default_quantity(capsys, monkeypat
     """--quantity sigma_peak (the default) with a real line is taken, and reaches caps.cap."""
     got = {}
 
-    def fake_cap(sp, chi, N, quantity):
-        got.update(chi=chi, N=N, quantity=quantity, length=sp.length)
+    def fake_cap(sp, chi, N, quantity, combined=False):
+        got.update(chi=chi, N=N, quantity=quantity, length=sp.length, combined=combined)
         raise SnappingInputError("stop here")
 
     monkeypatch.setattr(caps, "cap", fake_cap)
     rc, err = _cli(capsys, "estimate", "--line", "bungee-cord", "--length", "2", "--separation", "0.5", "--links",
                    "40", "--quantity", "v_peak")
     assert rc == 2 and "stop here" in err
-    assert got == {"chi": 0.25, "N": 40, "quantity": "v_peak", "length": 2.0}
+    assert got == {"chi": 0.25, "N": 40, "quantity": "v_peak", "length": 2.0, "combined": False}
 
 
 def test_elastic_run_interrupted_says_nothing_was_kept(capsys, monkeypatch, tmp_path):
