@@ -38,6 +38,21 @@ def _add_block(J, i, k, s, a00, a01, a10, a11, b00, b01, b10, b11):
 
 
 @njit(cache=True, error_model="numpy")
+def add_link_gradient(gD, N, j, gdx, gdy, gvx, gvy):
+    """Link j's part of the D row's gradient: ``-(gdx, gdy, gvx, gvy)`` on node j's position and
+    velocity, ``+`` on node j + 1's (none for the held end)."""
+    gD[4 * j] -= gdx
+    gD[4 * j + 1] -= gdy
+    gD[4 * j + 2] -= gvx
+    gD[4 * j + 3] -= gvy
+    if j + 1 < N:
+        gD[4 * j + 4] += gdx
+        gD[4 * j + 5] += gdy
+        gD[4 * j + 6] += gvx
+        gD[4 * j + 7] += gvy
+
+
+@njit(cache=True, error_model="numpy")
 def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J, gW, gD):
     """The Jacobian the method uses, from the tensions ``T``, strains ``E`` and strain rates
     ``ED`` of ``z`` (those :func:`elastic_kernels.rhs` left): the node blocks of
@@ -77,15 +92,7 @@ def jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J, gW, gD):
             f, fp = EK.law(E[j], ea[j], tabe, tabt)
             gdx, gdy = -(fp * ed * ux + f * px), -(fp * ed * uy + f * py)
             gvx, gvy = -f * ux, -f * uy
-        gD[4 * j] -= gdx
-        gD[4 * j + 1] -= gdy
-        gD[4 * j + 2] -= gvx
-        gD[4 * j + 3] -= gvy
-        if j + 1 < N:
-            gD[4 * j + 4] += gdx
-            gD[4 * j + 5] += gdy
-            gD[4 * j + 6] += gvx
-            gD[4 * j + 7] += gvy
+        add_link_gradient(gD, N, j, gdx, gdy, gvx, gvy)
         if tj == 0.0:
             continue
         # the node blocks (jac_given)

@@ -44,7 +44,7 @@ from . import elastic_kernels as EK
 from . import elastic_rodas as ER
 from .banded import band_lu, band_solve
 from .elastic_body import _geometry, add_body
-from .elastic_jacobian import jacobian
+from .elastic_jacobian import add_link_gradient, jacobian
 from .force_drag import add_drag
 from .rosenbrock import A_ST, C_NODE, C_ST, D_TIME, GAMMA
 
@@ -216,15 +216,7 @@ def compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD):
         else:
             gdx, gdy = -(fp * ed * ux + f * px), -(fp * ed * uy + f * py)
             gvx, gvy = -f * ux, -f * uy
-        gD[4 * j] -= gdx
-        gD[4 * j + 1] -= gdy
-        gD[4 * j + 2] -= gvx
-        gD[4 * j + 3] -= gvy
-        if j + 1 < N:
-            gD[4 * j + 4] += gdx
-            gD[4 * j + 5] += gdy
-            gD[4 * j + 6] += gvx
-            gD[4 * j + 7] += gvy
+        add_link_gradient(gD, N, j, gdx, gdy, gvx, gvy)
         if tj == 0.0:
             continue
         bl = EK.link_blocks(tj, fp, c, h[j], ln, ux, uy, dvx, dvy, udv)
