@@ -83,7 +83,7 @@ import time
 
 from . import _validate as V
 from .caps_inputs import END_MASS_MAX, SPEC_KEYS, SPEC_UNITS, LineSpec, spec  # noqa: F401 (caps' public names)
-from .caps_combined import combined_route
+from .caps_combined import combined_route, combined_verdict
 from .caps_format import format_answer, format_design  # noqa: F401 (caps' public names)
 from .caps_inputs import _pos
 from .caps_inputs import as_spec as _as_spec
@@ -278,8 +278,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                          f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
                                       + "); " + stretch_words(sl, ok)
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
-            if cg is not None:
+            if cg is not None:  # the ideal beside it: on the same graded links, extrapolated (its continuum limit)
                 stretching.update(model="combined (elastic + body) on graded links", combined=cg, why=cg["why"])
+                ideal_uniform, ideal_nd = ideal_nd, {**cg["ideal"]["extrapolated"], "method": ideal_nd["method"]}
             if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -300,16 +301,23 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     judged = {m: v[quantity] for m, v in alone_nd.items() if m != "stretching" or stretching["resolved"][quantity]}
     capped = decide(factor[quantity], real_nd[quantity], judged,
                     bool(present or (stretching["run"] and stretching["resolved"][quantity])), alone)
+    extra, rule_c = {}, ""
+    if stretching.get("combined"):  # (the verdict splits the ratio on the same links: :func:`combined_verdict`)
+        capped, why = combined_verdict(stretching["combined"], quantity, factor[quantity], judged,
+                                       lambda a: decide(0.0, real_nd[quantity], a, True, alone))
+        extra = {"cap_why": why, "ideal_uniform": _si(sp, ideal_uniform)}
+        rule_c = ("; combined: against the ideal's limit on the same graded links, the mechanism of the larger step "
+                  "down on the finest level (stretching's, or the body's by the runs alone)")
     from .regimes_analysis import LEVEL
 
     rule = (f"{quantity}: real/ideal >= {LEVEL:g} -> none (the ideal chain's own cap: geometry and links); else the "
-            f"mechanism whose run alone is closest to the real answer in |log(alone/real)|")
+            f"mechanism whose run alone is closest to the real answer in |log(alone/real)|") + rule_c
     return {"line": sp.name, "chi": chi, "N": N, "tol": runs.tol, "quantity": quantity, "numbers": sp.numbers(N),
             "mechanisms": present + (["stretching"] if stretching["run"] else []),
             "ideal": _si(sp, ideal_nd), "full": _si(sp, full_nd), "real": _si(sp, real_nd),
             "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
             "stretching": stretching, "resolution": resolution, "damping": runs.damping, "graded": grade,
-            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}}
+            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}, **extra}
 
 
 def stretch_words(levels: list, resolved: dict) -> str:
@@ -456,7 +464,7 @@ def auto_graded(runs, grading: dict, graded="auto") -> str:
 def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int | None = None, tol: float = 1e-6,
            max_tension=None, max_speed=None, max_acceleration=None, quantity: str = "sigma_peak",
            alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL, graded="auto",
-           **params) -> dict:
+           combined: bool = False, **params) -> dict:
     """Which end separations keep the real line's peaks under the limits: :func:`cap` at each chi
     of ``chis`` (the ideal, full and, with ``alone``, each-mechanism-alone runs; no N/2 check).
     ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
@@ -465,7 +473,8 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it, ``N`` (the
     row's links) and ``resolved``. ``N``: the links of every run; None (the default) or ``"auto"``:
     each chi on the links that resolve it, :func:`cap`'s ``N="auto"`` (since ``designres``; 200
-    links for every chi before), a line of discrete links on its own."""
+    links for every chi before), a line of discrete links on its own. ``combined``: :func:`cap`'s (the
+    combined model on graded links where a line with a body's stretching factor does not settle)."""
     sp = _as_spec(line, params)
     chis = _check_chis(chis)
     own = sp.own_links()
@@ -489,7 +498,7 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
 
     for chi in tqdm(sorted(chis), desc=f"design {sp.name or 'line'}", unit="chi", leave=False, disable=None):
         r = cap(sp, chi, N=N, tol=tol, check=False, alone=alone, quantity=quantity, damping=damping,
-                stiff_tol=stiff_tol, graded=graded)
+                stiff_tol=stiff_tol, graded=graded, combined=combined)
         n_rhs += r["n_rhs"]
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],

@@ -16,6 +16,13 @@ def format_answer(r: dict) -> list[str]:
            f"{r['tol']:g})", f"  {'peak':<12}{'ideal chain':>14}{'real line':>14}{'factor':>9}   units"]
     for q, u in QUANTITIES.items():
         out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
+    cg = r["stretching"].get("combined")
+    if cg and r.get("ideal_uniform"):
+        iu, lv = r["ideal_uniform"], "/".join(str(x["links"]) for x in cg["levels"])
+        out.append(f"  ideal chain: on the combined model's graded links ({lv}), levels {cg['pair'][0]}-{cg['pair'][1]} "
+                   "extrapolated (its continuum limit): " + ", ".join(
+                       f"{q} +- {cg['ideal']['relative_error'][q]:.2%}" for q in QUANTITIES)
+                   + f"; on {r['N']} uniform links it is " + ", ".join(f"{q} {iu[q]:.5g}" for q in QUANTITIES))
     if r["alone"]:
         left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
@@ -50,7 +57,8 @@ def format_answer(r: dict) -> list[str]:
         out.append(f"  resolution ({what}): " + ", ".join(f"{q} {v:+.2%}" for q, v in r["resolution"].items()))
     verdict = ("nothing but the ideal chain's own cap (real within 10% of ideal)" if r["cap"] == "none" else r["cap"])
     out.append(f"  capped by: {verdict} -- {r['quantity']} {r['real'][r['quantity']]:.5g} "
-               f"{QUANTITIES[r['quantity']]} (ideal {r['ideal'][r['quantity']]:.5g})")
+               f"{QUANTITIES[r['quantity']]} (ideal {r['ideal'][r['quantity']]:.5g})"
+               + (f"; {r['cap_why']}" if r.get("cap_why") else ""))
     out.append(f"  rule: {r['rule']}")
     stiff = [f"{x['run']} ({x['N']})" for x in r.get("runs", ()) if x["method"] == "rodas4"]
     out.append(f"  cost: {r['n_rhs']} right-hand-side evaluations, {r['wall']:.2f} s ({r['cpu']:.2f} s CPU); "
@@ -74,7 +82,8 @@ def format_design(d: dict) -> list[str]:
         i, x = r["ideal"], r["real"]
         where = ""
         if auto:
-            where = ("graded" if r.get("graded", {}).get("used") else str(r.get("N")))
+            where = ("combined" if r.get("stretching", {}).get("combined") else
+                     "graded" if r.get("graded", {}).get("used") else str(r.get("N")))
             where = f"  {where}{'' if r.get('resolved') else ' (NOT resolved)'}"
         out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
@@ -85,6 +94,11 @@ def format_design(d: dict) -> list[str]:
           for r in d["rows"] if r.get("graded", {}).get("used")]
     if gr:
         out.append(f"  real peaks from graded links, the last two levels extrapolated, at chi: {', '.join(gr)}")
+    cb = [f"{r['chi']:g} (T +- {r['stretching']['combined']['relative_error']['sigma_peak']:.2%}; capped by "
+          f"{r['cap']}: {r.get('cap_why', '')})" for r in d["rows"] if r.get("stretching", {}).get("combined")]
+    if cb:
+        out.append("  real peaks from the combined model (elastic + body) on graded links, extrapolated, against the "
+                   f"ideal chain's limit on the same links, at chi: {'; '.join(cb)}")
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:

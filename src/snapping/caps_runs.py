@@ -440,18 +440,21 @@ class Runs:
             self.bar.set_postfix_str(f"{entry['run']}: {entry['N']} links, {entry['cpu']:.1f} s", refresh=False)
             self.bar.update(1)
 
-    def get(self, on, N: int) -> dict:
-        key = (tuple(on), int(N))
+    def get(self, on, N: int, h=None, where: str = "") -> dict:
+        """The run with the mechanisms ``on`` on ``N`` uniform links, or on the links ``h`` (``where`` names
+        them, in the key and the log), by the fast method or, where bending waves are stiff, RODAS4 with
+        them grid-damped (:func:`method_for`); made once."""
+        key = (tuple(on), int(N)) + ((where,) if where else ())
         if key not in self.done:
-            p = problem(self.sp, self.chi, N, on)
+            p = problem(self.sp, self.chi, N, on, h=h)
             method, tol, omega_min = ("fast", self.tol, 0.0) if self.damping <= 0.0 else method_for(
                 p, self.tol, self.stiff_tol)
             if method == "rodas4":
-                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min)
+                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min, h=h)
             r = _run(p, method, tol)
             self.done[key] = r
-            self._logged({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
-                             "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
+            self._logged({"run": ("+".join(on) or "ideal") + (f" ({where})" if where else ""), "N": int(N),
+                          "method": r["method"], "tol": r["tol"], "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
 
     def stretching_body(self, present) -> list:
