@@ -71,6 +71,7 @@ def _unsettled(monkeypatch):
         ideal = [{"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 200.0 * (1.0 - 0.5 * 4.0 ** -k)}
                  for k in range(len(cg["levels"]))]
         return {"ideal": {"levels": ideal, "extrapolated": {"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 200.0},
+                          "links": [800, 1600],
                           "relative_error": {q: 0.0 for q in Q}},
                 "inextensible": [{"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 400.0} for _ in ideal]}
 
@@ -96,9 +97,9 @@ def test_cap_answers_from_the_combined_model_where_the_factor_does_not_settle(mo
     # on the finest level stretching's step 100.04/400 outweighs the body's 400/199.6: stretching caps it
     assert r["ideal"]["sigma_peak"] == pytest.approx(200.0 * si["sigma_peak"], rel=1e-12)
     assert r["factor"]["sigma_peak"] == pytest.approx(0.5, rel=1e-12)
-    assert r["ideal_uniform"]["sigma_peak"] < 150.0 * si["sigma_peak"]
+    assert r["ideal_on"]["uniform"]["sigma_peak"] < 150.0 * si["sigma_peak"] and r["ideal_on"]["what"] == "combined"
     assert r["cap"] == "stretching" and "x0.25" in r["cap_why"] and "x2" in r["cap_why"]
-    assert "ideal chain: on the combined model's graded links" in "\n".join(caps.format_answer(r))
+    assert "ideal chain: on the combined model's graded links (800 and 1600)" in "\n".join(caps.format_answer(r))
 
 
 def _cg(real, inext, ideal):
@@ -177,8 +178,9 @@ def test_same_links_runs_the_ideal_and_the_inextensible_line_on_the_combined_lev
         assert got["ideal"]["extrapolated"][q] == pytest.approx((4.0 * f1 - f0) / 3.0, rel=1e-12), q
         assert got["ideal"]["relative_error"][q] == pytest.approx(abs(f1 - f0) / 3.0 / abs((4.0 * f1 - f0) / 3.0),
                                                                    rel=1e-9), q
-    assert [x["run"] for x in runs.log] == ["ideal (combined level 0)", "drag (combined level 0)",
-                                            "ideal (combined level 1)", "drag (combined level 1)"]
+    assert [x["run"] for x in runs.log] == ["ideal (combined level 0)", "ideal (combined level 1)",
+                                            "drag (combined level 0)", "drag (combined level 1)"]
+    assert got["ideal"]["links"] == [links(0.3, 0).size, links(0.3, 1).size]
 
 
 def test_design_takes_the_combined_route(monkeypatch, capsys):

@@ -230,6 +230,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     sp, chi = runs.sp, runs.chi
     present = [m for m in MECHANISMS[:-1] if sp.has(m)]
     ideal_nd = runs.get((), N)
+    ideal_on = None  # graded or combined answers: the ideal on their links, extrapolated (its uniform-links run kept)
     grade = _grading(runs, N, present, graded)
     if grade["used"]:
         on, lb = tuple(present), bending_length(sp)
@@ -242,6 +243,10 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         grade["error"] = _si(sp, gl["error"])
         grade["within"] = gl["stopped"] == "within"
         check = False
+        gi = runs.ideal_on([(graded_h(chi, lb, k), f"graded {k}") for k in gl["pair"]])  # the ideal on the same links
+        ideal_on = {"what": "graded", "links": gi["links"], "relative_error": gi["relative_error"],
+                    "uniform": _si(sp, ideal_nd), "N": N}
+        ideal_nd = {**gi["extrapolated"], "method": gi["levels"][1]["method"]}
     else:
         full_nd = runs.get(tuple(present), N)
     alone_nd = {}
@@ -280,7 +285,10 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
             if cg is not None:  # the ideal beside it: on the same graded links, extrapolated (its continuum limit)
                 stretching.update(model="combined (elastic + body) on graded links", combined=cg, why=cg["why"])
-                ideal_uniform, ideal_nd = ideal_nd, {**cg["ideal"]["extrapolated"], "method": ideal_nd["method"]}
+                gi = cg["ideal"]
+                ideal_on = {"what": "combined", "links": gi["links"], "relative_error": gi["relative_error"],
+                            "uniform": _si(sp, runs.get((), N)), "N": N}
+                ideal_nd = {**gi["extrapolated"], "method": ideal_nd["method"]}
             if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -305,7 +313,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     if stretching.get("combined"):  # (the verdict splits the ratio on the same links: :func:`combined_verdict`)
         capped, why = combined_verdict(stretching["combined"], quantity, factor[quantity], judged,
                                        lambda a: decide(0.0, real_nd[quantity], a, True, alone))
-        extra = {"cap_why": why, "ideal_uniform": _si(sp, ideal_uniform)}
+        extra = {"cap_why": why}
         rule_c = ("; combined: against the ideal's limit on the same graded links, the mechanism of the larger step "
                   "down on the finest level (stretching's, or the body's by the runs alone)")
     from .regimes_analysis import LEVEL
@@ -317,7 +325,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
             "ideal": _si(sp, ideal_nd), "full": _si(sp, full_nd), "real": _si(sp, real_nd),
             "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
             "stretching": stretching, "resolution": resolution, "damping": runs.damping, "graded": grade,
-            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}, **extra}
+            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}, "ideal_on": ideal_on, **extra}
 
 
 def stretch_words(levels: list, resolved: dict) -> str:

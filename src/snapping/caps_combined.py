@@ -38,8 +38,7 @@ from __future__ import annotations
 import math
 import time
 
-from .caps_runs import (GRID_DAMPING, GRADED_ORDER, GRADED_WITHIN, QUANTITIES, graded_levels, method_for, problem,
-                        richardson)
+from .caps_runs import GRID_DAMPING, GRADED_ORDER, GRADED_WITHIN, QUANTITIES, graded_levels, method_for, problem
 
 __all__ = ["combined_links", "combined_level", "combined_answer", "combined_route", "COMBINED_METHOD",
            "COMBINED_TOL", "COMBINED_MAX_LINKS", "COMBINED_FIRST", "COMBINED_DAMPING", "same_links", "combined_verdict"]
@@ -142,17 +141,10 @@ def same_links(runs, present, cg: dict) -> dict:
     ``cg`` (:func:`combined_links`; ``runs.get``: the fast method, RODAS4 where bending waves are stiff), the
     ideal's extrapolated on ``cg``'s pair at :data:`GRADED_ORDER`: ``ideal`` (``levels``, ``extrapolated``,
     ``error``, ``relative_error``) and ``inextensible`` (its levels' peaks), nondimensional."""
-    ideal, inext = [], []
-    for k, x in enumerate(cg["levels"]):
-        h = combined_links(runs.chi, k)
-        ideal.append(runs.get((), h.size, h=h, where=f"combined level {k}"))
-        inext.append(runs.get(tuple(present), h.size, h=h, where=f"combined level {k}"))
-    a, b = cg["pair"]
-    ext = {q: richardson(ideal[a][q], ideal[b][q], GRADED_ORDER) for q in QUANTITIES}
-    return {"ideal": {"levels": ideal, "extrapolated": {q: ext[q][0] for q in QUANTITIES},
-                      "error": {q: ext[q][1] for q in QUANTITIES},
-                      "relative_error": {q: ext[q][1] / abs(ext[q][0]) for q in QUANTITIES}},
-            "inextensible": inext}
+    hs = [(combined_links(runs.chi, k), f"combined level {k}") for k in range(len(cg["levels"]))]
+    ideal = [runs.get((), h.size, h=h, where=where) for h, where in hs]  # (made once: ideal_on takes the pair's)
+    inext = [runs.get(tuple(present), h.size, h=h, where=where) for h, where in hs]
+    return {"ideal": {**runs.ideal_on([hs[k] for k in cg["pair"]]), "levels": ideal}, "inextensible": inext}
 
 
 def combined_verdict(cg: dict, quantity: str, factor: float, alone: dict, decide) -> tuple[str, str]:

@@ -16,13 +16,14 @@ def format_answer(r: dict) -> list[str]:
            f"{r['tol']:g})", f"  {'peak':<12}{'ideal chain':>14}{'real line':>14}{'factor':>9}   units"]
     for q, u in QUANTITIES.items():
         out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
-    cg = r["stretching"].get("combined")
-    if cg and r.get("ideal_uniform"):
-        iu, lv = r["ideal_uniform"], "/".join(str(x["links"]) for x in cg["levels"])
-        out.append(f"  ideal chain: on the combined model's graded links ({lv}), levels {cg['pair'][0]}-{cg['pair'][1]} "
-                   "extrapolated (its continuum limit): " + ", ".join(
-                       f"{q} +- {cg['ideal']['relative_error'][q]:.2%}" for q in QUANTITIES)
-                   + f"; on {r['N']} uniform links it is " + ", ".join(f"{q} {iu[q]:.5g}" for q in QUANTITIES))
+    io = r.get("ideal_on")
+    if io:
+        out.append(f"  ideal chain: on the {'combined model' if io['what'] == 'combined' else 'full run'}'s graded "
+                   f"links ({' and '.join(map(str, io['links']))}), extrapolated as it (the real answer's links; the "
+                   f"ideal's peaks grow with uniform links): " + ", ".join(
+                       f"{q} +- {io['relative_error'][q]:.2%}" for q in QUANTITIES)
+                   + f"; on {io['N']} uniform links it is " + ", ".join(f"{q} {io['uniform'][q]:.5g}"
+                                                                         for q in QUANTITIES))
     if r["alone"]:
         left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(

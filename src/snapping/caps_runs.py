@@ -457,6 +457,19 @@ class Runs:
                           "method": r["method"], "tol": r["tol"], "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
 
+    def ideal_on(self, links: list) -> dict:
+        """The ideal chain on two levels of graded links (``links``: [(h, where), (h, where)], coarse first;
+        :meth:`get`, the fast method) extrapolated at :data:`GRADED_ORDER` (:func:`richardson`): the ideal beside
+        a graded answer, on its links: ``levels`` (the two runs' peaks), ``extrapolated``, ``error`` and
+        ``relative_error`` per peak (nondimensional), ``links`` (their sizes). Its own fold is not the real
+        line's: where the links stop refining at the line's bending length, the ideal's estimate can stay large
+        (said: ``relative_error``)."""
+        lv = [self.get((), h.size, h=h, where=where) for h, where in links]
+        ext = {q: richardson(lv[0][q], lv[1][q], GRADED_ORDER) for q in QUANTITIES}
+        return {"levels": lv, "extrapolated": {q: ext[q][0] for q in QUANTITIES}, "links": [h.size for h, _ in links],
+                "error": {q: ext[q][1] for q in QUANTITIES},
+                "relative_error": {q: ext[q][1] / abs(ext[q][0]) for q in QUANTITIES}}
+
     def stretching_body(self, present) -> list:
         """The stretching factor's two levels for a line with a body (bending or drag among ``present``):
         :func:`stretch_factor_body` on :data:`STRETCH_BODY_LEVELS` (:func:`snapping.caps.cap` takes any other
