@@ -246,12 +246,12 @@ def _answers(names, chis, N) -> int:
 
 
 def _ideal_on(r: dict) -> str:
-    """Where the ideal beside an answer ran: on its graded links (its own error on T, its run on the answer's
-    uniform links beside) or on the answer's links."""
+    """What the ideal beside an answer is: its continuum limit (or a stand-in: graded, uniform; its error on T,
+    its run on the answer's uniform links beside) or the chain on the answer's links."""
     io = r.get("ideal_on")
     if not io:
         return "on the answer's links"
-    return (f"{io['what']} {'/'.join(map(str, io['links']))}: +-{io['relative_error']['sigma_peak']:.2%}; "
+    return (f"{io['source']['sigma_peak']}: +-{io['relative_error']['sigma_peak']:.2%}; "
             f"{io['uniform']['sigma_peak']:.4g} on {io['N']}")
 
 

@@ -318,7 +318,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         capped, why = combined_verdict(stretching["combined"], quantity, factor[quantity], judged,
                                        lambda a: decide(0.0, real_nd[quantity], a, True, alone))
         extra = {"cap_why": why}
-        rule_c = ("; combined: against the ideal's limit on the same graded links, the mechanism of the larger step "
+        rule_c = ("; combined: against the ideal's continuum limit, the mechanism of the larger step "
                   "down on the finest level (stretching's, or the body's by the runs alone)")
     from .regimes_analysis import LEVEL
 
