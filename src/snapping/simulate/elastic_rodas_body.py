@@ -44,11 +44,12 @@ from . import elastic_kernels as EK
 from . import elastic_rodas as ER
 from .banded import band_lu, band_solve
 from .elastic_body import _geometry, add_body
+from .elastic_body_jacobian import body_terms_jacobian
 from .elastic_jacobian import add_link_gradient, jacobian
 from .force_drag import add_drag
 from .rosenbrock import A_ST, C_NODE, C_ST, D_TIME, GAMMA
 
-__all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "local_dissipation", "body_accept",
+__all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "body_jacobian_fd", "local_dissipation", "body_accept",
            "KLB", "KUB", "WIDTHB", "NGW"]
 
 #: the body's reduced stage matrix's bandwidths (2 x 2 blocks reaching nodes i-2..i+2, interleaved x, y)
@@ -241,14 +242,9 @@ def compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD):
 
 
 @njit(cache=True, error_model="numpy")
-def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
-                  QP, Q, hmin):
-    """The Jacobian of :func:`body_rhs` at ``(t, z)`` (``T, E, ED`` the springs' there): the node blocks
-    ``B5`` (N x 5 x 8, see the module), the W row's gradient ``gW`` (nodes N-3..N-1) and the D row's ``gD``
-    (4N). The springs' part exact (:func:`elastic_jacobian.jacobian` into ``J3, gW4``), the body's by
-    central differences, the nodes perturbed in colours mod 5, the steps of
-    :func:`elastic_body.body_jac_fd` (``1e-6 hmin`` in position, ``2e-6`` of the shortest link where a
-    link is shorter than ``hmin/2``; ``1e-6 (1 + |v|)`` in velocity)."""
+def _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD):
+    """The springs' (:func:`elastic_jacobian.jacobian`) and the compressed links' (:func:`compression_jacobian`)
+    part of :func:`body_jacobian` into ``B5, gW, gD`` (overwritten)."""
     jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, gD)
     for i in range(N):
         for k in range(5):
@@ -260,6 +256,32 @@ def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4
         gW[8 + q] = gW4[q]
     if bd[7][P_PUSH] != 0.0:
         compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD)
+
+
+@njit(cache=True, error_model="numpy")
+def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
+                  QP, Q, hmin):
+    """The Jacobian of :func:`body_rhs` at ``(t, z)`` (``T, E, ED`` the springs' there): the node blocks
+    ``B5`` (N x 5 x 8, see the module), the W row's gradient ``gW`` (nodes N-3..N-1) and the D row's ``gD``
+    (4N). The springs' part exact (:func:`elastic_jacobian.jacobian` into ``J3, gW4``), the compressed links'
+    (:func:`compression_jacobian`), the body's (bending, drag) exact too
+    (:func:`elastic_body_jacobian.body_terms_jacobian`, branch fastbody; the coloured differences before,
+    :func:`body_jacobian_fd`, ~20x its cost). ``zz, GX, GY, QP, Q, hmin``: the differences' (unused here)."""
+    _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD)
+    Bl, K0L, El, CN, CT, KN, KT, sc, cx, cc = bd
+    ex, ey, phid = clamp_at(t, sc, cx, cc)
+    body_terms_jacobian(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, sc, ex, ey, phid, bs, B5, gW, gD,
+                        np.empty((4, 4)))
+
+
+@njit(cache=True, error_model="numpy")
+def body_jacobian_fd(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
+                  QP, Q, hmin):
+    """:func:`body_jacobian` with the body's part by central differences (the method's Jacobian until
+    branch fastbody, kept for the tests of the exact one), the nodes perturbed in colours mod 5, the steps of
+    :func:`elastic_body.body_jac_fd` (``1e-6 hmin`` in position, ``2e-6`` of the shortest link where a
+    link is shorter than ``hmin/2``; ``1e-6 (1 + |v|)`` in velocity)."""
+    _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD)
     n = z.shape[0]
     for i in range(n):
         zz[i] = z[i]
