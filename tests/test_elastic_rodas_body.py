@@ -163,3 +163,55 @@ def test_plain_line_bit_for_bit(start, pulled, v, a, s, nrhs, nsteps):
         A = solve(p, Elastic.from_wave_speed(30.0), tol=1e-6, method="rodas4", start=start, t_end=0.6).dataset.attrs
         assert (A["v_peak"], A["a_peak"], A["sigma_peak"], A["n_rhs"], A["n_steps"]) == (v, a, s, nrhs, nsteps)
         assert A["n_lu_pivoted"] == 0
+
+
+def _body_part(st, jac):
+    """The body's part (bending, drag: without the springs and the compressed links' push) of ``jac``
+    (:func:`RB.body_jacobian` or :func:`RB.body_jacobian_fd`) at the stepper's state: ``(B5, gW, gD)``."""
+    N = st.N
+    args = (N, st.t, st.y, st.pins[6], *st.bargs()[:6], *st.work[:3], st.J3, st.gW4, st.bd)
+    tail = (st.bs, st.zz, st.GX, st.GY, st.QP, st.Q, st.hmin)
+    S = (np.zeros((N, 5, 8)), np.zeros(RB.NGW), np.zeros(4 * N))
+    RB._springs_part(N, *args[2:], *S)
+    out = (np.zeros((N, 5, 8)), np.zeros(RB.NGW), np.zeros(4 * N))
+    jac(*args, *out, *tail)
+    return tuple(a - s for a, s in zip(out, S))
+
+
+@pytest.mark.parametrize("clamp", ["table", "angle", "none"])
+@pytest.mark.parametrize("seed", [2, 7])
+def test_exact_body_jacobian(clamp, seed):
+    """Branch fastbody: the body's exact Jacobian (:mod:`elastic_body_jacobian`) against central differences
+    of the body's own forces (:meth:`LineBody.forces`, the Radau path's Python-called kernel, push off),
+    node by node, and against the coloured differences it replaced (:func:`RB.body_jacobian_fd`) for the W
+    and D rows; each part (K, C, W, D) to 1e-8 of its own size (the differences' error is ~3e-10)."""
+    line, z = _random_line(N=12, clamp=clamp, seed=seed)
+    N, t = line.N, 0.13
+    st = RodasBodyStepper(line, t, z, 1.0, 1e-6)
+    B5, gW, gD = _body_part(st, RB.body_jacobian)
+    J = np.zeros((2 * N, 4 * N))  # the body's accelerations by the node states
+    for i in range(N):
+        for k in range(5):
+            jn = i - 2 + k
+            if 0 <= jn < N:
+                for r in range(2):
+                    J[2 * i + r, 4 * jn:4 * jn + 2] = B5[i, k, 2 * r:2 * r + 2]
+                    J[2 * i + r, 4 * jn + 2:4 * jn + 4] = B5[i, k, 4 + 2 * r:6 + 2 * r]
+    Jd = np.zeros_like(J)
+    for c in range(4 * N):
+        e = 1e-6 * (1.0 + abs(z[c]))
+        zp, zm = z.copy(), z.copy()
+        zp[c] += e
+        zm[c] -= e
+        fp, fm = line.body.forces(t, zp, push=False)[:2], line.body.forces(t, zm, push=False)[:2]
+        Jd[0::2, c] = (fp[0][:N] - fm[0][:N]) / (2.0 * e) / line.m
+        Jd[1::2, c] = (fp[1][:N] - fm[1][:N]) / (2.0 * e) / line.m
+    pos = np.tile([True, True, False, False], N)
+    for part in (pos, ~pos):  # K (positions) and C (velocities)
+        assert np.abs(Jd[:, part]).max() > 10.0
+        assert np.abs(J[:, part] - Jd[:, part]).max() < 1e-8 * np.abs(Jd[:, part]).max()
+    Bf, gWf, gDf = _body_part(st, RB.body_jacobian_fd)
+    assert np.abs(B5 - Bf).max() < 1e-8 * np.abs(Bf).max()
+    for a, b in ((gW, gWf), (gD, gDf)):
+        assert np.abs(b).max() > 0.1
+        assert np.abs(a - b).max() < 1e-8 * np.abs(b).max()
