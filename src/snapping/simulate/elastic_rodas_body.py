@@ -11,26 +11,27 @@ same tableau, controller and dense output); what differs:
   i-1 and i): the springs' exact blocks (:func:`elastic_jacobian.jacobian`), a pushing line's compressed
   links' exact ones (:func:`compression_jacobian`: by differences, a link within the step of its rest
   length, as at the bottom of a stiff catenary, strain ~1e-7 at c = 300, got a spurious EA/2 and the
-  steps fell 70-fold), plus the bending's and drag's by central differences over the nodes coloured
-  mod 5 (the steps of :func:`elastic_body.body_jac_fd`), in the
-  compact form ``B5[i, k, 0:4] = K``, ``B5[i, k, 4:8] = C`` (node i's accelerations by node
+  steps fell 70-fold), plus the bending's and drag's, exact since branch fastbody
+  (:mod:`elastic_body_jacobian`; before, central differences over the nodes coloured mod 5, the steps of
+  :func:`elastic_body.body_jac_fd`: :func:`body_jacobian_fd`, kept for the tests), in the compact form ``B5[i, k, 0:4] = K``, ``B5[i, k, 4:8] = C`` (node i's accelerations by node
   ``i - 2 + k``'s positions, velocities; 2 x 2 row-major);
 * the W row (the held end's power) gets the body's ``d/dz (M_N phi' - F_N . v_pin)``, which reaches
   nodes N-2 and N-1 (``gW`` holds nodes N-3..N-1: 12 entries), and the D row the body's
-  ``d/dz (2R + D_compression - P_drag)`` (all nodes: drag), both by the same coloured differences: the
-  dissipation is split into per-node terms (:func:`local_dissipation`, each reaching one node either
-  side) so that a colour's perturbed nodes (5 apart) are told apart;
+  ``d/dz (2R + D_compression - P_drag)`` (all nodes: drag), both exact too (the differences split the
+  dissipation into per-node terms, :func:`local_dissipation`, each reaching one node either side, so that a
+  colour's perturbed nodes, 5 apart, are told apart);
 * the reduced stage matrix ``I - g^2 K - g C`` is a band of 2 x 2 blocks reaching two nodes either
   side: interleaved bandwidth 5 below and above, factored with partial pivoting
-  (:func:`banded.band_lu`; bending makes it non-symmetric in general, so the spring-only path's
+  (:func:`banded_body.band_lu55`, :func:`banded.band_lu`'s general path until branch fastbody; bending makes
+  it non-symmetric in general, so the spring-only path's
   pivot-free block Thomas is not used); every factorisation counts as pivoted (``n_lu_pivoted``);
 * the clamp's angle (a constant or the cubic spline of :class:`LineBody`, its piecewise
   polynomial evaluated compiled: :func:`clamp_at`) at each stage's time; a clamp given as samples makes
   the system non-autonomous (``df/dt`` by a forward difference, as for a moving held end).
 
-Its step is compiled (:func:`body_accept`); the run's step loop and bookkeeping are
-:func:`elastic_solve.solve`'s Python loop (one call per accepted step), the peaks refined by
-``_Peaks.refine`` with this stepper. The plain line's ``"rodas4"`` (no body) is untouched.
+Its step is compiled (:func:`body_accept`); the run's step loop and bookkeeping too since branch fastbody
+(:mod:`elastic_body_advance`; before, :func:`elastic_solve.solve`'s Python loop, one call per accepted step),
+the peaks refined by ``_Peaks.refine`` with this stepper. The plain line's ``"rodas4"`` (no body) is untouched.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from numba import njit
 
 from . import elastic_kernels as EK
 from . import elastic_rodas as ER
-from .banded import band_lu, band_solve
+from .banded_body import WROW5, band_lu55, band_solve55
 from .elastic_body import _geometry, add_body
 from .elastic_body_jacobian import body_terms_jacobian
 from .elastic_jacobian import add_link_gradient, jacobian
@@ -54,8 +55,9 @@ __all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "body_ja
 
 #: the body's reduced stage matrix's bandwidths (2 x 2 blocks reaching nodes i-2..i+2, interleaved x, y)
 KLB = KUB = 5
-#: band storage width of :func:`banded.band_lu` (room for the pivoting's fill-in)
-WIDTHB = 2 * KLB + KUB + 1
+#: band storage width of :func:`banded_body.band_lu55` (room for the pivoting's fill-in and the reciprocal
+#: pivots; :func:`banded.band_lu`'s general path, 2 KLB + KUB + 1 wide, until branch fastbody)
+WIDTHB = WROW5
 #: entries of the W row's gradient: nodes N-3..N-1
 NGW = 12
 #: the scalars of a body (``bd[7]``): tip drag, wind x, y, clamped, push, clamp kind (0 none, 1 a
@@ -336,7 +338,7 @@ def body_jacobian_fd(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, 
 
 @njit(cache=True, error_model="numpy")
 def assemble_band5(N, B5, gh, ab):
-    """``I - g^2 K - g C`` (``g = gh``) in :func:`banded.band_lu`'s storage (row i, column j at
+    """``I - g^2 K - g C`` (``g = gh``) in :func:`banded_body.band_lu55`'s storage (row i, column j at
     ``ab[i, j - i + KLB]``), from the compact blocks ``B5``."""
     ab[:, :] = 0.0
     g2 = gh * gh
@@ -369,7 +371,7 @@ def solve5(N, B5, gW, gD, gh, ab, piv, b, U, w):
                     continue
                 acc += g2 * (B5[i, k, 2 * r] * b[4 * jn] + B5[i, k, 2 * r + 1] * b[4 * jn + 1])
             w[2 * i + r] = acc
-    band_solve(ab, 2 * N, KLB, KUB, piv, w)
+    band_solve55(ab, 2 * N, piv, w)
     for i in range(N):
         for r in range(2):
             uv = w[2 * i + r]
@@ -396,7 +398,7 @@ def body_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, bd
     gh = GAMMA * hs
     assemble_band5(N, B5, gh, ab)
     ctl[ER.C_NPIV] += 1.0
-    if band_lu(ab, 2 * N, KLB, KUB, piv) != 0:
+    if band_lu55(ab, 2 * N, piv) != 0:
         return np.inf
     cc = np.empty(5)
     for st in range(6):
