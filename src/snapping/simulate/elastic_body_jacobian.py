@@ -132,16 +132,53 @@ def bending_jacobian(N, z, pin, invm, Bl, K0L, El, clamped, ex, ey, phid, UX, UY
         dt = UX[j] * ex + UY[j] * ey
         MM[N] = Bl[N] * (math.atan2(cr, dt) - K0L[N]) + El[N] * (phid - OM[j])
     for j in range(N):
-        # T_j = Q_j g_j: +T_j on node j+1, -T_j on node j
+        # T_j = Q_j g_j (+T_j on node j+1, -T_j on node j), Q_j = M_{j+1} - M_j: the gradients of M_j
+        # (nodes j-1, j, j+1: "a") and M_{j+1} (nodes j, j+1, j+2: "b"), as _mgrad adds them
+        ppxa = ppya = pmxa = pmya = vpxa = vpya = vmxa = vmya = 0.0
+        if j >= 1:
+            bl = Bl[j]
+            el = El[j]
+            ppxa = bl * GLX[j] + el * AX[j]
+            ppya = bl * GLY[j] + el * AY[j]
+            pmxa = bl * GLX[j - 1] + el * AX[j - 1]
+            pmya = bl * GLY[j - 1] + el * AY[j - 1]
+            vpxa = el * GLX[j]
+            vpya = el * GLY[j]
+            vmxa = el * GLX[j - 1]
+            vmya = el * GLY[j - 1]
+        ppxb = ppyb = pmxb = pmyb = vpxb = vpyb = vmxb = vmyb = 0.0
+        i = j + 1
+        if i < N or clamped:
+            bl = Bl[i]
+            el = El[i]
+            pmxb = bl * GLX[j] + el * AX[j]
+            pmyb = bl * GLY[j] + el * AY[j]
+            vmxb = el * GLX[j]
+            vmyb = el * GLY[j]
+            if i < N:
+                ppxb = bl * GLX[i] + el * AX[i]
+                ppyb = bl * GLY[i] + el * AY[i]
+                vpxb = el * GLX[i]
+                vpyb = el * GLY[i]
+        dq[0, 0] = -pmxa
+        dq[0, 1] = -pmya
+        dq[0, 2] = -vmxa
+        dq[0, 3] = -vmya
+        dq[1, 0] = pmxb + (ppxa + pmxa)
+        dq[1, 1] = pmyb + (ppya + pmya)
+        dq[1, 2] = vmxb + (vpxa + vmxa)
+        dq[1, 3] = vmyb + (vpya + vmya)
+        dq[2, 0] = -(ppxb + pmxb) - ppxa
+        dq[2, 1] = -(ppyb + pmyb) - ppya
+        dq[2, 2] = -(vpxb + vmxb) - vpxa
+        dq[2, 3] = -(vpyb + vmyb) - vpya
+        dq[3, 0] = ppxb
+        dq[3, 1] = ppyb
+        dq[3, 2] = vpxb
+        dq[3, 3] = vpyb
         q = MM[j + 1] - MM[j]
         gx = GLX[j]
         gy = GLY[j]
-        for a in range(4):
-            for b in range(4):
-                dq[a, b] = 0.0
-        base = j - 1
-        _mgrad(j + 1, N, Bl, El, clamped, GLX, GLY, AX, AY, 1.0, dq, base)
-        _mgrad(j, N, Bl, El, clamped, GLX, GLY, AX, AY, -1.0, dq, base)
         L = LN[j]
         ux = UX[j]
         uy = UY[j]
@@ -149,52 +186,57 @@ def bending_jacobian(N, z, pin, invm, Bl, K0L, El, clamped, ex, ey, phid, UX, UY
         dgxx = 2.0 * ux * uy * il2 * q  # q dg/dd_j
         dgxy = (uy * uy - ux * ux) * il2 * q
         dgyy = -dgxx
-        for side in range(2):
-            row = j + side
-            sg = 1.0 if side == 1 else -1.0
-            for nn in range(4):
-                col = base + nn
-                if col < 0 or col >= N:
+        lo = 1 if j == 0 else 0
+        hi = min(4, N - j + 1)  # (columns j-1+nn < N)
+        for nn in range(lo, hi):
+            col = j - 1 + nn
+            kxx = gx * dq[nn, 0]
+            kxy = gx * dq[nn, 1]
+            kyx = gy * dq[nn, 0]
+            kyy = gy * dq[nn, 1]
+            if nn == 2:
+                kxx += dgxx
+                kxy += dgxy
+                kyx += dgxy
+                kyy += dgyy
+            elif nn == 1:
+                kxx -= dgxx
+                kxy -= dgxy
+                kyx -= dgxy
+                kyy -= dgyy
+            cxx = gx * dq[nn, 2]
+            cxy = gx * dq[nn, 3]
+            cyx = gy * dq[nn, 2]
+            cyy = gy * dq[nn, 3]
+            w = -invm[j]  # row j: -T_j
+            k = nn + 1
+            B5[j, k, 0] += w * kxx
+            B5[j, k, 1] += w * kxy
+            B5[j, k, 2] += w * kyx
+            B5[j, k, 3] += w * kyy
+            B5[j, k, 4] += w * cxx
+            B5[j, k, 5] += w * cxy
+            B5[j, k, 6] += w * cyx
+            B5[j, k, 7] += w * cyy
+            if j + 1 < N:  # row j+1: +T_j
+                w = invm[j + 1]
+                k = nn
+                B5[j + 1, k, 0] += w * kxx
+                B5[j + 1, k, 1] += w * kxy
+                B5[j + 1, k, 2] += w * kyx
+                B5[j + 1, k, 3] += w * kyy
+                B5[j + 1, k, 4] += w * cxx
+                B5[j + 1, k, 5] += w * cxy
+                B5[j + 1, k, 6] += w * cyx
+                B5[j + 1, k, 7] += w * cyy
+            else:  # the held end: W' gets -T_{N-1} . v_pin
+                m = 4 * (col - N + 3)
+                if m < 0:
                     continue
-                kxx = gx * dq[nn, 0]
-                kxy = gx * dq[nn, 1]
-                kyx = gy * dq[nn, 0]
-                kyy = gy * dq[nn, 1]
-                if col == j + 1:
-                    kxx += dgxx
-                    kxy += dgxy
-                    kyx += dgxy
-                    kyy += dgyy
-                elif col == j:
-                    kxx -= dgxx
-                    kxy -= dgxy
-                    kyx -= dgxy
-                    kyy -= dgyy
-                cxx = gx * dq[nn, 2]
-                cxy = gx * dq[nn, 3]
-                cyx = gy * dq[nn, 2]
-                cyy = gy * dq[nn, 3]
-                if row < N:
-                    if col - row < -2 or col - row > 2:
-                        continue
-                    k = col - row + 2
-                    w = sg * invm[row]
-                    B5[row, k, 0] += w * kxx
-                    B5[row, k, 1] += w * kxy
-                    B5[row, k, 2] += w * kyx
-                    B5[row, k, 3] += w * kyy
-                    B5[row, k, 4] += w * cxx
-                    B5[row, k, 5] += w * cxy
-                    B5[row, k, 6] += w * cyx
-                    B5[row, k, 7] += w * cyy
-                else:  # the held end: W' gets -T_{N-1} . v_pin
-                    m = 4 * (col - N + 3)
-                    if m < 0:
-                        continue
-                    gW[m] -= pin[2] * kxx + pin[3] * kyx
-                    gW[m + 1] -= pin[2] * kxy + pin[3] * kyy
-                    gW[m + 2] -= pin[2] * cxx + pin[3] * cyx
-                    gW[m + 3] -= pin[2] * cxy + pin[3] * cyy
+                gW[m] -= pin[2] * kxx + pin[3] * kyx
+                gW[m + 1] -= pin[2] * kxy + pin[3] * kyy
+                gW[m + 2] -= pin[2] * cxx + pin[3] * cyx
+                gW[m + 3] -= pin[2] * cxy + pin[3] * cyy
     if clamped:  # W' gets M_N phi'
         for a in range(4):
             for b in range(4):
