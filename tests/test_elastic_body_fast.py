@@ -42,6 +42,13 @@ def test_exact_body_jacobian(clamp, seed):
     line, z = _random_line(N=12, clamp=clamp, seed=seed)
     N, t = line.N, 0.13
     st = RodasBodyStepper(line, t, z, 1.0, 1e-6)
+    # the stepper's Jacobian (body_f_and_jacobian: the moments and geometry its evaluation left) is body_jacobian's
+    st.f_and_jacobian()  # (again: the starting step's trial evaluation left other tensions in st.work)
+    full = (np.zeros((N, 5, 8)), np.zeros(RB.NGW), np.zeros(4 * N))
+    RB.body_jacobian(N, t, st.y, st.pins[6], *st.bargs()[:6], *st.work[:3], st.J3, st.gW4, st.bd, *full, st.bs,
+                     st.zz, st.GX, st.GY, st.QP, st.Q, st.hmin)
+    for a, b in zip(full, (st.B5, st.gW12, st.gDb)):
+        assert np.array_equal(a, b)
     B5, gW, gD = _body_part(st, RB.body_jacobian)
     J = np.zeros((2 * N, 4 * N))  # the body's accelerations by the node states
     for i in range(N):

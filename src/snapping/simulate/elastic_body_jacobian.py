@@ -99,10 +99,12 @@ def _om_grad(l, N, s, GLX, GLY, AX, AY, gD):
 
 @njit(cache=True, error_model="numpy")
 def bending_jacobian(N, z, pin, invm, Bl, K0L, El, clamped, ex, ey, phid, UX, UY, LN, OM, MM, GLX, GLY, AX, AY, B5,
-                     gW, gD, dq):
+                     gW, gD, dq, have_mm=False):
     """Add the bending's (stiffness, damping, the clamp's) derivatives to the node blocks ``B5`` (N x 5 x 8,
     :mod:`elastic_rodas_body`'s layout), the W row ``gW`` (nodes N-3..N-1) and the D row ``gD``. The
-    geometry ``UX, UY, LN, OM`` of ``z`` on entry; ``MM, GLX, GLY, AX, AY`` (N + 1) and ``dq`` (4 x 4) scratch."""
+    geometry ``UX, UY, LN, OM`` of ``z`` on entry; ``GLX, GLY, AX, AY`` (N + 1) and ``dq`` (4 x 4) scratch, ``MM``
+    the node moments (N + 1: computed here, or with ``have_mm`` those :func:`elastic_body.body_forces` left
+    there at this state: the atan2s of an evaluation not done twice)."""
     for j in range(N):
         if j + 1 < N:
             vx1 = z[4 * j + 6]
@@ -120,17 +122,18 @@ def bending_jacobian(N, z, pin, invm, Bl, K0L, El, clamped, ex, ey, phid, UX, UY
         GLY[j] = dx / L2
         AX[j] = (dvy - 2.0 * dx * OM[j]) / L2
         AY[j] = (-dvx - 2.0 * dy * OM[j]) / L2
-    MM[0] = 0.0
-    for i in range(1, N):
-        cr = UX[i - 1] * UY[i] - UY[i - 1] * UX[i]
-        dt = UX[i - 1] * UX[i] + UY[i - 1] * UY[i]
-        MM[i] = Bl[i] * (math.atan2(cr, dt) - K0L[i]) + El[i] * (OM[i] - OM[i - 1])
-    MM[N] = 0.0
-    if clamped:
-        j = N - 1
-        cr = UX[j] * ey - UY[j] * ex
-        dt = UX[j] * ex + UY[j] * ey
-        MM[N] = Bl[N] * (math.atan2(cr, dt) - K0L[N]) + El[N] * (phid - OM[j])
+    if not have_mm:  # (elastic_body.body_forces' moments, its arithmetic)
+        MM[0] = 0.0
+        for i in range(1, N):
+            cr = UX[i - 1] * UY[i] - UY[i - 1] * UX[i]
+            dt = UX[i - 1] * UX[i] + UY[i - 1] * UY[i]
+            MM[i] = Bl[i] * (math.atan2(cr, dt) - K0L[i]) + El[i] * (OM[i] - OM[i - 1])
+        MM[N] = 0.0
+        if clamped:
+            j = N - 1
+            cr = UX[j] * ey - UY[j] * ex
+            dt = UX[j] * ex + UY[j] * ey
+            MM[N] = Bl[N] * (math.atan2(cr, dt) - K0L[N]) + El[N] * (phid - OM[j])
     for j in range(N):
         # T_j = Q_j g_j (+T_j on node j+1, -T_j on node j), Q_j = M_{j+1} - M_j: the gradients of M_j
         # (nodes j-1, j, j+1: "a") and M_{j+1} (nodes j, j+1, j+2: "b"), as _mgrad adds them
@@ -356,14 +359,17 @@ def drag_jacobian(N, z, invm, CN, CT, KN, KT, cd, wx, wy, UX, UY, LN, B5, gD):
 
 
 @njit(cache=True, error_model="numpy")
-def body_terms_jacobian(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, sc, ex, ey, phid, bs, B5, gW, gD, dq):
+def body_terms_jacobian(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, sc, ex, ey, phid, bs, B5, gW, gD, dq,
+                        ready=False):
     """Add the derivatives of :func:`elastic_rodas_body._body_eval`'s terms (the body without the
     compressed links' push) to ``B5``, ``gW``, ``gD``: :func:`bending_jacobian` and
     :func:`drag_jacobian`. ``sc`` the body's scalars (tip drag, wind, clamped: indices 0..3 of
     :mod:`elastic_rodas_body`'s ``P_*``), ``(ex, ey, phid)`` the clamp at the time; ``bs`` the nine
-    N + 1 scratch arrays, ``dq`` a 4 x 4 one."""
+    N + 1 scratch arrays, ``dq`` a 4 x 4 one. ``ready``: ``bs[0:5]`` hold the geometry and moments of this
+    state (an evaluation of the body's forces at it, :func:`elastic_body.body_forces`, came just before)."""
     UX, UY, LN, OM, MM = bs[0], bs[1], bs[2], bs[3], bs[4]
-    _geometry(N, z, pin, UX, UY, LN, OM)
+    if not ready:
+        _geometry(N, z, pin, UX, UY, LN, OM)
     bending_jacobian(N, z, pin, invm, Bl, K0L, El, sc[3] != 0.0, ex, ey, phid, UX, UY, LN, OM, MM, bs[5], bs[6],
-                     bs[7], bs[8], B5, gW, gD, dq)
+                     bs[7], bs[8], B5, gW, gD, dq, ready)
     drag_jacobian(N, z, invm, CN, CT, KN, KT, sc[0], sc[1], sc[2], UX, UY, LN, B5, gD)

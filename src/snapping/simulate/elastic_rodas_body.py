@@ -269,11 +269,18 @@ def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4
     (:func:`compression_jacobian`), the body's (bending, drag) exact too
     (:func:`elastic_body_jacobian.body_terms_jacobian`, branch fastbody; the coloured differences before,
     :func:`body_jacobian_fd`, ~20x its cost). ``zz, GX, GY, QP, Q, hmin``: the differences' (unused here)."""
+    _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, False)
+
+
+@njit(cache=True, error_model="numpy")
+def _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, ready):
+    """:func:`body_jacobian`; ``ready``: ``bs`` holds the geometry and moments of ``(t, z)`` (:func:`body_rhs`
+    there came just before: :func:`body_f_and_jacobian`)."""
     _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD)
     Bl, K0L, El, CN, CT, KN, KT, sc, cx, cc = bd
     ex, ey, phid = clamp_at(t, sc, cx, cc)
     body_terms_jacobian(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, sc, ex, ey, phid, bs, B5, gW, gD,
-                        np.empty((4, 4)))
+                        np.empty((4, 4)), ready)
 
 
 @njit(cache=True, error_model="numpy")
@@ -424,11 +431,12 @@ def body_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, bd
 @njit(cache=True, error_model="numpy")
 def body_f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, g, bd, f, B5, gW, gD, T, E, ED,
                         FV, J3, gW4, bs, zz, GX, GY, QP, Q, hmin):
-    """``f(t, z)`` and the Jacobian there (:func:`body_jacobian`, the springs' from the same tensions)."""
+    """``f(t, z)`` and the Jacobian there (:func:`body_jacobian`, the springs' from the same tensions, the body's
+    from the same geometry and moments); leaves the body's force on the held end in ``bs[5][N], bs[6][N]``
+    (the Jacobian's scratch there stops at N - 1: :func:`elastic_body_advance.body_measure` reads them)."""
     ER.pin_at(t, pinpar, pintab, pin)
     body_rhs(N, t, z, pin, h, invm, ea, damp, tabe, tabt, g, bd, f, T, E, ED, FV, bs)
-    body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY, QP,
-                  Q, hmin)
+    _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, True)
 
 
 @njit(cache=True, error_model="numpy")
