@@ -218,8 +218,8 @@ def _answers(names, chis, N) -> int:
     caps.cap("bungee-cord", 0.25, N=12)  # compile the kernels (both methods)
     caps.cap("nylon-monofilament", 0.1, N=8, check=False, alone=False, graded=False)
     print("| line | chi | wall s | CPU s | load | links | error bar v, a, T | within 1% | cap | T ideal (N) | "
-          "T real (N) | evaluations |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "T real (N) | factor | evaluations | ideal: its error (T), on uniform links (N) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for chi in chis:
         for name in names:
             load = os.getloadavg()[0]
@@ -240,8 +240,19 @@ def _answers(names, chis, N) -> int:
                                                                           if not ok)
             print(f"| {name} | {chi:g} | {r['wall']:.1f} | {r['cpu']:.1f} | {load:.1f}-{os.getloadavg()[0]:.1f} | "
                   f"{links} | {', '.join(f'{e:.2%}' for e in err)} | {'own links' if own else 'yes' if max(err) <= 0.01 else 'NO'} | "
-                  f"{r['cap']} | {r['ideal']['sigma_peak']:.4g} | {r['real']['sigma_peak']:.4g} | {r['n_rhs']} |", flush=True)
+                  f"{r['cap']} | {r['ideal']['sigma_peak']:.4g} | {r['real']['sigma_peak']:.4g} | "
+                  f"{r['factor']['sigma_peak']:.3f} | {r['n_rhs']} | " + _ideal_on(r) + " |", flush=True)
     return 0
+
+
+def _ideal_on(r: dict) -> str:
+    """Where the ideal beside an answer ran: on its graded links (its own error on T, its run on the answer's
+    uniform links beside) or on the answer's links."""
+    io = r.get("ideal_on")
+    if not io:
+        return "on the answer's links"
+    return (f"{io['what']} {'/'.join(map(str, io['links']))}: +-{io['relative_error']['sigma_peak']:.2%}; "
+            f"{io['uniform']['sigma_peak']:.4g} on {io['N']}")
 
 
 def _graded_tol() -> float:

@@ -67,9 +67,18 @@ def _unsettled(monkeypatch):
         return {"v_peak": f, "a_peak": f, "sigma_peak": f, "N": N, "n_rhs": 5, "wall": 0.0, "cpu": 0.0,
                 "strain_peak": 0.02, "s_sigma": 0.9, "t_sigma": 1.2, "t_snap": 1.19, "method": "combined rodas4"}
 
+    def same(runs, present, cg):  # the ideal's sigma 200 (1 - 0.5 h^2) and v 20, a 1e5; the inextensible's 400 M g
+        ideal = [{"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 200.0 * (1.0 - 0.5 * 4.0 ** -k)}
+                 for k in range(len(cg["levels"]))]
+        return {"ideal": {"levels": ideal, "extrapolated": {"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 200.0},
+                          "links": [800, 1600],
+                          "relative_error": {q: 0.0 for q in Q}},
+                "inextensible": [{"v_peak": 20.0, "a_peak": 1e5, "sigma_peak": 400.0} for _ in ideal]}
+
     monkeypatch.setattr(caps_runs, "stretch_factor_body", fake)
     monkeypatch.setattr(caps_combined, "combined_level", lambda sp, chi, on, k, **kw: _law(k))
     monkeypatch.setattr(caps_combined, "combined_links", lambda chi, k, first=-1: np.ones(100 * 2 ** k))
+    monkeypatch.setattr(caps_combined, "same_links", same)
 
 
 def test_cap_answers_from_the_combined_model_where_the_factor_does_not_settle(monkeypatch):
@@ -84,6 +93,35 @@ def test_cap_answers_from_the_combined_model_where_the_factor_does_not_settle(mo
         assert s["factor"][q] == pytest.approx(limit * si[q] / r["full"][q], rel=1e-12), q
     assert "did not settle" in s["why"] and "graded links (100/200/400/800/1600)" in s["why"]
     assert [x["N"] for x in r["runs"] if x["run"] == "combined"] == [100, 200, 400, 800, 1600]
+    # the ideal beside it is its limit on the same links (200 M g, not the 16 uniform links'), the factor against it;
+    # on the finest level stretching's step 100.04/400 outweighs the body's 400/199.6: stretching caps it
+    assert r["ideal"]["sigma_peak"] == pytest.approx(200.0 * si["sigma_peak"], rel=1e-12)
+    assert r["factor"]["sigma_peak"] == pytest.approx(0.5, rel=1e-12)
+    assert r["ideal_on"]["uniform"]["sigma_peak"] < 150.0 * si["sigma_peak"] and r["ideal_on"]["what"] == "combined"
+    assert r["cap"] == "stretching" and "x0.25" in r["cap_why"] and "x2" in r["cap_why"]
+    assert "ideal chain: on the combined model's graded links (800 and 1600)" in "\n".join(caps.format_answer(r))
+
+
+def _cg(real, inext, ideal):
+    return {"levels": [{"links": 10, "sigma_peak": 1.0}, {"links": 20, "sigma_peak": real}],
+            "inextensible": [{"sigma_peak": 1.0}, {"sigma_peak": inext}],
+            "ideal": {"levels": [{"sigma_peak": 1.0}, {"sigma_peak": ideal}]}}
+
+
+@pytest.mark.parametrize("real, inext, ideal, factor, expect", [
+    (146.1, 864.4, 203.3, 0.71, "stretching"),      # the rope at chi 0.1: the body raises it x4.25, stretching x0.169
+    (80.0, 100.0, 200.0, 0.40, "drag"),            # the body halves it, stretching takes 20% more: the body's
+    (50.0, 180.0, 200.0, 0.25, "stretching"),      # both lower it, stretching more (x0.28 vs x0.9)
+    (150.0, 180.0, 200.0, 0.85, "stretching"),     # x0.833 vs the body's x0.9: stretching's step is the larger
+    (70.0, 80.0, 200.0, 0.40, "drag"),             # x0.875 vs the body's x0.4
+    (150.0, 140.0, 200.0, 0.80, "drag"),           # stretching raises it (x1.07): the body's
+    (190.0, 210.0, 200.0, 0.93, "none"),           # within 10% of the ideal's limit
+])
+def test_combined_verdict_splits_the_ratio_on_the_finest_level(real, inext, ideal, factor, expect):
+    got, why = caps_combined.combined_verdict(_cg(real, inext, ideal), "sigma_peak", factor, {"drag": 1.0},
+                                              lambda alone: min(alone))
+    assert got == expect
+    assert f"({20} links)" in why and f"x{inext / ideal:.3g}" in why and f"x{real / inext:.3g}" in why
 
 
 def test_off_by_default_the_unsettled_factor_is_left_out(monkeypatch):
@@ -104,4 +142,63 @@ def test_cli_estimate_combined(monkeypatch, capsys):
     s = json.loads(capsys.readouterr().out)["stretching"]
     assert s["model"] == "combined (elastic + body) on graded links" and s["combined"]["pair"] == [3, 4]
     assert main(["estimate", "--chi", "0.3", "--combined"]) == 2
+    assert "--combined is a real line's option" in capsys.readouterr().err
+
+
+def test_same_links_runs_the_ideal_and_the_inextensible_line_on_the_combined_levels(monkeypatch):
+    """The rope without bending (drag: the fast method) at chi 0.3 on the levels of first = -4: the ideal chain and
+    the inextensible line with drag built here by hand, run directly; the ideal's pair extrapolated by hand."""
+    from snapping.simulate import run
+
+    sp = caps.spec("climbing-rope", ei=0.0)
+
+    def links(chi, k, first=-1):
+        s = 0.5 ** (-4 + k)
+        return grading.fold_following(chi, frac=continuum.FRAC0 * s, h_min=continuum.H_MIN0 * s,
+                                      h_max=min(0.5, continuum.H_MAX0 * s))
+
+    monkeypatch.setattr(caps_combined, "combined_links", links)
+    runs = caps_runs.Runs(sp, 0.3, 1e-6, 1e-4, caps_runs.GRID_DAMPING)
+    got = caps_combined.same_links(runs, ("drag",), {"levels": [{}, {}], "pair": (0, 1)})
+    lam, rho = sp.mass / sp.length, 1.2
+    drag = Body(0.0, drag_normal=0.5 * rho * sp.cd_normal * sp.diameter * sp.length / lam,
+                drag_tangential=0.5 * rho * sp.cd_tangential * math.pi * sp.diameter * sp.length / lam)
+    ideal = []
+    for k in (0, 1):
+        h = links(0.3, k)
+        for body, out in ((None, got["ideal"]["levels"][k]), (drag, got["inextensible"][k])):
+            a = run(Problem.catenary(0.3, links=Links.graded(h), body=body), method="fast", tol=1e-6,
+                    progress=False).dataset.attrs
+            for q in Q:
+                assert out[q] == pytest.approx(float(a[q]), rel=1e-12), (k, body, q)
+            if body is None:
+                ideal.append(a)
+    for q in Q:
+        f0, f1 = float(ideal[0][q]), float(ideal[1][q])
+        assert got["ideal"]["extrapolated"][q] == pytest.approx((4.0 * f1 - f0) / 3.0, rel=1e-12), q
+        assert got["ideal"]["relative_error"][q] == pytest.approx(abs(f1 - f0) / 3.0 / abs((4.0 * f1 - f0) / 3.0),
+                                                                   rel=1e-9), q
+    assert [x["run"] for x in runs.log] == ["ideal (combined level 0)", "ideal (combined level 1)",
+                                            "drag (combined level 0)", "drag (combined level 1)"]
+    assert got["ideal"]["links"] == [links(0.3, 0).size, links(0.3, 1).size]
+
+
+def test_design_takes_the_combined_route(monkeypatch, capsys):
+    import json
+
+    from snapping.cli import main
+
+    _unsettled(monkeypatch)
+    d = caps.design("bungee-cord", chis=(0.3,), N=16, max_tension=1e9, alone=False, graded=False, combined=True)
+    row = d["rows"][0]
+    assert row["stretching"]["model"] == "combined (elastic + body) on graded links" and row["cap"] == "stretching"
+    assert row["factor"]["sigma_peak"] == pytest.approx(0.5, rel=1e-12)
+    text = "\n".join(caps.format_design(d))
+    assert "real peaks from the combined model (elastic + body) on graded links" in text
+    assert "stretching factor NOT applied" not in text
+    assert main(["design", "--line", "bungee-cord", "--chis", "0.3", "--links", "16", "--max-tension", "1e9",
+                 "--combined", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert row["stretching"]["model"] == "combined (elastic + body) on graded links"
+    assert main(["design", "--max-tension", "1e9", "--combined"]) == 2
     assert "--combined is a real line's option" in capsys.readouterr().err

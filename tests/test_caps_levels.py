@@ -84,8 +84,10 @@ class _FakeRuns:
         self.sp, self.chi, self.tol, self.damping, self.log = sp, chi, 1e-6, 1.0, []
         self.kappa, self.run_level = kappa or {}, run_level
 
-    def get(self, on, N):
-        self.log.append((tuple(on), N))
+    ideal_on = caps_runs.Runs.ideal_on  # (the ideal on graded links: this get's, 1 on every level)
+
+    def get(self, on, N, h=None, where=""):
+        self.log.append((tuple(on), N) + ((where,) if where else ()))
         return {"v_peak": 1.0, "a_peak": 1.0, "sigma_peak": 1.0, "method": "dop853",
                 "kappa_peak": self.kappa.get((tuple(on), N), 0.0)}
 

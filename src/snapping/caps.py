@@ -83,7 +83,8 @@ import time
 
 from . import _validate as V
 from .caps_inputs import END_MASS_MAX, SPEC_KEYS, SPEC_UNITS, LineSpec, spec  # noqa: F401 (caps' public names)
-from .caps_combined import combined_route
+from .caps_combined import combined_route, combined_verdict
+from .caps_format import format_answer, format_design  # noqa: F401 (caps' public names)
 from .caps_inputs import _pos
 from .caps_inputs import as_spec as _as_spec
 from .caps_inputs import check_chis as _check_chis
@@ -229,6 +230,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     sp, chi = runs.sp, runs.chi
     present = [m for m in MECHANISMS[:-1] if sp.has(m)]
     ideal_nd = runs.get((), N)
+    ideal_on = None  # graded or combined answers: the ideal on their links, extrapolated (its uniform-links run kept)
     grade = _grading(runs, N, present, graded)
     if grade["used"]:
         on, lb = tuple(present), bending_length(sp)
@@ -241,6 +243,10 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         grade["error"] = _si(sp, gl["error"])
         grade["within"] = gl["stopped"] == "within"
         check = False
+        gi = runs.ideal_on([(graded_h(chi, lb, k), f"graded {k}") for k in gl["pair"]])  # the ideal on the same links
+        ideal_on = {"what": "graded", "links": gi["links"], "relative_error": gi["relative_error"],
+                    "uniform": _si(sp, ideal_nd), "N": N}
+        ideal_nd = {**gi["extrapolated"], "method": gi["levels"][1]["method"]}
     else:
         full_nd = runs.get(tuple(present), N)
     alone_nd = {}
@@ -277,8 +283,12 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                          f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
                                       + "); " + stretch_words(sl, ok)
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
-            if cg is not None:
+            if cg is not None:  # the ideal beside it: on the same graded links, extrapolated (its continuum limit)
                 stretching.update(model="combined (elastic + body) on graded links", combined=cg, why=cg["why"])
+                gi = cg["ideal"]
+                ideal_on = {"what": "combined", "links": gi["links"], "relative_error": gi["relative_error"],
+                            "uniform": _si(sp, runs.get((), N)), "N": N}
+                ideal_nd = {**gi["extrapolated"], "method": ideal_nd["method"]}
             if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -299,16 +309,23 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     judged = {m: v[quantity] for m, v in alone_nd.items() if m != "stretching" or stretching["resolved"][quantity]}
     capped = decide(factor[quantity], real_nd[quantity], judged,
                     bool(present or (stretching["run"] and stretching["resolved"][quantity])), alone)
+    extra, rule_c = {}, ""
+    if stretching.get("combined"):  # (the verdict splits the ratio on the same links: :func:`combined_verdict`)
+        capped, why = combined_verdict(stretching["combined"], quantity, factor[quantity], judged,
+                                       lambda a: decide(0.0, real_nd[quantity], a, True, alone))
+        extra = {"cap_why": why}
+        rule_c = ("; combined: against the ideal's limit on the same graded links, the mechanism of the larger step "
+                  "down on the finest level (stretching's, or the body's by the runs alone)")
     from .regimes_analysis import LEVEL
 
     rule = (f"{quantity}: real/ideal >= {LEVEL:g} -> none (the ideal chain's own cap: geometry and links); else the "
-            f"mechanism whose run alone is closest to the real answer in |log(alone/real)|")
+            f"mechanism whose run alone is closest to the real answer in |log(alone/real)|") + rule_c
     return {"line": sp.name, "chi": chi, "N": N, "tol": runs.tol, "quantity": quantity, "numbers": sp.numbers(N),
             "mechanisms": present + (["stretching"] if stretching["run"] else []),
             "ideal": _si(sp, ideal_nd), "full": _si(sp, full_nd), "real": _si(sp, real_nd),
             "alone": {m: _si(sp, v) for m, v in alone_nd.items()}, "factor": factor, "cap": capped, "rule": rule,
             "stretching": stretching, "resolution": resolution, "damping": runs.damping, "graded": grade,
-            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}}
+            "methods": {"ideal": ideal_nd["method"], "full": full_nd["method"]}, "ideal_on": ideal_on, **extra}
 
 
 def stretch_words(levels: list, resolved: dict) -> str:
@@ -455,7 +472,7 @@ def auto_graded(runs, grading: dict, graded="auto") -> str:
 def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: int | None = None, tol: float = 1e-6,
            max_tension=None, max_speed=None, max_acceleration=None, quantity: str = "sigma_peak",
            alone: bool = True, damping: float = GRID_DAMPING, stiff_tol: float = STIFF_TOL, graded="auto",
-           **params) -> dict:
+           combined: bool = False, **params) -> dict:
     """Which end separations keep the real line's peaks under the limits: :func:`cap` at each chi
     of ``chis`` (the ideal, full and, with ``alone``, each-mechanism-alone runs; no N/2 check).
     ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
@@ -464,7 +481,8 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it, ``N`` (the
     row's links) and ``resolved``. ``N``: the links of every run; None (the default) or ``"auto"``:
     each chi on the links that resolve it, :func:`cap`'s ``N="auto"`` (since ``designres``; 200
-    links for every chi before), a line of discrete links on its own."""
+    links for every chi before), a line of discrete links on its own. ``combined``: :func:`cap`'s (the
+    combined model on graded links where a line with a body's stretching factor does not settle)."""
     sp = _as_spec(line, params)
     chis = _check_chis(chis)
     own = sp.own_links()
@@ -488,7 +506,7 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
 
     for chi in tqdm(sorted(chis), desc=f"design {sp.name or 'line'}", unit="chi", leave=False, disable=None):
         r = cap(sp, chi, N=N, tol=tol, check=False, alone=alone, quantity=quantity, damping=damping,
-                stiff_tol=stiff_tol, graded=graded)
+                stiff_tol=stiff_tol, graded=graded, combined=combined)
         n_rhs += r["n_rhs"]
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],
@@ -505,95 +523,3 @@ def _row_resolved(r: dict):
     """A design row's verdict: :func:`cap`'s ``resolved`` where it gives one (``N="auto"``, own links),
     else None (given links: no check in a design)."""
     return r.get("resolved")
-
-
-def format_answer(r: dict) -> list[str]:
-    """Text lines of a :func:`cap` answer."""
-    out = [f"What caps the snap: {r['line']} at chi = {r['chi']:g}, {r['N']} links (runs of the real model, tol "
-           f"{r['tol']:g})", f"  {'peak':<12}{'ideal chain':>14}{'real line':>14}{'factor':>9}   units"]
-    for q, u in QUANTITIES.items():
-        out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
-    if r["alone"]:
-        left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
-        out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(
-            f"{m} {v[r['quantity']]:.5g}"
-            + (" (factor not resolved: the ideal's)" if m == "stretching" and left else "")
-            for m, v in r["alone"].items()))
-    out.append(f"  stretching: {r['stretching']['why']}")
-    if r.get("auto_N") and r.get("graded", {}).get("used"):
-        out.append(f"  links: graded (below) from the first, {r['N']} links for the ideal chain and each "
-                   f"mechanism alone")
-    elif r.get("own_links"):
-        out.append(f"  links: {r['own_links']['why']}")
-    elif r.get("auto_why"):
-        out.append(f"  links: {r['auto_why']}")
-    elif r.get("auto_N"):
-        out.append(f"  links: doubled over {', '.join(map(str, r['auto_N']))} until {r['quantity']} moved by <= "
-                   f"{RESOLVED:.0%}: {'resolved' if r['resolved'] else 'NOT resolved'} at {r['N']}")
-    g = r.get("graded", {})
-    if g.get("too_fine"):
-        out.append(f"  graded links: {g['why']}")
-    if g.get("used"):
-        a, b = (g["levels"][k] for k in g["pair"])
-        obs = g.get("observed_order")
-        out.append(f"  graded links: {g['why']}; full run on levels of {', '.join(map(str, g['levels']))} links, "
-                   f"{a} and {b} extrapolated (order {g['order']:g}"
-                   + (", observed " + ", ".join(f"{q} {v:.2f}" for q, v in obs.items()) if obs else "")
-                   + f"; {g['stop_why']}): " + ", ".join(
-                       f"{q} +- {g['relative_error'][q]:.2%}" for q in QUANTITIES)
-                   + f" ({'within' if g['within'] else 'NOT within'} 1%)")
-    if r["resolution"]:
-        what = "graded levels, coarse -> fine" if g.get("used") else "full run, N/2 -> N"
-        out.append(f"  resolution ({what}): " + ", ".join(f"{q} {v:+.2%}" for q, v in r["resolution"].items()))
-    verdict = ("nothing but the ideal chain's own cap (real within 10% of ideal)" if r["cap"] == "none" else r["cap"])
-    out.append(f"  capped by: {verdict} -- {r['quantity']} {r['real'][r['quantity']]:.5g} "
-               f"{QUANTITIES[r['quantity']]} (ideal {r['ideal'][r['quantity']]:.5g})")
-    out.append(f"  rule: {r['rule']}")
-    stiff = [f"{x['run']} ({x['N']})" for x in r.get("runs", ()) if x["method"] == "rodas4"]
-    out.append(f"  cost: {r['n_rhs']} right-hand-side evaluations, {r['wall']:.2f} s ({r['cpu']:.2f} s CPU); "
-               f"{len(r.get('runs', ()))} runs" + (f", RODAS4 (stiff): {', '.join(stiff)}" if stiff else ""))
-    return out
-
-
-def format_design(d: dict) -> list[str]:
-    """Text lines of a :func:`design` answer."""
-    lim = ", ".join(f"{q} <= {v:g} {QUANTITIES[q]}" for q, v in d["limits"].items())
-    q = d.get("quantity", "sigma_peak")
-    auto = d["N"] == "auto"
-    links = (f"links resolved per chi (N='auto': doubled from {AUTO_N[0]} until {q} moves by <= {RESOLVED:.0%}, or "
-             f"graded)" if auto else f"{d['N']} links")
-    out = [f"Design from runs of the real model: {d['line']}, {links}; limits {lim}",
-           f"  {'chi':>6}{'ideal v':>11}{'real v':>11}{'ideal a':>11}{'real a':>11}{'ideal T':>11}{'real T':>11}"
-           f"{'T factor':>10}  {'capped by':<12}  real ok  ideal ok" + ("  links" if auto else "")]
-    for r in d["rows"]:
-        i, x = r["ideal"], r["real"]
-        where = ""
-        if auto:
-            where = ("graded" if r.get("graded", {}).get("used") else str(r.get("N")))
-            where = f"  {where}{'' if r.get('resolved') else ' (NOT resolved)'}"
-        out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
-                   f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
-                   f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
-                   f"{'yes' if r['ideal_admissible'] else 'no':>8}" + where)
-    gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%}"
-          + ("" if r["graded"].get("stopped", "within") == "within" else ", NOT all peaks within 1%") + ")"
-          for r in d["rows"] if r.get("graded", {}).get("used")]
-    if gr:
-        out.append(f"  real peaks from graded links, the last two levels extrapolated, at chi: {', '.join(gr)}")
-    st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
-          for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
-    if st:
-        lv = sorted({tuple(x["N"] for x in r["stretching"]["levels"]) for r in d["rows"] if r.get("stretching", {}).get("run")})
-        out.append(f"  stretching factor NOT applied (not resolved from {' or '.join(f'{a} to {b}' for a, b in lv)} "
-                   f"links) at chi: {'; '.join(st)}")
-    ok = d["admissible_chi"]
-    out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")
-    out.append(f"  capped by: the mechanism whose run alone comes nearest the real {q} (none: real/ideal >= 0.9, "
-               f"the ideal chain's own cap)")
-    out.append(f"  cost: {d.get('n_rhs', 0)} right-hand-side evaluations, {d['wall']:.1f} s "
-               f"({d.get('cpu', d['wall']):.1f} s CPU)")
-    return out
-
-
-def _cap_word(c: str) -> str:
-    return "-" if c.startswith("not decided") else c

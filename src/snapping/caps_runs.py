@@ -440,19 +440,35 @@ class Runs:
             self.bar.set_postfix_str(f"{entry['run']}: {entry['N']} links, {entry['cpu']:.1f} s", refresh=False)
             self.bar.update(1)
 
-    def get(self, on, N: int) -> dict:
-        key = (tuple(on), int(N))
+    def get(self, on, N: int, h=None, where: str = "") -> dict:
+        """The run with the mechanisms ``on`` on ``N`` uniform links, or on the links ``h`` (``where`` names
+        them, in the key and the log), by the fast method or, where bending waves are stiff, RODAS4 with
+        them grid-damped (:func:`method_for`); made once."""
+        key = (tuple(on), int(N)) + ((where,) if where else ())
         if key not in self.done:
-            p = problem(self.sp, self.chi, N, on)
+            p = problem(self.sp, self.chi, N, on, h=h)
             method, tol, omega_min = ("fast", self.tol, 0.0) if self.damping <= 0.0 else method_for(
                 p, self.tol, self.stiff_tol)
             if method == "rodas4":
-                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min)
+                p = problem(self.sp, self.chi, N, on, damping=self.damping, omega_min=omega_min, h=h)
             r = _run(p, method, tol)
             self.done[key] = r
-            self._logged({"run": "+".join(on) or "ideal", "N": int(N), "method": r["method"], "tol": r["tol"],
-                             "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
+            self._logged({"run": ("+".join(on) or "ideal") + (f" ({where})" if where else ""), "N": int(N),
+                          "method": r["method"], "tol": r["tol"], "n_rhs": r["n_rhs"], "cpu": r["cpu"]})
         return self.done[key]
+
+    def ideal_on(self, links: list) -> dict:
+        """The ideal chain on two levels of graded links (``links``: [(h, where), (h, where)], coarse first;
+        :meth:`get`, the fast method) extrapolated at :data:`GRADED_ORDER` (:func:`richardson`): the ideal beside
+        a graded answer, on its links: ``levels`` (the two runs' peaks), ``extrapolated``, ``error`` and
+        ``relative_error`` per peak (nondimensional), ``links`` (their sizes). Its own fold is not the real
+        line's: where the links stop refining at the line's bending length, the ideal's estimate can stay large
+        (said: ``relative_error``)."""
+        lv = [self.get((), h.size, h=h, where=where) for h, where in links]
+        ext = {q: richardson(lv[0][q], lv[1][q], GRADED_ORDER) for q in QUANTITIES}
+        return {"levels": lv, "extrapolated": {q: ext[q][0] for q in QUANTITIES}, "links": [h.size for h, _ in links],
+                "error": {q: ext[q][1] for q in QUANTITIES},
+                "relative_error": {q: ext[q][1] / abs(ext[q][0]) for q in QUANTITIES}}
 
     def stretching_body(self, present) -> list:
         """The stretching factor's two levels for a line with a body (bending or drag among ``present``):

@@ -31,11 +31,11 @@ def add_real_options(p, resolve: bool = True) -> None:
     g.add_argument("--end-mass", type=float, default=None, metavar="KG", help="a point mass at the free end, kg")
     g.add_argument("--tip-drag-area", type=float, default=None, metavar="M2",
                    help="drag area C_d A of the free end's tip body in m^2")
+    g.add_argument("--combined", action="store_true",
+                   help="where a line with bending or drag stretches and its stretching factor does not settle "
+                        "on uniform links (the climbing rope), answer from the combined model on graded links "
+                        "(snapping.caps_combined: minutes of CPU per chi; default: stretching left out, and said)")
     if resolve:
-        g.add_argument("--combined", action="store_true",
-                       help="where a line with bending or drag stretches and its stretching factor does not settle "
-                            "on uniform links (the climbing rope), answer from the combined model on graded links "
-                            "(snapping.caps_combined: minutes of CPU; default: stretching left out, and said)")
         g.add_argument("--resolve", action="store_true",
                        help="double the links from 100 (to 1600 at most) until the peak of --quantity moves by at "
                             "most 1%%, or graded links (instead of --links; the default without --links since "
@@ -142,7 +142,7 @@ def cmd_real_design(args) -> int:
     kw = {} if args.chis is None else {"chis": args.chis}
     d = caps.design(sp, N=links, max_tension=args.max_tension,
                     max_speed=args.max_speed, max_acceleration=args.max_acceleration,
-                    quantity=getattr(args, "quantity", "sigma_peak"), **kw)
+                    quantity=getattr(args, "quantity", "sigma_peak"), combined=args.combined, **kw)
     if args.json:
         print_json({**d, "dimensionless_numbers": d["numbers"]})
     else:
