@@ -34,7 +34,7 @@ from numba import njit
 
 from .elastic_body import _geometry
 
-__all__ = ["body_terms_jacobian"]
+__all__ = ["body_terms_jacobian", "bending_jacobian", "drag_jacobian"]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
