@@ -287,7 +287,6 @@ def drag_jacobian(N, z, invm, CN, CT, KN, KT, cd, wx, wy, UX, UY, LN, B5, gD):
         fx = -an * unx - at * ut * tx
         fy = -an * uny - at * ut * ty
         scr = 1.0 if cr > 0.0 else (-1.0 if cr < 0.0 else 0.0)
-        sut = 1.0 if ut > 0.0 else (-1.0 if ut < 0.0 else 0.0)
         # dF/du at fixed tau: -CN s_cr un m^T - an (I - tau tau^T) - (CT |ut| + at) tau tau^T, m = (ty, -tx)
         ccn = CN[j] * scr
         ctt = CT[j] * abs(ut) + at
