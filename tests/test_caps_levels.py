@@ -85,6 +85,7 @@ class _FakeRuns:
         self.kappa, self.run_level = kappa or {}, run_level
 
     ideal_on = caps_runs.Runs.ideal_on  # (the ideal on graded links: this get's, 1 on every level)
+    limit = False
 
     def get(self, on, N, h=None, where=""):
         self.log.append((tuple(on), N) + ((where,) if where else ()))

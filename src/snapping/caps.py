@@ -48,6 +48,10 @@ ideal's times the applied factor; the **real answer** is the full run's times it
 cannot run together: the factors are taken as independent, and the answer says so). Below the
 threshold the answer says stretching was left out, and why.
 
+**The ideal beside it** (:mod:`snapping.caps_ideal`): where the answer is a limit (``N="auto"``, graded links, the
+combined model) the ideal chain's continuum limit at chi (shipped: :func:`snapping.table.limits.ideal_limit`), not
+the ideal on the answer's links, whose peaks grow with them; on given links or a chain's own, the same links.
+
 **The capping mechanism** (rule): if the real peak (of ``quantity``, default the tension) is
 within 10% of the ideal's (ratio >= :data:`snapping.regimes_analysis.LEVEL` = 0.9, the
 crossover of the regime studies) nothing caps it but the ideal chain's own cap (geometry, and
@@ -83,7 +87,8 @@ import time
 
 from . import _validate as V
 from .caps_inputs import END_MASS_MAX, SPEC_KEYS, SPEC_UNITS, LineSpec, spec  # noqa: F401 (caps' public names)
-from .caps_combined import combined_route, combined_verdict
+from .caps_combined import combined_links, combined_route, combined_verdict
+from .caps_ideal import beside
 from .caps_format import format_answer, format_design  # noqa: F401 (caps' public names)
 from .caps_inputs import _pos
 from .caps_inputs import as_spec as _as_spec
@@ -205,6 +210,7 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
     bar = tqdm(desc=f"{sp.name or 'line'}, chi={chi:g}", unit="run", leave=False, disable=None)  # (off without a terminal)
     try:
         runs = Runs(sp, chi, tol, stiff_tol, damping, stretch_method, bar=bar, combined=combined)
+        runs.limit = N == "auto"  # (links chosen until the answer settles: the ideal's limit beside it)
         if N == "auto":
             r = _auto(runs, quantity, alone, graded)
         else:
@@ -230,7 +236,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     sp, chi = runs.sp, runs.chi
     present = [m for m in MECHANISMS[:-1] if sp.has(m)]
     ideal_nd = runs.get((), N)
-    ideal_on = None  # graded or combined answers: the ideal on their links, extrapolated (its uniform-links run kept)
+    limit_links = None  # (a limit answer's graded links: the stand-in for a peak without a shipped ideal limit)
     grade = _grading(runs, N, present, graded)
     if grade["used"]:
         on, lb = tuple(present), bending_length(sp)
@@ -243,10 +249,7 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
         grade["error"] = _si(sp, gl["error"])
         grade["within"] = gl["stopped"] == "within"
         check = False
-        gi = runs.ideal_on([(graded_h(chi, lb, k), f"graded {k}") for k in gl["pair"]])  # the ideal on the same links
-        ideal_on = {"what": "graded", "links": gi["links"], "relative_error": gi["relative_error"],
-                    "uniform": _si(sp, ideal_nd), "N": N}
-        ideal_nd = {**gi["extrapolated"], "method": gi["levels"][1]["method"]}
+        limit_links = [(graded_h(chi, lb, k), f"graded {k}") for k in gl["pair"]]
     else:
         full_nd = runs.get(tuple(present), N)
     alone_nd = {}
@@ -283,12 +286,9 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
                                          f"elastic over rigid on {sl[0]['N']} and {sl[1]['N']} links")
                                       + "); " + stretch_words(sl, ok)
                                       + ("" if all(ok.values()) else unresolved_stretching_words(ratio, body))})
-            if cg is not None:  # the ideal beside it: on the same graded links, extrapolated (its continuum limit)
+            if cg is not None:  # (its links: the ideal's stand-in where no shipped limit exists, caps_ideal)
                 stretching.update(model="combined (elastic + body) on graded links", combined=cg, why=cg["why"])
-                gi = cg["ideal"]
-                ideal_on = {"what": "combined", "links": gi["links"], "relative_error": gi["relative_error"],
-                            "uniform": _si(sp, runs.get((), N)), "N": N}
-                ideal_nd = {**gi["extrapolated"], "method": ideal_nd["method"]}
+                limit_links = [(combined_links(chi, k), f"combined level {k}") for k in cg["pair"]]
             if alone and not body:  # (with a body the factor is stretching's with it, not alone: no such run)
                 alone_nd["stretching"] = {q: ideal_nd[q] * factor_s[q] for q in QUANTITIES}
         else:
@@ -305,6 +305,10 @@ def _answer(runs: Runs, N: int, quantity: str, check: bool, alone: bool, graded=
     if check:
         half = runs.get(tuple(present), N // 2)
         resolution = {q: (full_nd[q] - half[q]) / full_nd[q] for q in QUANTITIES}
+    ideal_on = None
+    if runs.limit or limit_links is not None:  # a limit answer: the ideal's continuum limit beside it (caps_ideal)
+        ideal_nd, ideal_on = beside(runs, ideal_nd, limit_links)
+        ideal_on.update(uniform=_si(sp, ideal_on["uniform"]), N=N)
     factor = {q: real_nd[q] / ideal_nd[q] for q in QUANTITIES}
     judged = {m: v[quantity] for m, v in alone_nd.items() if m != "stretching" or stretching["resolved"][quantity]}
     capped = decide(factor[quantity], real_nd[quantity], judged,

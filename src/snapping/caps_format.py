@@ -18,12 +18,13 @@ def format_answer(r: dict) -> list[str]:
         out.append(f"  {q:<12}{r['ideal'][q]:14.5g}{r['real'][q]:14.5g}{r['factor'][q]:9.4f}   {u}")
     io = r.get("ideal_on")
     if io:
-        out.append(f"  ideal chain: on the {'combined model' if io['what'] == 'combined' else 'full run'}'s graded "
-                   f"links ({' and '.join(map(str, io['links']))}), extrapolated as it (the real answer's links; the "
-                   f"ideal's peaks grow with uniform links): " + ", ".join(
-                       f"{q} +- {io['relative_error'][q]:.2%}" for q in QUANTITIES)
-                   + f"; on {io['N']} uniform links it is " + ", ".join(f"{q} {io['uniform'][q]:.5g}"
-                                                                         for q in QUANTITIES))
+        src = {"limit": "its continuum limit (shipped, snapping.table.limits)",
+               "graded": "on the answer's graded links " + "/".join(map(str, io.get("links") or ())) + ", extrapolated",
+               "uniform": f"on {io['N']} uniform links (no limit: not converged)"}
+        out.append("  ideal chain: " + "; ".join(f"{q} {src[io['source'][q]]} +- {io['relative_error'][q]:.2%}"
+                                                 for q in QUANTITIES)
+                   + f" (the ideal's peaks grow with its links; on {io['N']} uniform links: "
+                   + ", ".join(f"{q} {io['uniform'][q]:.5g}" for q in QUANTITIES) + ")")
     if r["alone"]:
         left = not r["stretching"].get("resolved", {}).get(r["quantity"], True)
         out.append(f"  each mechanism alone ({r['quantity']}): " + ", ".join(

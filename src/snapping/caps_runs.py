@@ -430,6 +430,7 @@ class Runs:
     def __init__(self, sp, chi, tol, stiff_tol, damping, stretch_method=STRETCH_METHOD, bar=None, combined=False):
         self.sp, self.chi, self.tol, self.stiff_tol, self.damping = sp, chi, tol, stiff_tol, damping
         self.combined = bool(combined)  # the combined model on graded links where the uniform factor does not settle
+        self.limit = False  # a limit answer (N="auto"): the ideal's continuum limit beside it (snapping.caps_ideal)
         self.stretch_method = stretch_method  # the stretching factor's elastic method (:func:`stretch_factor`)
         self.done, self.log = {}, []
         self.bar = bar  # a progress bar (tqdm): one step per run made, the last run in its postfix
