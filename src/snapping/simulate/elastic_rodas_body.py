@@ -11,26 +11,27 @@ same tableau, controller and dense output); what differs:
   i-1 and i): the springs' exact blocks (:func:`elastic_jacobian.jacobian`), a pushing line's compressed
   links' exact ones (:func:`compression_jacobian`: by differences, a link within the step of its rest
   length, as at the bottom of a stiff catenary, strain ~1e-7 at c = 300, got a spurious EA/2 and the
-  steps fell 70-fold), plus the bending's and drag's by central differences over the nodes coloured
-  mod 5 (the steps of :func:`elastic_body.body_jac_fd`), in the
-  compact form ``B5[i, k, 0:4] = K``, ``B5[i, k, 4:8] = C`` (node i's accelerations by node
+  steps fell 70-fold), plus the bending's and drag's, exact since branch fastbody
+  (:mod:`elastic_body_jacobian`; before, central differences over the nodes coloured mod 5, the steps of
+  :func:`elastic_body.body_jac_fd`: :func:`body_jacobian_fd`, kept for the tests), in the compact form ``B5[i, k, 0:4] = K``, ``B5[i, k, 4:8] = C`` (node i's accelerations by node
   ``i - 2 + k``'s positions, velocities; 2 x 2 row-major);
 * the W row (the held end's power) gets the body's ``d/dz (M_N phi' - F_N . v_pin)``, which reaches
   nodes N-2 and N-1 (``gW`` holds nodes N-3..N-1: 12 entries), and the D row the body's
-  ``d/dz (2R + D_compression - P_drag)`` (all nodes: drag), both by the same coloured differences: the
-  dissipation is split into per-node terms (:func:`local_dissipation`, each reaching one node either
-  side) so that a colour's perturbed nodes (5 apart) are told apart;
+  ``d/dz (2R + D_compression - P_drag)`` (all nodes: drag), both exact too (the differences split the
+  dissipation into per-node terms, :func:`local_dissipation`, each reaching one node either side, so that a
+  colour's perturbed nodes, 5 apart, are told apart);
 * the reduced stage matrix ``I - g^2 K - g C`` is a band of 2 x 2 blocks reaching two nodes either
   side: interleaved bandwidth 5 below and above, factored with partial pivoting
-  (:func:`banded.band_lu`; bending makes it non-symmetric in general, so the spring-only path's
+  (:func:`banded_body.band_lu55`, :func:`banded.band_lu`'s general path until branch fastbody; bending makes
+  it non-symmetric in general, so the spring-only path's
   pivot-free block Thomas is not used); every factorisation counts as pivoted (``n_lu_pivoted``);
 * the clamp's angle (a constant or the cubic spline of :class:`LineBody`, its piecewise
   polynomial evaluated compiled: :func:`clamp_at`) at each stage's time; a clamp given as samples makes
   the system non-autonomous (``df/dt`` by a forward difference, as for a moving held end).
 
-Its step is compiled (:func:`body_accept`); the run's step loop and bookkeeping are
-:func:`elastic_solve.solve`'s Python loop (one call per accepted step), the peaks refined by
-``_Peaks.refine`` with this stepper. The plain line's ``"rodas4"`` (no body) is untouched.
+Its step is compiled (:func:`body_accept`); the run's step loop and bookkeeping too since branch fastbody
+(:mod:`elastic_body_advance`; before, :func:`elastic_solve.solve`'s Python loop, one call per accepted step),
+the peaks refined by ``_Peaks.refine`` with this stepper. The plain line's ``"rodas4"`` (no body) is untouched.
 """
 
 from __future__ import annotations
@@ -42,19 +43,21 @@ from numba import njit
 
 from . import elastic_kernels as EK
 from . import elastic_rodas as ER
-from .banded import band_lu, band_solve
+from .banded_body import WROW5, band_lu55, band_solve55
 from .elastic_body import _geometry, add_body
+from .elastic_body_jacobian import body_terms_jacobian
 from .elastic_jacobian import add_link_gradient, jacobian
 from .force_drag import add_drag
 from .rosenbrock import A_ST, C_NODE, C_ST, D_TIME, GAMMA
 
-__all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "local_dissipation", "body_accept",
+__all__ = ["RodasBodyStepper", "clamp_at", "body_rhs", "body_jacobian", "body_jacobian_fd", "local_dissipation", "body_accept",
            "KLB", "KUB", "WIDTHB", "NGW"]
 
 #: the body's reduced stage matrix's bandwidths (2 x 2 blocks reaching nodes i-2..i+2, interleaved x, y)
 KLB = KUB = 5
-#: band storage width of :func:`banded.band_lu` (room for the pivoting's fill-in)
-WIDTHB = 2 * KLB + KUB + 1
+#: band storage width of :func:`banded_body.band_lu55` (room for the pivoting's fill-in and the reciprocal
+#: pivots; :func:`banded.band_lu`'s general path, 2 KLB + KUB + 1 wide, until branch fastbody)
+WIDTHB = WROW5
 #: entries of the W row's gradient: nodes N-3..N-1
 NGW = 12
 #: the scalars of a body (``bd[7]``): tip drag, wind x, y, clamped, push, clamp kind (0 none, 1 a
@@ -241,14 +244,9 @@ def compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD):
 
 
 @njit(cache=True, error_model="numpy")
-def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
-                  QP, Q, hmin):
-    """The Jacobian of :func:`body_rhs` at ``(t, z)`` (``T, E, ED`` the springs' there): the node blocks
-    ``B5`` (N x 5 x 8, see the module), the W row's gradient ``gW`` (nodes N-3..N-1) and the D row's ``gD``
-    (4N). The springs' part exact (:func:`elastic_jacobian.jacobian` into ``J3, gW4``), the body's by
-    central differences, the nodes perturbed in colours mod 5, the steps of
-    :func:`elastic_body.body_jac_fd` (``1e-6 hmin`` in position, ``2e-6`` of the shortest link where a
-    link is shorter than ``hmin/2``; ``1e-6 (1 + |v|)`` in velocity)."""
+def _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD):
+    """The springs' (:func:`elastic_jacobian.jacobian`) and the compressed links' (:func:`compression_jacobian`)
+    part of :func:`body_jacobian` into ``B5, gW, gD`` (overwritten)."""
     jacobian(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, gD)
     for i in range(N):
         for k in range(5):
@@ -260,6 +258,39 @@ def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4
         gW[8 + q] = gW4[q]
     if bd[7][P_PUSH] != 0.0:
         compression_jacobian(N, z, pin, h, invm, ea, damp, B5, gW, gD)
+
+
+@njit(cache=True, error_model="numpy")
+def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
+                  QP, Q, hmin):
+    """The Jacobian of :func:`body_rhs` at ``(t, z)`` (``T, E, ED`` the springs' there): the node blocks
+    ``B5`` (N x 5 x 8, see the module), the W row's gradient ``gW`` (nodes N-3..N-1) and the D row's ``gD``
+    (4N). The springs' part exact (:func:`elastic_jacobian.jacobian` into ``J3, gW4``), the compressed links'
+    (:func:`compression_jacobian`), the body's (bending, drag) exact too
+    (:func:`elastic_body_jacobian.body_terms_jacobian`, branch fastbody; the coloured differences before,
+    :func:`body_jacobian_fd`, ~20x its cost). ``zz, GX, GY, QP, Q, hmin``: the differences' (unused here)."""
+    _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, False)
+
+
+@njit(cache=True, error_model="numpy")
+def _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, ready):
+    """:func:`body_jacobian`; ``ready``: ``bs`` holds the geometry and moments of ``(t, z)`` (:func:`body_rhs`
+    there came just before: :func:`body_f_and_jacobian`)."""
+    _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD)
+    Bl, K0L, El, CN, CT, KN, KT, sc, cx, cc = bd
+    ex, ey, phid = clamp_at(t, sc, cx, cc)
+    body_terms_jacobian(N, z, pin, invm, Bl, K0L, El, CN, CT, KN, KT, sc, ex, ey, phid, bs, B5, gW, gD,
+                        np.empty((4, 4)), ready)
+
+
+@njit(cache=True, error_model="numpy")
+def body_jacobian_fd(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY,
+                  QP, Q, hmin):
+    """:func:`body_jacobian` with the body's part by central differences (the method's Jacobian until
+    branch fastbody, kept for the tests of the exact one), the nodes perturbed in colours mod 5, the steps of
+    :func:`elastic_body.body_jac_fd` (``1e-6 hmin`` in position, ``2e-6`` of the shortest link where a
+    link is shorter than ``hmin/2``; ``1e-6 (1 + |v|)`` in velocity)."""
+    _springs_part(N, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD)
     n = z.shape[0]
     for i in range(n):
         zz[i] = z[i]
@@ -314,7 +345,7 @@ def body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4
 
 @njit(cache=True, error_model="numpy")
 def assemble_band5(N, B5, gh, ab):
-    """``I - g^2 K - g C`` (``g = gh``) in :func:`banded.band_lu`'s storage (row i, column j at
+    """``I - g^2 K - g C`` (``g = gh``) in :func:`banded_body.band_lu55`'s storage (row i, column j at
     ``ab[i, j - i + KLB]``), from the compact blocks ``B5``."""
     ab[:, :] = 0.0
     g2 = gh * gh
@@ -347,7 +378,7 @@ def solve5(N, B5, gW, gD, gh, ab, piv, b, U, w):
                     continue
                 acc += g2 * (B5[i, k, 2 * r] * b[4 * jn] + B5[i, k, 2 * r + 1] * b[4 * jn + 1])
             w[2 * i + r] = acc
-    band_solve(ab, 2 * N, KLB, KUB, piv, w)
+    band_solve55(ab, 2 * N, piv, w)
     for i in range(N):
         for r in range(2):
             uv = w[2 * i + r]
@@ -374,7 +405,7 @@ def body_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, bd
     gh = GAMMA * hs
     assemble_band5(N, B5, gh, ab)
     ctl[ER.C_NPIV] += 1.0
-    if band_lu(ab, 2 * N, KLB, KUB, piv) != 0:
+    if band_lu55(ab, 2 * N, piv) != 0:
         return np.inf
     cc = np.empty(5)
     for st in range(6):
@@ -400,11 +431,12 @@ def body_step(N, t, hs, z0, ft, auto, pins, h, invm, ea, damp, tabe, tabt, g, bd
 @njit(cache=True, error_model="numpy")
 def body_f_and_jacobian(N, t, z, pinpar, pintab, pin, h, invm, ea, damp, tabe, tabt, g, bd, f, B5, gW, gD, T, E, ED,
                         FV, J3, gW4, bs, zz, GX, GY, QP, Q, hmin):
-    """``f(t, z)`` and the Jacobian there (:func:`body_jacobian`, the springs' from the same tensions)."""
+    """``f(t, z)`` and the Jacobian there (:func:`body_jacobian`, the springs' from the same tensions, the body's
+    from the same geometry and moments); leaves the body's force on the held end in ``bs[5][N], bs[6][N]``
+    (the Jacobian's scratch there stops at N - 1: :func:`elastic_body_advance.body_measure` reads them)."""
     ER.pin_at(t, pinpar, pintab, pin)
     body_rhs(N, t, z, pin, h, invm, ea, damp, tabe, tabt, g, bd, f, T, E, ED, FV, bs)
-    body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, zz, GX, GY, QP,
-                  Q, hmin)
+    _body_jacobian(N, t, z, pin, h, invm, ea, damp, tabe, tabt, T, E, ED, J3, gW4, bd, B5, gW, gD, bs, True)
 
 
 @njit(cache=True, error_model="numpy")

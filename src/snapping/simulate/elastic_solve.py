@@ -48,6 +48,7 @@ from scipy.integrate import DOP853, Radau
 
 from .. import _validate as V
 from . import elastic_advance as EA
+from . import elastic_body_advance as EBA
 from . import elastic_checkpoint as ECK
 from . import elastic_checks as EC
 from . import elastic_progress as EP
@@ -77,8 +78,8 @@ PEAK_RESTEP = 1
 #: that reach the snap err by at most 0.04 of it; DOP853 at tol 1e-2, c = 100, by 0.76 at
 #: t = 0.23, with a false snap there; Radau at tol 1e-2, N = 30, c = 300 by 0.15 at t = 1.75)
 ENERGY_ERROR_FAIL = 0.1
-#: RODAS4 (node and links) runs its step loop compiled (:func:`elastic_advance.advance`,
-#: ``advance_links``); False: the Python loop
+#: RODAS4 (node and links, a body's too: :mod:`elastic_body_advance`, branch fastbody) runs its step loop
+#: compiled (:func:`elastic_advance.advance`, ``advance_links``); False: the Python loop
 #: below, one step a call (the reference the compiled loop equals, bit for bit)
 COMPILED_LOOP = True
 #: a compiled RODAS4 run (and a rodas4-links run of either loop) refines its peaks compiled
@@ -235,8 +236,8 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
     (t first), the running peak's state, the first slack time, when the stop rule was armed,
     status and reason; the snapshots and the peaks' kept steps (refined by
     :meth:`_Peaks.refine`) are filled in."""
-    run = (EA.LinksRun if isinstance(solver, LinksStepper) else EA.RodasRun)(solver, mm0, energy_fail=ENERGY_ERROR_FAIL,
-                                                                            **kw)
+    Run = EA.LinksRun if isinstance(solver, LinksStepper) else EBA.BodyRun if line.body is not None else EA.RodasRun
+    run = Run(solver, mm0, energy_fail=ENERGY_ERROR_FAIL, **kw)
     if state is not None:  # (a resumed run: elastic_checkpoint)
         run.restore(state)
     chunks, status = [], "completed"
@@ -274,7 +275,7 @@ def _run_rodas(solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_
         elif code == EA.R_ENERGY:
             status, stop_reason = "failed", _ENERGY_MSG
         break
-    if COMPILED_REFINE:
+    if COMPILED_REFINE and line.body is None:  # (a body's peaks: _Peaks.refine with its stepper)
         peaks.run = run
     else:
         for k, (val, tp, segs) in zip({**peaks.COLS, **peaks.APPROACH}, run.segments().values()):
@@ -412,7 +413,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
         count[0] += 1
         return line.rhs(t, z)
 
-    Rodas = RodasStepper if line.body is None else RodasBodyStepper  # (a body: elastic_rodas_body, Python loop)
+    Rodas = RodasStepper if line.body is None else RodasBodyStepper  # (a body: elastic_rodas_body, elastic_body_advance)
     if method == "rodas4":
         solver = Rodas(line, 0.0, z0, t_bound, tol)
     elif method == "rodas4-links":
@@ -472,7 +473,7 @@ def _solve(line, problem, inputs, *, method, tol, t_end, t_end_max, stop_fractio
 
     bar = EP.open_run_bar(problem, method, t_end, progress)
     try:
-        if method in ("rodas4", "rodas4-links") and COMPILED_LOOP and line.body is None:
+        if method in ("rodas4", "rodas4-links") and COMPILED_LOOP:
             with sigs if sigs is not None else contextlib.nullcontext():  # (the signals noted, checkpointed runs)
                 rec_steps, peak_state, first_slack, t_armed, status, stop_reason = _run_rodas(
                     solver, line, mm0, snaps, snap_t, snap_z, snap_kind, peaks, peak_state, stop_reason, restep,
