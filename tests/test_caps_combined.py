@@ -119,12 +119,15 @@ def _cg(real, inext, ideal):
     (70.0, 80.0, 200.0, 0.40, "drag"),             # x0.875 vs the body's x0.4
     (150.0, 140.0, 200.0, 0.80, "drag"),           # stretching raises it (x1.07): the body's
     (190.0, 210.0, 200.0, 0.93, "none"),           # within 10% of the ideal's limit
+    (240.0, 1200.0, 200.0, 0.50, "stretching"),    # the body raises it x6 (takes nothing down), stretching x0.2
+    (95.0, 97.5, 100.0, 0.80, "stretching"),       # neither step below 0.9 on the finest level: the larger, said
 ])
 def test_combined_verdict_splits_the_ratio_on_the_finest_level(real, inext, ideal, factor, expect):
     got, why = caps_combined.combined_verdict(_cg(real, inext, ideal), "sigma_peak", factor, {"drag": 1.0},
                                               lambda alone: min(alone))
     assert got == expect
     assert f"({20} links)" in why and f"x{inext / ideal:.3g}" in why and f"x{real / inext:.3g}" in why
+    assert ("neither below 0.9" in why) == (factor < 0.9 and min(real / inext, inext / ideal) >= 0.9)
 
 
 def test_off_by_default_the_unsettled_factor_is_left_out(monkeypatch):
@@ -198,6 +201,8 @@ def test_design_takes_the_combined_route(monkeypatch, capsys):
     assert row["factor"]["sigma_peak"] < 0.9
     text = "\n".join(caps.format_design(d))
     assert "real peaks from the combined model (elastic + body) on graded links" in text
+    assert row["cap_why"] and row["cap_why"] in text and "stretching takes it down" in text
+    assert row["ideal_on"]["source"] == {q: "limit" for q in Q}
     assert "stretching factor NOT applied" not in text
     assert main(["design", "--line", "bungee-cord", "--chis", "0.3", "--links", "16", "--max-tension", "1e9",
                  "--combined", "--json"]) == 0

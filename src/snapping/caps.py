@@ -177,7 +177,9 @@ def cap(line=None, chi: float = 0.25, *, N: int | str | None = None, tol: float 
         extrapolated), ``observed_order`` (per peak, from the last three levels; None with two),
         ``stopped`` (``"within"`` or ``"max_links"``: why no finer level was run) and ``stop_why``,
         ``bending_length``, ``error`` (SI) and ``relative_error`` per peak, ``within`` (every peak's
-        error <= 1%)), ``runs`` (each run:
+        error <= 1%)), ``ideal_on`` (None, or where ``ideal`` is the ideal chain's continuum limit -- the
+        answer a limit: ``N="auto"``, graded links, the combined model -- what it is per peak:
+        :func:`snapping.caps_ideal.beside`), ``cap_why`` (a combined answer's verdict in words), ``runs`` (each run:
         what, links, method, evaluations, CPU s), ``n_rhs``, ``wall`` and ``cpu`` (s).
     """
     from .estimates import check_chi
@@ -515,6 +517,7 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
         rows.append({"chi": r["chi"], "ideal": r["ideal"], "real": r["real"], "factor": r["factor"], "cap": r["cap"],
                      "alone": r["alone"], "mechanisms": r["mechanisms"], "graded": r["graded"],
                      "stretching": r["stretching"], "N": r.get("N", N), "resolved": _row_resolved(r),
+                     "ideal_on": r.get("ideal_on"), "cap_why": r.get("cap_why"),
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
     ok = [r["chi"] for r in rows if r["admissible"]]

@@ -22,15 +22,15 @@ inextensible answer's (:func:`snapping.caps_runs.method_for`), RODAS4 at :data:`
 answer (:func:`combined_answer`): :func:`snapping.caps_runs.graded_levels` (levels 0 and 1, then more
 while a peak's Richardson estimate at order 2 is over 1%, up to :data:`COMBINED_MAX_LINKS` links).
 
-**The ideal beside it, and the verdict** (:func:`same_links`, :func:`combined_verdict`). The ideal chain's
-peaks grow with uniform links, so the real answer is compared with the ideal chain **on the same graded
-levels**, extrapolated on the same pair: its continuum limit (the rope at chi 0.1: T 177.2, 196.3, 203.3 M g
-on 947/1857/3680 links, the stretching study's limit 205.98). The inextensible line with the same body is
-run on the same levels too, and the verdict splits the real/ideal ratio on the finest level into the body's
-step (inextensible with body / ideal) and stretching's (combined / inextensible with body): below 0.9
-(:data:`snapping.regimes_analysis.LEVEL`), the step that takes the peak further down in |log| names the
-mechanism -- ``"stretching"``, or, where the body's step does, the body's mechanism by
-:func:`snapping.caps.decide`'s rule among the runs alone.
+**The ideal beside it, and the verdict** (:func:`same_links`, :func:`combined_verdict`). The answer's factor is
+taken against the ideal chain's continuum limit (shipped: :mod:`snapping.caps_ideal`). For the verdict, the ideal
+chain and the inextensible line with the same body are run on the combined levels too (the ideal's there: T 177.2,
+196.3, 203.3, 205.3 M g on the rope's 947-7328 links at chi 0.1; its limit 205.98), and real/ideal on the finest
+level splits into the body's step b (inextensible with the body / ideal) and stretching's s (combined /
+inextensible with the body). A step that raises the peak takes nothing down: the mechanism is the one whose
+step takes the peak further down (``"stretching"``, or the body's, named by :func:`snapping.caps.decide`'s rule
+among the runs alone); the words say when neither step is below 0.9
+(:data:`snapping.regimes_analysis.LEVEL`) on the finest level though the factor is.
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def combined_route(runs, present, full_nd: dict, uniform: list, resolved: dict) 
         runs._logged({"run": "combined", "N": x["links"], "method": x["method"], "tol": COMBINED_TOL,
                       "n_rhs": x["n_rhs"], "cpu": x["cpu"]})
 
-    cg = combined_answer(runs.sp, runs.chi, present, logged=logged)
+    cg = combined_answer(runs.sp, runs.chi, present, logged=logged, damping=runs.damping)  # (same_links': the same)
     ext, rel = cg["extrapolated"], cg["relative_error"]
     links = "/".join(str(x["links"]) for x in cg["levels"])
     off = [q for q in QUANTITIES if not resolved[q]]
@@ -149,11 +149,12 @@ def same_links(runs, present, cg: dict) -> dict:
 
 def combined_verdict(cg: dict, quantity: str, factor: float, alone: dict, decide) -> tuple[str, str]:
     """The capping mechanism of a combined answer ``cg`` (:func:`combined_route` with :func:`same_links`) and
-    why, in words: ``"none"`` where ``factor`` (real / the ideal's limit, of ``quantity``) is at least
-    :data:`snapping.regimes_analysis.LEVEL`; else, on the finest level, the body's step b (the inextensible
-    line with the body over the ideal chain) and stretching's s (the combined model over the inextensible line
-    with the body): ``"stretching"`` where s < LEVEL and |log s| >= |log b|, else ``decide(alone)`` (the body's
-    mechanism nearest the real answer, :func:`snapping.caps.decide`'s rule; ``alone``: {mechanism: peak})."""
+    why, in words: ``"none"`` where ``factor`` (real / the ideal's continuum limit, of ``quantity``) is at
+    least :data:`snapping.regimes_analysis.LEVEL`; else, on the finest level, the body's step b (the
+    inextensible line with the body over the ideal chain) and stretching's s (the combined model over the
+    inextensible line with the body), each step down min(log step, 0): ``"stretching"`` where stretching's
+    step down is the larger, else ``decide(alone)`` (the body's mechanism nearest the real answer,
+    :func:`snapping.caps.decide`'s rule; ``alone``: {mechanism: peak})."""
     from .regimes_analysis import LEVEL
 
     k = len(cg["levels"]) - 1
@@ -162,7 +163,11 @@ def combined_verdict(cg: dict, quantity: str, factor: float, alone: dict, decide
     steps = (f"on the finest level ({cg['levels'][k]['links']} links) the body's step (inextensible with it / ideal) "
              f"x{b:.3g}, stretching's (combined / inextensible with the body) x{s:.3g}")
     if factor >= LEVEL:
-        return "none", f"real/ideal {factor:.3g} >= {LEVEL:g} (the ideal's limit on the same links); {steps}"
-    if s < LEVEL and abs(math.log(s)) >= abs(math.log(b)):
-        return "stretching", f"real/ideal {factor:.3g} < {LEVEL:g}; {steps}: stretching takes it down"
-    return decide(alone), f"real/ideal {factor:.3g} < {LEVEL:g}; {steps}: the body takes it down"
+        return "none", f"real/ideal {factor:.3g} >= {LEVEL:g} (the ideal chain's continuum limit); {steps}"
+    head = f"real/ideal {factor:.3g} < {LEVEL:g} (the ideal chain's continuum limit); {steps}"
+    if min(s, b) >= LEVEL:
+        head += f" (neither below {LEVEL:g} on the finest level)"
+    down_s, down_b = min(math.log(s), 0.0), min(math.log(b), 0.0)
+    if down_s < down_b or (down_s == down_b and s <= b):
+        return "stretching", head + ": stretching takes it down"
+    return decide(alone), head + ": the body takes it down"

@@ -20,9 +20,14 @@ def format_answer(r: dict) -> list[str]:
     if io:
         src = {"limit": "its continuum limit (shipped, snapping.table.limits)",
                "graded": "on the answer's graded links " + "/".join(map(str, io.get("links") or ())) + ", extrapolated",
-               "uniform": f"on {io['N']} uniform links (no limit: not converged)"}
-        out.append("  ideal chain: " + "; ".join(f"{q} {src[io['source'][q]]} +- {io['relative_error'][q]:.2%}"
-                                                 for q in QUANTITIES)
+               "uniform": f"on {io['N']} uniform links"}
+
+        def err(q):
+            e = io["relative_error"][q]
+            return f"+- {e:.2%}" if e == e else "(error unknown)"
+
+        out.append("  ideal chain: " + "; ".join(f"{q} {src[io['source'][q]]} {err(q)}" for q in QUANTITIES)
+                   + "".join(f" [{q}: {w}]" for q, w in io.get("why", {}).items())
                    + f" (the ideal's peaks grow with its links; on {io['N']} uniform links: "
                    + ", ".join(f"{q} {io['uniform'][q]:.5g}" for q in QUANTITIES) + ")")
     if r["alone"]:
@@ -97,10 +102,10 @@ def format_design(d: dict) -> list[str]:
     if gr:
         out.append(f"  real peaks from graded links, the last two levels extrapolated, at chi: {', '.join(gr)}")
     cb = [f"{r['chi']:g} (T +- {r['stretching']['combined']['relative_error']['sigma_peak']:.2%}; capped by "
-          f"{r['cap']}: {r.get('cap_why', '')})" for r in d["rows"] if r.get("stretching", {}).get("combined")]
+          f"{r['cap']}: {r.get('cap_why') or '-'})" for r in d["rows"] if r.get("stretching", {}).get("combined")]
     if cb:
         out.append("  real peaks from the combined model (elastic + body) on graded links, extrapolated, against the "
-                   f"ideal chain's limit on the same links, at chi: {'; '.join(cb)}")
+                   f"ideal chain's continuum limit, at chi: {'; '.join(cb)}")
     st = [f"{r['chi']:g} ({', '.join(q for q, ok in r['stretching']['resolved'].items() if not ok)})"
           for r in d["rows"] if r.get("stretching", {}).get("run") and not all(r["stretching"]["resolved"].values())]
     if st:

@@ -6,14 +6,15 @@ is where a peak falls 10% below it). Computing it costs 1-100 s of CPU per chi (
 2140-33759 links at chi 0.05), more than a design answer's budget, so the limits at :data:`CHIS` are shipped
 in ``snapping/data/ideal_limits.nc``, built by :func:`build` (``python -m snapping.table.limits``: each chi
 :func:`snapping.continuum.converge` with ``levels=5, first=-1``, its limit and error bar per peak, 318 s of CPU
-in all; relative bars 6e-4 (v), 3e-3 (a), 4e-3 (T) at chi 0.05, under 1e-4 from chi 0.2; the command, CPU
+in all; relative bars 6e-4 (v), 3e-3 (a), 4e-3 (T) at chi 0.05; from chi 0.2 v and T under 1e-4, a 4e-4; the command, CPU
 time and machine in the file's attributes). They agree with the regime studies' ideal limits, computed on their
 own levels (v 32.970, 14.8208, 8.9642, 4.5340 at chi 0.1-0.5; ``tests/test_ideal_limits.py``).
 
 :func:`ideal_limit` interpolates them: a cubic spline (scipy's ``CubicSpline``, not-a-knot) of log(limit) in
 log(chi), exact at the nodes; its error bar, between nodes, the larger of the two neighbouring nodes' error bars
 plus the interpolation's own error (the leave-one-out error at those nodes: the spline through the other
-nodes, an overestimate for a smooth peak). A peak that does not converge over the levels at a node (the
+nodes, an overestimate for a smooth peak; where fewer than five converged nodes surround it, a flat 10%). A
+peak that does not converge over the levels at a node (the
 acceleration at large chi: the ideal chain's grows without limit with its links there) has no limit there, nor
 in the intervals beside it: None, said.
 
