@@ -210,3 +210,32 @@ def test_design_takes_the_combined_route(monkeypatch, capsys):
     assert row["stretching"]["model"] == "combined (elastic + body) on graded links"
     assert main(["design", "--max-tension", "1e9", "--combined"]) == 2
     assert "--combined is a real line's option" in capsys.readouterr().err
+
+
+def test_design_counts_admissible_only_rows_with_nothing_unsure(monkeypatch):
+    """Rows under the limit: resolved (admissible), not resolved in the links, stretching left out of the limited
+    peak, stretching left out of another peak only; and one over the limit."""
+    LV = [{"N": 50}, {"N": 100}]
+    rows = {0.1: {"resolved": False, "stretching": {}},
+            0.2: {"resolved": True, "stretching": {"run": True, "levels": LV, "resolved": {
+                "v_peak": True, "a_peak": True, "sigma_peak": False}}},
+            0.3: {"resolved": True, "stretching": {"run": True, "levels": LV, "resolved": {
+                "v_peak": True, "a_peak": False, "sigma_peak": True}}},
+            0.4: {"resolved": True, "stretching": {"run": False}},
+            0.5: {"resolved": True, "stretching": {}, "T": 5.0}}
+
+    def fake(sp, chi, **kw):
+        x = rows[chi]
+        peaks = {"v_peak": 1.0, "a_peak": 1.0, "sigma_peak": x.get("T", 1.0)}
+        return {"chi": chi, "ideal": peaks, "real": peaks, "factor": peaks, "cap": "none", "alone": {},
+                "mechanisms": [], "graded": {}, "stretching": x["stretching"], "n_rhs": 1, "resolved": x["resolved"]}
+
+    monkeypatch.setattr(caps, "cap", fake)
+    d = caps.design("bungee-cord", chis=sorted(rows), max_tension=2.0)
+    assert d["admissible_chi"] == [0.3, 0.4]
+    assert [x["chi"] for x in d["admissible_unsure"]] == [0.1, 0.2]
+    assert d["admissible_unsure"][0]["why"] == ["not resolved in the links"]
+    assert "stretching left out of sigma_peak" in d["admissible_unsure"][1]["why"][0]
+    text = "\n".join(caps.format_design(d))
+    assert "under the limits but NOT counted admissible: 0.1 (not resolved in the links); 0.2 (stretching" in text
+    assert "admissible chi (real line): 0.3, 0.4" in text and " yes?" in text

@@ -99,7 +99,7 @@ from .caps_runs import (GRADED_ORDER, GRID_DAMPING, MECHANISMS, QUANTITIES, STIF
                         stretch_factor, body_stretch_words)
 from .caps_runs import grading_for as _grading
 
-__all__ = ["LineSpec", "spec", "cap", "design", "decide", "auto_hopeless", "auto_graded", "AUTO_GRADED_LINKS", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
+__all__ = ["LineSpec", "spec", "cap", "design", "decide", "unsure", "auto_hopeless", "auto_graded", "AUTO_GRADED_LINKS", "STRETCH_MATTERS", "STRETCH_N", "QUANTITIES", "MECHANISMS", "AUTO_N",
            "format_answer", "format_design"]
 
 #: the full run's peak speed (the speed the line reaches) over the wave speed above which the stretching is run
@@ -484,7 +484,9 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
     ``rows`` per chi: ``ideal`` and ``real`` peaks, ``factor`` (real/ideal per peak), ``cap``
     (the mechanism that capped the snap at that chi, decided on ``quantity``: :func:`cap`'s rule),
     ``graded`` (:func:`cap`'s: the real peaks from graded links, extrapolated, with their error),
-    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it, ``N`` (the
+    ``admissible`` (real peaks under every limit) and ``ideal_admissible`` beside it, ``unsure`` (why the
+    real peaks may be off: :func:`unsure`; ``admissible_chi`` lists only rows under the limits with nothing
+    unsure, ``admissible_unsure`` the others under them, with why), ``N`` (the
     row's links) and ``resolved``. ``N``: the links of every run; None (the default) or ``"auto"``:
     each chi on the links that resolve it, :func:`cap`'s ``N="auto"`` (since ``designres``; 200
     links for every chi before), a line of discrete links on its own. ``combined``: :func:`cap`'s (the
@@ -520,10 +522,30 @@ def design(line=None, chis=(0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5), *, N: in
                      "ideal_on": r.get("ideal_on"), "cap_why": r.get("cap_why"),
                      "admissible": all(r["real"][q] <= lim for q, lim in limits.items()),
                      "ideal_admissible": all(r["ideal"][q] <= lim for q, lim in limits.items())})
-    ok = [r["chi"] for r in rows if r["admissible"]]
+    for r in rows:
+        r["unsure"] = unsure(r, limits)
+    ok = [r["chi"] for r in rows if r["admissible"] and not r["unsure"]]
+    maybe = [{"chi": r["chi"], "why": r["unsure"]} for r in rows if r["admissible"] and r["unsure"]]
     return {"line": sp.name, "N": N, "limits": limits, "quantity": quantity, "rows": rows, "admissible_chi": ok,
+            "admissible_unsure": maybe,
             "numbers": sp.numbers(None if N == "auto" else N), "n_rhs": n_rhs, "wall": time.perf_counter() - t0,
             "cpu": time.process_time() - c0}
+
+
+def unsure(row: dict, limits: dict) -> list[str]:
+    """Why a design row's real peaks may not be what the line does (empty: nothing known against them): not
+    resolved in its links (``resolved`` False), or a stretching factor left out (not resolved, no combined
+    answer) on a peak under a limit -- stretching can raise it (the bungee cord's tension x1.21-1.28) or
+    lower it (the climbing rope's x0.5-0.7). A row under the limits for which this is not empty is not
+    counted admissible (:func:`design`'s ``admissible_unsure``)."""
+    why = []
+    if row.get("resolved") is False:
+        why.append("not resolved in the links")
+    st = row.get("stretching") or {}
+    left = [q for q in limits if st.get("run") and not st.get("resolved", {}).get(q, True)]
+    if left:
+        why.append(f"stretching left out of {', '.join(left)} (its factor not resolved; combined=True answers it)")
+    return why
 
 
 def _row_resolved(r: dict):

@@ -94,7 +94,7 @@ def format_design(d: dict) -> list[str]:
             where = f"  {where}{'' if r.get('resolved') else ' (NOT resolved)'}"
         out.append(f"  {r['chi']:6.3g}{i['v_peak']:11.4g}{x['v_peak']:11.4g}{i['a_peak']:11.4g}{x['a_peak']:11.4g}"
                    f"{i['sigma_peak']:11.4g}{x['sigma_peak']:11.4g}{r['factor']['sigma_peak']:10.4f}  "
-                   f"{_cap_word(r['cap']):<12}  {'yes' if r['admissible'] else 'no':>7}  "
+                   f"{_cap_word(r['cap']):<12}  {('yes?' if r.get('unsure') else 'yes') if r['admissible'] else 'no':>7}  "
                    f"{'yes' if r['ideal_admissible'] else 'no':>8}" + where)
     gr = [f"{r['chi']:g} (T +- {r['graded']['relative_error']['sigma_peak']:.2%}"
           + ("" if r["graded"].get("stopped", "within") == "within" else ", NOT all peaks within 1%") + ")"
@@ -112,6 +112,9 @@ def format_design(d: dict) -> list[str]:
         lv = sorted({tuple(x["N"] for x in r["stretching"]["levels"]) for r in d["rows"] if r.get("stretching", {}).get("run")})
         out.append(f"  stretching factor NOT applied (not resolved from {' or '.join(f'{a} to {b}' for a, b in lv)} "
                    f"links) at chi: {'; '.join(st)}")
+    if d.get("admissible_unsure"):
+        out.append("  under the limits but NOT counted admissible: " + "; ".join(
+            f"{x['chi']:g} ({', '.join(x['why'])})" for x in d["admissible_unsure"]))
     ok = d["admissible_chi"]
     out.append(f"  admissible chi (real line): {', '.join(f'{c:g}' for c in ok) if ok else 'none of those tried'}")
     out.append(f"  capped by: the mechanism whose run alone comes nearest the real {q} (none: real/ideal >= 0.9, "
