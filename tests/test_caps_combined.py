@@ -102,7 +102,7 @@ def test_cap_answers_from_the_combined_model_where_the_factor_does_not_settle(mo
     assert r["factor"]["sigma_peak"] == pytest.approx(100.0 / lim, rel=1e-12) and 100.0 / lim < 0.9
     assert r["ideal_on"]["uniform"]["sigma_peak"] < 0.5 * lim * si["sigma_peak"]
     assert r["cap"] == "stretching" and "x0.25" in r["cap_why"] and "x2" in r["cap_why"]
-    assert "ideal chain: v_peak its continuum limit" in "\n".join(caps.format_answer(r))
+    assert "ideal chain: its continuum limit (shipped, snapping.table.limits): v_peak +- " in "\n".join(caps.format_answer(r))
 
 
 def _cg(real, inext, ideal):

@@ -26,7 +26,10 @@ def format_answer(r: dict) -> list[str]:
             e = io["relative_error"][q]
             return f"+- {e:.2%}" if e == e else "(error unknown)"
 
-        out.append("  ideal chain: " + "; ".join(f"{q} {src[io['source'][q]]} {err(q)}" for q in QUANTITIES)
+        groups = {}  # (one phrase per source: the peaks it gives, with their bars)
+        for q in QUANTITIES:
+            groups.setdefault(io["source"][q], []).append(f"{q} {err(q)}")
+        out.append("  ideal chain: " + "; ".join(f"{src[k]}: {', '.join(v)}" for k, v in groups.items())
                    + "".join(f" [{q}: {w}]" for q, w in io.get("why", {}).items())
                    + f" (the ideal's peaks grow with its links; on {io['N']} uniform links: "
                    + ", ".join(f"{q} {io['uniform'][q]:.5g}" for q in QUANTITIES) + ")")
