@@ -239,3 +239,24 @@ def test_design_counts_admissible_only_rows_with_nothing_unsure(monkeypatch):
     text = "\n".join(caps.format_design(d))
     assert "under the limits but NOT counted admissible: 0.1 (not resolved in the links); 0.2 (stretching" in text
     assert "admissible chi (real line): 0.3, 0.4" in text and " yes?" in text
+
+
+def test_a_peak_out_of_the_asymptotic_range_escalates_and_is_not_resolved(monkeypatch):
+    """v and T on an order-2 law; a agrees to 0.1% on levels 0-1 (the two-level estimate says +-0.03%) and then
+    jumps (the rope's acceleration at chi 0.5: 38.7, 39.3, 57.0, 187.8): a third level is run, a's order is
+    negative, so levels are added to max_links and a is left unresolved; v and T stay resolved."""
+    def law(k):
+        x = _law(k)
+        x["a_peak"] = [100.0, 100.1, 150.0, 400.0, 900.0, 2000.0][k]
+        return x
+
+    monkeypatch.setattr(caps_combined, "combined_level", lambda sp, chi, on, k, **kw: law(k))
+    monkeypatch.setattr(caps_combined, "combined_links", lambda chi, k, first=-1: np.ones(100 * 2 ** k))
+    g = caps_combined.combined_answer(None, 0.1, ("bending",), max_links=1000)
+    assert len(g["levels"]) == 4 and g["stopped"] == "max_links"  # (level 4 would need 1600 links)
+    assert not g["resolved"]["a_peak"] and g["resolved"]["v_peak"] and g["resolved"]["sigma_peak"]
+    assert g["asymptotic"] == {"v_peak": True, "a_peak": False, "sigma_peak": True}
+    assert "a_peak converges at no order >= 1" in g["why"]
+    # the order-2 law alone still stops where it did (three levels at least): pair (3, 4)
+    monkeypatch.setattr(caps_combined, "combined_level", lambda sp, chi, on, k, **kw: _law(k))
+    assert caps_combined.combined_answer(None, 0.1, ("bending",))["pair"] == (3, 4)

@@ -515,7 +515,7 @@ def observed_order(f0: float, f1: float, f2: float, ratio: float = 2.0) -> float
 
 
 def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links: int = MAX_ESCALATED_LINKS,
-                  order: float = GRADED_ORDER, quantities=QUANTITIES) -> dict:
+                  order: float = GRADED_ORDER, quantities=QUANTITIES, min_levels: int = 2) -> dict:
     """The graded levels of an answer, escalated: levels 0 and 1 (``run_level(k)``: the peaks of level
     k, {peak: value}), then each next level (``links_of(k)``: its links, without running it) while any
     peak's error estimate -- the Richardson correction of the last two levels at ``order``
@@ -524,7 +524,10 @@ def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links:
     two levels extrapolated: the last two), ``extrapolated``, ``error`` and ``relative_error`` per
     peak, ``observed_order`` per peak (:func:`observed_order` of the last three levels; None with two),
     ``stopped`` (``"within"``: every error <= ``within``; ``"max_links"``: the next level would pass
-    ``max_links``) and ``why`` (in words).
+    ``max_links``) and ``why`` (in words). ``min_levels`` (>= 3): at least that many levels, and from three on a
+    peak whose last three levels do not converge at first order at least (:func:`observed_order` under 1 or
+    nan: not in the asymptotic range, where the order-2 estimate of two levels means nothing) counts as not
+    within (``asymptotic`` per peak).
 
     >>> f = lambda k: {"x": 1.0 + 0.5 * 0.5 ** (2 * k)}                  # 1 + c h^2, h halving
     >>> g = graded_levels(f, lambda k: 100 * 2 ** k, within=0.01, quantities=("x",))
@@ -535,15 +538,21 @@ def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links:
     while True:
         ext = {q: richardson(lv[-2][q], lv[-1][q], order) for q in quantities}
         rel = {q: (ext[q][1] / abs(ext[q][0]) if ext[q][0] != 0.0 else float("inf")) for q in quantities}
-        worst = max(rel, key=lambda q: rel[q])
-        if rel[worst] <= within:
+        asym = {q: True for q in quantities}
+        if min_levels >= 3 and len(lv) >= 3:
+            asym = {q: observed_order(lv[-3][q], lv[-2][q], lv[-1][q]) >= 1.0 for q in quantities}  # (nan: False)
+        judged = {q: rel[q] if asym[q] else float("inf") for q in quantities}
+        worst = max(judged, key=lambda q: judged[q])
+        if judged[worst] <= within and len(lv) >= min_levels:
             stopped, why = "within", (f"every peak's error estimate <= {within:.0%} on levels {len(lv) - 2}-"
                                       f"{len(lv) - 1}")
             break
         n = int(links_of(len(lv)))
         if n > max_links:
-            stopped, why = "max_links", (f"{worst} +- {rel[worst]:.2%} > {within:.0%} on levels {len(lv) - 2}-"
-                                         f"{len(lv) - 1}, but level {len(lv)} would need {n} links (> {max_links})")
+            short = (f"{worst} +- {rel[worst]:.2%} > {within:.0%}" if asym[worst] else
+                     f"{worst} converges at no order >= 1 over levels {len(lv) - 3}-{len(lv) - 1} (not asymptotic)")
+            stopped, why = "max_links", (f"{short} on levels {len(lv) - 2}-{len(lv) - 1}, but level {len(lv)} would "
+                                         f"need {n} links (> {max_links})")
             break
         lv.append(run_level(len(lv)))
     obs = None
@@ -551,4 +560,4 @@ def graded_levels(run_level, links_of, within: float = GRADED_WITHIN, max_links:
         obs = {q: observed_order(lv[-3][q], lv[-2][q], lv[-1][q]) for q in quantities}
     return {"levels": lv, "pair": (len(lv) - 2, len(lv) - 1), "extrapolated": {q: ext[q][0] for q in quantities},
             "error": {q: ext[q][1] for q in quantities}, "relative_error": rel, "observed_order": obs,
-            "stopped": stopped, "why": why}
+            "stopped": stopped, "why": why, "asymptotic": asym}
