@@ -257,6 +257,15 @@ def test_a_peak_out_of_the_asymptotic_range_escalates_and_is_not_resolved(monkey
     assert not g["resolved"]["a_peak"] and g["resolved"]["v_peak"] and g["resolved"]["sigma_peak"]
     assert g["asymptotic"] == {"v_peak": True, "a_peak": False, "sigma_peak": True}
     assert "a_peak converges at no order >= 1" in g["why"]
+    # a creeping a (differences 0.1, 0.4, 0.4: order 0) whose last two levels agree within 1% (+-0.13%): not resolved
+    def creep(k):
+        x = _law(k)
+        x["a_peak"] = [100.0, 100.1, 100.5, 100.9, 101.3][k]
+        return x
+
+    monkeypatch.setattr(caps_combined, "combined_level", lambda sp, chi, on, k, **kw: creep(k))
+    g = caps_combined.combined_answer(None, 0.1, ("bending",), max_links=1000)
+    assert g["relative_error"]["a_peak"] < 0.01 and not g["asymptotic"]["a_peak"] and not g["resolved"]["a_peak"]
     # the order-2 law alone still stops where it did (three levels at least): pair (3, 4)
     monkeypatch.setattr(caps_combined, "combined_level", lambda sp, chi, on, k, **kw: _law(k))
     assert caps_combined.combined_answer(None, 0.1, ("bending",))["pair"] == (3, 4)
