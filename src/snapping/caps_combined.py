@@ -19,8 +19,9 @@ settings (``Elastic(ea=EA/(M g), grid_damping=4)``, start ``"matched"``, ``stop_
 and T peaks, :data:`snapping.regimes_spec.STRETCH_PEAK_ATTRS`), the line's body and masses
 (:func:`snapping.caps_runs.problem` on the graded links), its fast bending waves grid-damped as the
 inextensible answer's (:func:`snapping.caps_runs.method_for`), RODAS4 at :data:`COMBINED_TOL`. The
-answer (:func:`combined_answer`): :func:`snapping.caps_runs.graded_levels` (levels 0 and 1, then more
-while a peak's Richardson estimate at order 2 is over 1%, up to :data:`COMBINED_MAX_LINKS` links).
+answer (:func:`combined_answer`): :func:`snapping.caps_runs.graded_levels` (levels 0-2, :data:`COMBINED_MIN_LEVELS`,
+then more while a peak's Richardson estimate at order 2 is over 1% or its last three levels converge at no order
+>= 1, up to :data:`COMBINED_MAX_LINKS` links).
 
 **The ideal beside it, and the verdict** (:func:`same_links`, :func:`combined_verdict`). The answer's factor is
 taken against the ideal chain's continuum limit (shipped: :mod:`snapping.caps_ideal`). For the verdict, the ideal
